@@ -1,0 +1,195 @@
+//! `mrslc`: the command-line driver of the mrsl compiler.
+
+use clap::{Parser, Subcommand, ValueEnum};
+use codespan_reporting::term::termcolor::{ColorChoice, StandardStream};
+use mrsl::{Diagnostic, KernelKind, Options};
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "mrslc", version, about = "Compiler for mrsl, a multi-rate shading language", long_about = None)]
+struct Cli {
+    /// When to colour diagnostics.
+    #[arg(long, value_enum, default_value_t = Color::Auto, global = true)]
+    color: Color,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Color {
+    Auto,
+    Always,
+    Never,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Check a program and print its diagnostics; exit code 1 if it has errors.
+    Check {
+        /// The .mrsl program.
+        file: PathBuf,
+    },
+    /// Compile a program to WGSL kernels and a layout description.
+    ///
+    /// Writes <name>.coarse.bB.wgsl, <name>.fine.bB.wgsl (B = each block size),
+    /// <name>.reference.wgsl and <name>.layout.json into the output directory.
+    Compile {
+        /// The .mrsl program.
+        file: PathBuf,
+        /// Output directory (created if missing).
+        #[arg(short, long, default_value = ".")]
+        out_dir: PathBuf,
+        /// Print one artifact to standard output instead of writing files.
+        #[arg(long, value_enum)]
+        emit: Option<Emit>,
+        /// Coarse block size(s) to generate kernels for.
+        #[arg(short, long = "block", value_parser = ["2", "4"], default_values = ["2", "4"])]
+        blocks: Vec<String>,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+enum Emit {
+    Coarse,
+    Fine,
+    Reference,
+    Layout,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(&cli) {
+        Ok(code) => code,
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn run(cli: &Cli) -> Result<ExitCode, String> {
+    match &cli.command {
+        Command::Check { file } => {
+            let (name, source) = read(file)?;
+            let diagnostics = mrsl::check(&source);
+            report(cli.color, &diagnostics, &name, &source);
+            let errors = diagnostics.iter().filter(|d| d.is_error()).count();
+            let warnings = diagnostics.len() - errors;
+            if errors > 0 {
+                eprintln!(
+                    "{name}: {errors} error{}, {warnings} warning{}",
+                    plural(errors),
+                    plural(warnings)
+                );
+                Ok(ExitCode::from(1))
+            } else {
+                eprintln!("{name}: ok ({warnings} warning{})", plural(warnings));
+                Ok(ExitCode::SUCCESS)
+            }
+        }
+        Command::Compile {
+            file,
+            out_dir,
+            emit,
+            blocks,
+        } => {
+            let (name, source) = read(file)?;
+            let block_sizes: Vec<u32> = blocks
+                .iter()
+                .map(|b| b.parse().expect("clap restricts block sizes"))
+                .collect();
+            let options = Options {
+                block_sizes: block_sizes.clone(),
+                file_name: name.clone(),
+                ..Options::default()
+            };
+            let program = match mrsl::compile(&source, &options) {
+                Ok(p) => p,
+                Err(diagnostics) => {
+                    report(cli.color, &diagnostics, &name, &source);
+                    return Ok(ExitCode::from(1));
+                }
+            };
+            report(cli.color, &program.warnings, &name, &source);
+            let layout =
+                serde_json::to_string_pretty(&program.layout).map_err(|e| e.to_string())?;
+            if let Some(emit) = emit {
+                let block = *block_sizes.last().unwrap_or(&4);
+                let text = match emit {
+                    Emit::Layout => layout,
+                    Emit::Coarse => program
+                        .kernel(KernelKind::Coarse, block)
+                        .map(|k| k.wgsl.clone())
+                        .unwrap_or_default(),
+                    Emit::Fine => program
+                        .kernel(KernelKind::Fine, block)
+                        .map(|k| k.wgsl.clone())
+                        .unwrap_or_default(),
+                    Emit::Reference => program
+                        .kernel(KernelKind::Reference, block)
+                        .map(|k| k.wgsl.clone())
+                        .unwrap_or_default(),
+                };
+                std::io::stdout()
+                    .write_all(text.as_bytes())
+                    .map_err(|e| e.to_string())?;
+                return Ok(ExitCode::SUCCESS);
+            }
+            std::fs::create_dir_all(out_dir)
+                .map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
+            let stem = file
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("program");
+            let mut written = vec![];
+            for k in &program.kernels {
+                let file_name = match k.block_size {
+                    Some(b) => format!("{stem}.{}.b{b}.wgsl", k.kind.name()),
+                    None => format!("{stem}.{}.wgsl", k.kind.name()),
+                };
+                written.push(write(out_dir, &file_name, &k.wgsl)?);
+            }
+            written.push(write(out_dir, &format!("{stem}.layout.json"), &layout)?);
+            for path in written {
+                eprintln!("wrote {}", path.display());
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+fn read(file: &Path) -> Result<(String, String), String> {
+    let source = std::fs::read_to_string(file)
+        .map_err(|e| format!("cannot read {}: {e}", file.display()))?;
+    Ok((file.display().to_string(), source))
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> Result<PathBuf, String> {
+    let path = dir.join(name);
+    std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    Ok(path)
+}
+
+fn plural(n: usize) -> &'static str {
+    if n == 1 { "" } else { "s" }
+}
+
+/// Prints diagnostics to stderr: coloured on a terminal, plain otherwise.
+fn report(color: Color, diagnostics: &[Diagnostic], name: &str, source: &str) {
+    if diagnostics.is_empty() {
+        return;
+    }
+    let colored = match color {
+        Color::Always => true,
+        Color::Never => false,
+        Color::Auto => std::io::stderr().is_terminal(),
+    };
+    if colored {
+        let mut stream = StandardStream::stderr(ColorChoice::Always);
+        let _ = mrsl::diagnostic::emit_colored(&mut stream, diagnostics, name, source);
+    } else {
+        eprint!("{}", mrsl::render_all(diagnostics, name, source));
+    }
+}

@@ -1,0 +1,175 @@
+//! The one diagnostic type every stage reports through, and its rendering with codespan-reporting.
+
+use crate::syntax::ast::Span;
+use codespan_reporting::diagnostic as cs;
+use codespan_reporting::files::SimpleFile;
+use codespan_reporting::term;
+use serde::Serialize;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, PartialOrd, Ord)]
+#[serde(rename_all = "lowercase")]
+pub enum Severity {
+    Warning,
+    Error,
+    /// A failure of the compiler itself (e.g. naga rejected generated code).
+    Bug,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Label {
+    pub span: Span,
+    pub message: String,
+    pub primary: bool,
+}
+
+impl Label {
+    pub fn primary(span: Span, message: impl Into<String>) -> Label {
+        Label {
+            span,
+            message: message.into(),
+            primary: true,
+        }
+    }
+    pub fn secondary(span: Span, message: impl Into<String>) -> Label {
+        Label {
+            span,
+            message: message.into(),
+            primary: false,
+        }
+    }
+}
+
+/// A message about the program, with the places it concerns.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Diagnostic {
+    pub severity: Severity,
+    /// A stable code, e.g. `E0201`; documented in docs/language.md.
+    pub code: &'static str,
+    pub message: String,
+    pub labels: Vec<Label>,
+    pub notes: Vec<String>,
+}
+
+impl Diagnostic {
+    pub fn error(code: &'static str, message: impl Into<String>) -> Diagnostic {
+        Diagnostic {
+            severity: Severity::Error,
+            code,
+            message: message.into(),
+            labels: vec![],
+            notes: vec![],
+        }
+    }
+    pub fn warning(code: &'static str, message: impl Into<String>) -> Diagnostic {
+        Diagnostic {
+            severity: Severity::Warning,
+            ..Diagnostic::error(code, message)
+        }
+    }
+    pub fn bug(message: impl Into<String>) -> Diagnostic {
+        Diagnostic {
+            severity: Severity::Bug,
+            ..Diagnostic::error("E9000", message)
+        }
+    }
+    pub fn with_label(mut self, label: Label) -> Diagnostic {
+        self.labels.push(label);
+        self
+    }
+    pub fn with_note(mut self, note: impl Into<String>) -> Diagnostic {
+        self.notes.push(note.into());
+        self
+    }
+    pub fn is_error(&self) -> bool {
+        self.severity != Severity::Warning
+    }
+    /// The primary span, if any.
+    pub fn span(&self) -> Option<Span> {
+        self.labels.iter().find(|l| l.primary).map(|l| l.span)
+    }
+
+    fn to_codespan(&self) -> cs::Diagnostic<()> {
+        let severity = match self.severity {
+            Severity::Warning => cs::Severity::Warning,
+            Severity::Error => cs::Severity::Error,
+            Severity::Bug => cs::Severity::Bug,
+        };
+        let labels = self
+            .labels
+            .iter()
+            .map(|l| {
+                let style = if l.primary {
+                    cs::LabelStyle::Primary
+                } else {
+                    cs::LabelStyle::Secondary
+                };
+                cs::Label::new(style, (), l.span.range()).with_message(&l.message)
+            })
+            .collect();
+        cs::Diagnostic::new(severity)
+            .with_code(self.code)
+            .with_message(&self.message)
+            .with_labels(labels)
+            .with_notes(self.notes.clone())
+    }
+
+    /// Renders without colour, as tests and non-terminal output want it.
+    pub fn render(&self, file_name: &str, source: &str) -> String {
+        render_all(std::slice::from_ref(self), file_name, source)
+    }
+}
+
+/// Renders several diagnostics, without colour, one after another.
+pub fn render_all(diagnostics: &[Diagnostic], file_name: &str, source: &str) -> String {
+    let file = SimpleFile::new(file_name, clamp_source(source));
+    let config = term::Config::default();
+    let mut out = String::new();
+    for diagnostic in diagnostics {
+        let d = clamp_spans(diagnostic, source.len());
+        let one = term::emit_into_string(&config, &file, &d.to_codespan()).unwrap_or_else(|_| {
+            format!("{}[{}]: {}\n", severity_word(d.severity), d.code, d.message)
+        });
+        out.push_str(&one);
+    }
+    out
+}
+
+/// Renders with ANSI colour to a writer (a terminal).
+pub fn emit_colored(
+    writer: &mut (impl term::WriteStyle + ?Sized),
+    diagnostics: &[Diagnostic],
+    file_name: &str,
+    source: &str,
+) -> std::io::Result<()> {
+    let file = SimpleFile::new(file_name, clamp_source(source));
+    let config = term::Config::default();
+    for diagnostic in diagnostics {
+        let d = clamp_spans(diagnostic, source.len());
+        term::emit_to_write_style(writer, &config, &file, &d.to_codespan())
+            .map_err(std::io::Error::other)?;
+    }
+    Ok(())
+}
+
+fn severity_word(severity: Severity) -> &'static str {
+    match severity {
+        Severity::Warning => "warning",
+        Severity::Error => "error",
+        Severity::Bug => "bug",
+    }
+}
+
+fn clamp_source(source: &str) -> &str {
+    source
+}
+
+/// Keeps every span inside the source and on char boundaries, so rendering never fails.
+fn clamp_spans(diagnostic: &Diagnostic, len: usize) -> Diagnostic {
+    let mut d = diagnostic.clone();
+    for label in &mut d.labels {
+        let end = (label.span.end as usize).min(len);
+        let start = (label.span.start as usize).min(end);
+        label.span = Span::new(start, end);
+    }
+    d
+}

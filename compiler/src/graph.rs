@@ -1,0 +1,184 @@
+//! The effect dependency graph: rate rules, cycles, and the order effects are computed in.
+
+use crate::check::{Checked, EffectId};
+use crate::diagnostic::{Diagnostic, Label};
+use crate::syntax::ast::{Rate, Span};
+use petgraph::algo::tarjan_scc;
+use petgraph::graph::{DiGraph, NodeIndex};
+
+/// Effects and outputs as nodes, uses as edges (from the used effect to its user).
+#[derive(Debug)]
+pub struct EffectGraph {
+    pub graph: DiGraph<EffectId, Span>,
+    /// Topological order, dependencies first; only effects that reach an output.
+    pub order: Vec<EffectId>,
+    /// For each effect, the effects that read it.
+    pub users: Vec<Vec<EffectId>>,
+    /// Whether an output (transitively) needs the effect.
+    pub live: Vec<bool>,
+}
+
+impl EffectGraph {
+    fn node(id: EffectId) -> NodeIndex {
+        NodeIndex::new(id.index())
+    }
+    /// Every effect `id` needs, transitively, including itself; in `order`.
+    pub fn closure(&self, id: EffectId, checked: &Checked) -> Vec<EffectId> {
+        let mut needed = vec![false; checked.effects.len()];
+        let mut stack = vec![id];
+        while let Some(e) = stack.pop() {
+            if !std::mem::replace(&mut needed[e.index()], true) {
+                stack.extend(checked.effects[e.index()].deps.iter().map(|(d, _)| *d));
+            }
+        }
+        self.order
+            .iter()
+            .copied()
+            .filter(|e| needed[e.index()])
+            .collect()
+    }
+}
+
+/// Builds the graph and checks the rate rules and acyclicity.
+pub fn build(checked: &Checked) -> (EffectGraph, Vec<Diagnostic>) {
+    let mut diagnostics = vec![];
+    let effects = &checked.effects;
+    // Phase 1: register every node; ids and node indices coincide.
+    let mut graph = DiGraph::with_capacity(effects.len(), effects.len() * 2);
+    for i in 0..effects.len() {
+        graph.add_node(EffectId(i as u32));
+    }
+    // Phase 2: edges, checking that coarse effects read only coarse effects.
+    let mut users = vec![vec![]; effects.len()];
+    for (i, e) in effects.iter().enumerate() {
+        let user = EffectId(i as u32);
+        for &(dep, span) in &e.deps {
+            graph.add_edge(EffectGraph::node(dep), EffectGraph::node(user), span);
+            users[dep.index()].push(user);
+            let d = &effects[dep.index()];
+            if e.rate == Rate::Coarse && d.rate != Rate::Coarse {
+                diagnostics.push(
+                    Diagnostic::error("E0310", format!("coarse effect `{}` depends on fine {} `{}`", e.name, if d.rate == Rate::Out { "output" } else { "effect" }, d.name))
+                        .with_label(Label::primary(span, format!("`{}` is only available per pixel", d.name)))
+                        .with_label(Label::secondary(checked.effect_decl(dep).rate_span, "declared fine here"))
+                        .with_label(Label::secondary(checked.effect_decl(user).rate_span, "declared coarse here"))
+                        .with_note("a coarse sample is shaded before any fine effect; make the dependency coarse or this effect fine"),
+                );
+            }
+        }
+    }
+    // Phase 3: strongly connected components; each non-trivial one is a cycle.
+    let mut cyclic = false;
+    for scc in tarjan_scc(&graph) {
+        let is_cycle = scc.len() > 1 || graph.contains_edge(scc[0], scc[0]);
+        if !is_cycle {
+            continue;
+        }
+        cyclic = true;
+        let path = cycle_path(&graph, &scc);
+        let names: Vec<&str> = path
+            .iter()
+            .map(|n| effects[graph[*n].index()].name.as_str())
+            .collect();
+        let mut shown = names.clone();
+        shown.push(names[0]);
+        let mut d = Diagnostic::error(
+            "E0311",
+            format!(
+                "effects depend on each other in a cycle: {}",
+                shown.join(" -> ")
+            ),
+        );
+        for (k, &n) in path.iter().enumerate() {
+            let next = path[(k + 1) % path.len()];
+            let user = &effects[graph[next].index()];
+            let span = user
+                .deps
+                .iter()
+                .find(|(dep, _)| *dep == graph[n])
+                .map(|(_, s)| *s)
+                .unwrap_or(user.name_span);
+            let message = format!("`{}` reads `{}`", user.name, effects[graph[n].index()].name);
+            d = d.with_label(if k == 0 {
+                Label::primary(span, message)
+            } else {
+                Label::secondary(span, message)
+            });
+        }
+        diagnostics.push(d.with_note(
+            "effects form a DAG: break the cycle by computing one value from the inputs directly",
+        ));
+    }
+    // Phase 4: liveness and topological order (skipped for cyclic graphs).
+    let mut live = vec![false; effects.len()];
+    let mut stack: Vec<EffectId> = effects
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e.rate == Rate::Out)
+        .map(|(i, _)| EffectId(i as u32))
+        .collect();
+    while let Some(e) = stack.pop() {
+        if !std::mem::replace(&mut live[e.index()], true) {
+            stack.extend(effects[e.index()].deps.iter().map(|(d, _)| *d));
+        }
+    }
+    let order = if cyclic {
+        vec![]
+    } else {
+        petgraph::algo::toposort(&graph, None)
+            .map(|nodes| {
+                nodes
+                    .into_iter()
+                    .map(|n| graph[n])
+                    .filter(|e| live[e.index()])
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    (
+        EffectGraph {
+            graph,
+            order,
+            users,
+            live,
+        },
+        diagnostics,
+    )
+}
+
+/// A simple cycle through the nodes of one strongly connected component,
+/// starting from its first declared effect.
+fn cycle_path(graph: &DiGraph<EffectId, Span>, scc: &[NodeIndex]) -> Vec<NodeIndex> {
+    let start = *scc.iter().min().expect("an SCC is never empty");
+    let in_scc = |n: NodeIndex| scc.contains(&n);
+    // Depth-first search for a path back to `start` within the component.
+    let mut path = vec![start];
+    let mut visited = vec![start];
+    fn dfs(
+        graph: &DiGraph<EffectId, Span>,
+        start: NodeIndex,
+        path: &mut Vec<NodeIndex>,
+        visited: &mut Vec<NodeIndex>,
+        in_scc: &dyn Fn(NodeIndex) -> bool,
+    ) -> bool {
+        let current = *path.last().expect("path starts non-empty");
+        let mut next: Vec<NodeIndex> = graph.neighbors(current).collect();
+        next.sort();
+        for n in next {
+            if n == start {
+                return true;
+            }
+            if in_scc(n) && !visited.contains(&n) {
+                visited.push(n);
+                path.push(n);
+                if dfs(graph, start, path, visited, in_scc) {
+                    return true;
+                }
+                path.pop();
+            }
+        }
+        false
+    }
+    dfs(graph, start, &mut path, &mut visited, &in_scc);
+    path
+}

@@ -1,0 +1,211 @@
+//! mrsl: a compiler for a multi-rate shading language.
+//!
+//! A program declares G-buffer inputs, uniforms, functions and *effects* at
+//! coarse or fine rate; coarse effects may `refine` themselves where they are
+//! not smooth. [`compile`] turns the source into three WGSL compute kernels
+//! (coarse, fine, reference), validated by naga, and a [`Layout`] describing
+//! every binding and the coarse-to-fine interface.
+//!
+//! ```
+//! let source = "
+//!     in float3 normal;
+//!     uniform float3 light = float3(0.0, 1.0, 0.0);
+//!     coarse effect float diffuse {
+//!         diffuse = saturate(dot(normal, light));
+//!         if (fwidth(diffuse) > 0.05) refine;
+//!     }
+//!     fine out float4 color = float4(float3(diffuse), 1.0);
+//! ";
+//! let program = mrsl::compile(source, &mrsl::Options::default()).expect("valid program");
+//! assert!(program.kernel(mrsl::KernelKind::Fine, 4).unwrap().wgsl.contains("fn fine_main"));
+//! assert_eq!(program.layout.interface.slots.len(), 1);
+//! ```
+//!
+//! The crate does no I/O and touches no GPU: everything here runs anywhere.
+
+pub mod check;
+pub mod deriv;
+pub mod diagnostic;
+pub mod graph;
+pub mod interface;
+pub mod layout;
+pub mod syntax;
+pub mod types;
+pub mod wgsl;
+
+pub use diagnostic::{Diagnostic, Label, Severity, render_all};
+pub use layout::Layout;
+pub use wgsl::KernelKind;
+
+/// Which kernels to generate, and for which block sizes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Options {
+    /// Coarse block sizes to generate coarse and fine kernels for (2 and/or 4).
+    pub block_sizes: Vec<u32>,
+    pub coarse: bool,
+    pub fine: bool,
+    pub reference: bool,
+    /// Name shown in diagnostics and generated-code headers.
+    pub file_name: String,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            block_sizes: vec![2, 4],
+            coarse: true,
+            fine: true,
+            reference: true,
+            file_name: "program.mrsl".into(),
+        }
+    }
+}
+
+/// Block sizes the generated kernels support.
+pub const BLOCK_SIZES: [u32; 2] = [2, 4];
+
+/// One generated WGSL compute kernel.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Kernel {
+    pub kind: KernelKind,
+    /// Coarse block size; `None` for the reference kernel.
+    pub block_size: Option<u32>,
+    pub entry_point: &'static str,
+    pub workgroup_size: [u32; 3],
+    pub wgsl: String,
+}
+
+/// A compiled program.
+#[derive(Debug, Clone)]
+pub struct Program {
+    pub kernels: Vec<Kernel>,
+    pub layout: Layout,
+    /// Warnings (the program compiled regardless).
+    pub warnings: Vec<Diagnostic>,
+}
+
+impl Program {
+    /// The kernel of `kind` for block size `block` (ignored for the reference kernel).
+    pub fn kernel(&self, kind: KernelKind, block: u32) -> Option<&Kernel> {
+        self.kernels.iter().find(|k| {
+            k.kind == kind && (kind == KernelKind::Reference || k.block_size == Some(block))
+        })
+    }
+}
+
+/// Parses and checks a program without generating code: every diagnostic,
+/// errors and warnings, in source order.
+pub fn check(source: &str) -> Vec<Diagnostic> {
+    match analyse(source, "program.mrsl") {
+        Ok((_, warnings)) => warnings,
+        Err(diagnostics) => diagnostics,
+    }
+}
+
+/// Compiles a program to kernels and a layout, or returns its diagnostics
+/// (errors, and warnings found alongside them).
+pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnostic>> {
+    if let Some(bad) = options
+        .block_sizes
+        .iter()
+        .find(|b| !BLOCK_SIZES.contains(b))
+    {
+        return Err(vec![
+            Diagnostic::error("E0900", format!("unsupported block size {bad}"))
+                .with_note("supported block sizes: 2, 4"),
+        ]);
+    }
+    let program = syntax::parse(source).map_err(|d| vec![d])?;
+    let (checked, mut diagnostics) = check::check(&program);
+    let (graph, graph_diagnostics) = graph::build(&checked);
+    diagnostics.extend(graph_diagnostics);
+    let (deriv, deriv_diagnostics) = deriv::analyse(&checked);
+    diagnostics.extend(deriv_diagnostics);
+    sort(&mut diagnostics);
+    if diagnostics.iter().any(|d| d.is_error()) {
+        return Err(diagnostics);
+    }
+    let interface = interface::allocate(&checked, &graph);
+    let layout = layout::build(&checked, &graph, &interface);
+    let inputs = wgsl::Inputs {
+        checked: &checked,
+        graph: &graph,
+        interface: &interface,
+        deriv: &deriv,
+        layout: &layout,
+        file_name: &options.file_name,
+        source,
+    };
+    let mut kernels = vec![];
+    let mut wanted = vec![];
+    for &b in &options.block_sizes {
+        if options.coarse {
+            wanted.push((KernelKind::Coarse, Some(b)));
+        }
+        if options.fine {
+            wanted.push((KernelKind::Fine, Some(b)));
+        }
+    }
+    if options.reference {
+        wanted.push((KernelKind::Reference, None));
+    }
+    for (kind, block) in wanted {
+        let wgsl = wgsl::write_string(&inputs, kind, block.unwrap_or(1));
+        if let Err(message) = validate_wgsl(&wgsl) {
+            let what = match block {
+                Some(b) => format!("{} kernel ({b}x{b})", kind.name()),
+                None => format!("{} kernel", kind.name()),
+            };
+            return Err(vec![
+                Diagnostic::bug(format!("internal compiler error: the generated {what} failed naga validation"))
+                    .with_note("the program passed every check, so this is a bug in mrsl; please report it with the program")
+                    .with_note(message),
+            ]);
+        }
+        kernels.push(Kernel {
+            kind,
+            block_size: block,
+            entry_point: kind.entry_point(),
+            workgroup_size: kind.workgroup_size(),
+            wgsl,
+        });
+    }
+    Ok(Program {
+        kernels,
+        layout,
+        warnings: diagnostics,
+    })
+}
+
+/// Runs the front end and all checks; returns warnings on success.
+fn analyse(source: &str, _file_name: &str) -> Result<((), Vec<Diagnostic>), Vec<Diagnostic>> {
+    let program = syntax::parse(source).map_err(|d| vec![d])?;
+    let (checked, mut diagnostics) = check::check(&program);
+    let (_, graph_diagnostics) = graph::build(&checked);
+    diagnostics.extend(graph_diagnostics);
+    let (_, deriv_diagnostics) = deriv::analyse(&checked);
+    diagnostics.extend(deriv_diagnostics);
+    sort(&mut diagnostics);
+    if diagnostics.iter().any(|d| d.is_error()) {
+        Err(diagnostics)
+    } else {
+        Ok(((), diagnostics))
+    }
+}
+
+fn sort(diagnostics: &mut [Diagnostic]) {
+    diagnostics.sort_by_key(|d| (d.span().map(|s| s.start).unwrap_or(u32::MAX), d.code));
+}
+
+/// Parses and validates WGSL with naga, as WebGPU requires (no optional capabilities).
+pub fn validate_wgsl(wgsl: &str) -> Result<(), String> {
+    let module = naga::front::wgsl::parse_str(wgsl)
+        .map_err(|e| e.emit_to_string_with_path(wgsl, "generated.wgsl"))?;
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::empty(),
+    )
+    .validate(&module)
+    .map_err(|e| e.emit_to_string_with_path(wgsl, "generated.wgsl"))?;
+    Ok(())
+}

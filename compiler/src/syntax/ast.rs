@@ -1,0 +1,320 @@
+//! The abstract syntax tree, exactly as written, with a span on every node.
+//!
+//! The tree is never rewritten after parsing: analyses keep their results in
+//! side tables keyed by [`NodeId`] (see `check`), as naga's `ModuleInfo` does.
+
+use serde::Serialize;
+
+/// A byte range in the source.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, PartialOrd, Ord)]
+pub struct Span {
+    pub start: u32,
+    pub end: u32,
+}
+
+impl Span {
+    pub fn new(start: usize, end: usize) -> Span {
+        Span {
+            start: start as u32,
+            end: end as u32,
+        }
+    }
+    pub fn range(self) -> std::ops::Range<usize> {
+        self.start as usize..self.end as usize
+    }
+    pub fn to(self, other: Span) -> Span {
+        Span {
+            start: self.start.min(other.start),
+            end: self.end.max(other.end),
+        }
+    }
+}
+
+/// Identifies an expression or statement; dense, starting at 0, in parse order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct NodeId(pub u32);
+
+/// Hands out [`NodeId`]s while parsing.
+#[derive(Debug, Default)]
+pub struct IdGen(std::cell::Cell<u32>);
+
+impl IdGen {
+    pub fn next(&self) -> NodeId {
+        let id = self.0.get();
+        self.0.set(id + 1);
+        NodeId(id)
+    }
+    pub fn count(&self) -> u32 {
+        self.0.get()
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ident {
+    pub name: String,
+    pub span: Span,
+}
+
+/// `@name` or `@name(args)` before a declaration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Attribute {
+    pub name: Ident,
+    pub args: Vec<Expr>,
+    pub span: Span,
+}
+
+/// A type as written: a name, resolved by the checker.
+pub type TypeName = Ident;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Program {
+    pub items: Vec<Item>,
+    /// How many [`NodeId`]s the parser handed out.
+    pub node_count: u32,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Item {
+    Input(InputDecl),
+    Uniform(UniformDecl),
+    Const(ConstDecl),
+    Function(FunctionDecl),
+    Effect(EffectDecl),
+}
+
+impl Item {
+    pub fn name(&self) -> &Ident {
+        match self {
+            Item::Input(d) => &d.name,
+            Item::Uniform(d) => &d.name,
+            Item::Const(d) => &d.name,
+            Item::Function(d) => &d.name,
+            Item::Effect(d) => &d.name,
+        }
+    }
+    pub fn attrs(&self) -> &[Attribute] {
+        match self {
+            Item::Input(d) => &d.attrs,
+            Item::Uniform(d) => &d.attrs,
+            Item::Effect(d) => &d.attrs,
+            Item::Const(_) | Item::Function(_) => &[],
+        }
+    }
+}
+
+/// `in float3 normal;`: a G-buffer channel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputDecl {
+    pub attrs: Vec<Attribute>,
+    pub ty: TypeName,
+    pub name: Ident,
+    pub span: Span,
+}
+
+/// `uniform float x = 1.0;`, `uniform float4 lights[8];`, `uniform texture2d t;`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UniformDecl {
+    pub attrs: Vec<Attribute>,
+    pub ty: TypeName,
+    pub name: Ident,
+    pub array_len: Option<Expr>,
+    pub default: Option<Expr>,
+    pub span: Span,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConstDecl {
+    pub ty: TypeName,
+    pub name: Ident,
+    pub value: Expr,
+    pub span: Span,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Param {
+    pub ty: TypeName,
+    pub name: Ident,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct FunctionDecl {
+    pub ret: TypeName,
+    pub name: Ident,
+    pub params: Vec<Param>,
+    pub body: Block,
+    pub span: Span,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Rate {
+    /// `coarse effect`: once per coarse sample, resampled or refined.
+    Coarse,
+    /// `fine effect`: once per pixel.
+    Fine,
+    /// `fine out`: once per pixel, written to an output target.
+    Out,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum EffectBody {
+    /// `= expr;`
+    Expr(Expr),
+    /// `{ statements }`, assigning the effect's own name.
+    Block(Block),
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct EffectDecl {
+    pub attrs: Vec<Attribute>,
+    pub rate: Rate,
+    /// The span of the rate keywords (`coarse effect`, `fine out`).
+    pub rate_span: Span,
+    pub ty: TypeName,
+    pub name: Ident,
+    pub body: EffectBody,
+    pub span: Span,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Block {
+    pub stmts: Vec<Stmt>,
+    pub span: Span,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stmt {
+    pub id: NodeId,
+    pub span: Span,
+    pub kind: StmtKind,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AssignOp {
+    Set,
+    Add,
+    Sub,
+    Mul,
+    Div,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum StmtKind {
+    /// `float x = e;` or `float x;` (zero-initialised).
+    Local {
+        ty: TypeName,
+        name: Ident,
+        init: Option<Expr>,
+    },
+    /// `target op= value;`
+    Assign {
+        target: Expr,
+        op: AssignOp,
+        value: Expr,
+    },
+    /// `x++` / `x--` (as statements only).
+    Step {
+        target: Expr,
+        increment: bool,
+    },
+    If {
+        cond: Expr,
+        then: Box<Stmt>,
+        otherwise: Option<Box<Stmt>>,
+    },
+    For {
+        init: Option<Box<Stmt>>,
+        cond: Option<Expr>,
+        step: Option<Box<Stmt>>,
+        body: Box<Stmt>,
+    },
+    Block(Block),
+    Refine,
+    Return(Option<Expr>),
+    Break,
+    Continue,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum UnaryOp {
+    Neg,
+    Not,
+    BitNot,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum BinaryOp {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Rem,
+    Shl,
+    Shr,
+    BitAnd,
+    BitOr,
+    BitXor,
+    And,
+    Or,
+    Eq,
+    Ne,
+    Lt,
+    Gt,
+    Le,
+    Ge,
+}
+
+impl BinaryOp {
+    pub fn symbol(self) -> &'static str {
+        use BinaryOp::*;
+        match self {
+            Add => "+",
+            Sub => "-",
+            Mul => "*",
+            Div => "/",
+            Rem => "%",
+            Shl => "<<",
+            Shr => ">>",
+            BitAnd => "&",
+            BitOr => "|",
+            BitXor => "^",
+            And => "&&",
+            Or => "||",
+            Eq => "==",
+            Ne => "!=",
+            Lt => "<",
+            Gt => ">",
+            Le => "<=",
+            Ge => ">=",
+        }
+    }
+}
+
+/// Integer literal suffix: none (adapts to context), `u` or `i`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IntSuffix {
+    None,
+    U,
+    I,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Expr {
+    pub id: NodeId,
+    pub span: Span,
+    pub kind: ExprKind,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum ExprKind {
+    Int(u64, IntSuffix),
+    Float(f64),
+    Bool(bool),
+    Name(String),
+    Unary(UnaryOp, Box<Expr>),
+    Binary(BinaryOp, Box<Expr>, Box<Expr>),
+    Ternary(Box<Expr>, Box<Expr>, Box<Expr>),
+    Call { callee: Ident, args: Vec<Expr> },
+    Field { base: Box<Expr>, field: Ident },
+    Index { base: Box<Expr>, index: Box<Expr> },
+}

@@ -1,0 +1,233 @@
+//! The types of mrsl values, their WGSL spelling and host layout rules.
+
+use serde::Serialize;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Scalar {
+    Bool,
+    Int,
+    Uint,
+    Float,
+}
+
+impl Scalar {
+    pub fn name(self) -> &'static str {
+        match self {
+            Scalar::Bool => "bool",
+            Scalar::Int => "int",
+            Scalar::Uint => "uint",
+            Scalar::Float => "float",
+        }
+    }
+    pub fn wgsl(self) -> &'static str {
+        match self {
+            Scalar::Bool => "bool",
+            Scalar::Int => "i32",
+            Scalar::Uint => "u32",
+            Scalar::Float => "f32",
+        }
+    }
+}
+
+/// A type. `AbstractInt`/`AbstractFloat` are the types of unsuffixed literals
+/// (and constant expressions of them); they convert to a concrete type where
+/// one is expected, exactly as WGSL's abstract numerics do.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub enum Type {
+    Scalar(Scalar),
+    Vector(Scalar, u8),
+    /// Square float matrices only (`float2x2`, `float3x3`, `float4x4`).
+    Matrix(u8),
+    Texture2d,
+    Sampler,
+    /// Uniform arrays only.
+    Array(Box<Type>, u32),
+    AbstractInt,
+    AbstractFloat,
+    /// The type of an expression that already produced an error; never reported again.
+    Error,
+}
+
+pub const FLOAT: Type = Type::Scalar(Scalar::Float);
+pub const INT: Type = Type::Scalar(Scalar::Int);
+pub const UINT: Type = Type::Scalar(Scalar::Uint);
+pub const BOOL: Type = Type::Scalar(Scalar::Bool);
+
+impl Type {
+    /// Parses a type name as written in mrsl.
+    pub fn from_name(name: &str) -> Option<Type> {
+        let scalar = |s: &str| match s {
+            "bool" => Some(Scalar::Bool),
+            "int" => Some(Scalar::Int),
+            "uint" => Some(Scalar::Uint),
+            "float" => Some(Scalar::Float),
+            _ => None,
+        };
+        match name {
+            "texture2d" => return Some(Type::Texture2d),
+            "sampler" => return Some(Type::Sampler),
+            "float2x2" => return Some(Type::Matrix(2)),
+            "float3x3" => return Some(Type::Matrix(3)),
+            "float4x4" => return Some(Type::Matrix(4)),
+            _ => {}
+        }
+        if let Some(s) = scalar(name) {
+            return Some(Type::Scalar(s));
+        }
+        let (base, n) = name.split_at(name.len().checked_sub(1)?);
+        let n: u8 = n.parse().ok()?;
+        if (2..=4).contains(&n) {
+            return scalar(base).map(|s| Type::Vector(s, n));
+        }
+        None
+    }
+
+    pub fn scalar(&self) -> Option<Scalar> {
+        match self {
+            Type::Scalar(s) | Type::Vector(s, _) => Some(*s),
+            Type::Matrix(_) => Some(Scalar::Float),
+            Type::AbstractFloat => Some(Scalar::Float),
+            Type::AbstractInt => Some(Scalar::Int),
+            _ => None,
+        }
+    }
+
+    /// Number of 32-bit components.
+    pub fn components(&self) -> u32 {
+        match self {
+            Type::Scalar(_) | Type::AbstractInt | Type::AbstractFloat => 1,
+            Type::Vector(_, n) => *n as u32,
+            Type::Matrix(n) => (*n as u32) * (*n as u32),
+            Type::Array(t, n) => t.components() * n,
+            _ => 0,
+        }
+    }
+
+    pub fn vector_len(&self) -> Option<u8> {
+        match self {
+            Type::Vector(_, n) => Some(*n),
+            _ => None,
+        }
+    }
+
+    pub fn is_error(&self) -> bool {
+        matches!(self, Type::Error)
+    }
+    pub fn is_abstract(&self) -> bool {
+        matches!(self, Type::AbstractInt | Type::AbstractFloat)
+    }
+    pub fn is_numeric_value(&self) -> bool {
+        matches!(
+            self.scalar(),
+            Some(Scalar::Int | Scalar::Uint | Scalar::Float)
+        ) && !matches!(self, Type::Array(..))
+    }
+    /// float, floatN, or an abstract literal that can become one.
+    pub fn is_float_like(&self) -> bool {
+        matches!(
+            self,
+            Type::Scalar(Scalar::Float)
+                | Type::Vector(Scalar::Float, _)
+                | Type::AbstractFloat
+                | Type::AbstractInt
+        )
+    }
+    /// A plain value that can live in a variable, the interface or an output.
+    pub fn is_value(&self) -> bool {
+        matches!(self, Type::Scalar(_) | Type::Vector(..) | Type::Matrix(_))
+    }
+
+    /// The concrete type an abstract one becomes with no other constraint.
+    pub fn concretize(&self) -> Type {
+        match self {
+            Type::AbstractInt => INT,
+            Type::AbstractFloat => FLOAT,
+            other => other.clone(),
+        }
+    }
+
+    /// Whether a value of `self` may be used where `target` is expected
+    /// (equal, or an abstract literal that converts).
+    pub fn converts_to(&self, target: &Type) -> bool {
+        if self == target || self.is_error() || target.is_error() {
+            return true;
+        }
+        match (self, target) {
+            (Type::AbstractInt, Type::Scalar(Scalar::Int | Scalar::Uint | Scalar::Float)) => true,
+            (Type::AbstractInt, Type::AbstractFloat) => true,
+            (Type::AbstractFloat, Type::Scalar(Scalar::Float)) => true,
+            _ => false,
+        }
+    }
+
+    /// The mrsl spelling, for diagnostics.
+    pub fn name(&self) -> String {
+        match self {
+            Type::Scalar(s) => s.name().to_string(),
+            Type::Vector(s, n) => format!("{}{n}", s.name()),
+            Type::Matrix(n) => format!("float{n}x{n}"),
+            Type::Texture2d => "texture2d".into(),
+            Type::Sampler => "sampler".into(),
+            Type::Array(t, n) => format!("{}[{n}]", t.name()),
+            Type::AbstractInt => "int literal".into(),
+            Type::AbstractFloat => "float literal".into(),
+            Type::Error => "{error}".into(),
+        }
+    }
+
+    /// The WGSL spelling.
+    pub fn wgsl(&self) -> String {
+        match self {
+            Type::Scalar(s) => s.wgsl().to_string(),
+            Type::Vector(s, n) => format!("vec{n}<{}>", s.wgsl()),
+            Type::Matrix(n) => format!("mat{n}x{n}<f32>"),
+            Type::Texture2d => "texture_2d<f32>".into(),
+            Type::Sampler => "sampler".into(),
+            Type::Array(t, n) => format!("array<{}, {n}>", t.wgsl()),
+            Type::AbstractInt => "i32".into(),
+            Type::AbstractFloat => "f32".into(),
+            Type::Error => "f32".into(),
+        }
+    }
+
+    /// WGSL host-shareable (uniform address space) alignment and size in bytes.
+    /// `bool` is stored as a `u32`.
+    pub fn uniform_align_size(&self) -> (u32, u32) {
+        match self {
+            Type::Scalar(_) => (4, 4),
+            Type::Vector(_, 2) => (8, 8),
+            Type::Vector(_, 3) => (16, 12),
+            Type::Vector(_, _) => (16, 16),
+            Type::Matrix(2) => (8, 16),
+            Type::Matrix(3) => (16, 48),
+            Type::Matrix(_) => (16, 64),
+            Type::Array(t, n) => {
+                let (align, size) = t.uniform_align_size();
+                let stride = round_up(size, align.max(16));
+                (align.max(16), stride * n)
+            }
+            _ => (4, 4),
+        }
+    }
+
+    /// The type as stored in a host-shareable buffer (bool becomes u32).
+    pub fn host_type(&self) -> Type {
+        match self {
+            Type::Scalar(Scalar::Bool) => UINT,
+            Type::Vector(Scalar::Bool, n) => Type::Vector(Scalar::Uint, *n),
+            Type::Array(t, n) => Type::Array(Box::new(t.host_type()), *n),
+            other => other.clone(),
+        }
+    }
+}
+
+pub fn round_up(value: u32, align: u32) -> u32 {
+    value.div_ceil(align) * align
+}
+
+impl std::fmt::Display for Type {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.name())
+    }
+}

@@ -1,0 +1,1470 @@
+//! WGSL code generation: the coarse, fine and reference compute kernels.
+//!
+//! All three kernels share the same per-effect functions
+//! (`mrsl_eval_<effect>`); they differ in what a "position" is (a coarse
+//! sample or a pixel), in how an effect's value at another position is
+//! obtained (`mrsl_at_<effect>`, used by derivatives), and in their entry
+//! point. See docs/language.md, "What the kernels do", for the contract.
+
+use crate::check::{Callee, Checked, EffectId, KeyCompare, LocalId, Symbol, UniformKind};
+use crate::deriv::{DerivInfo, visit_expr, visit_stmt_exprs};
+use crate::graph::EffectGraph;
+use crate::interface::Interface;
+use crate::layout::{self, Layout};
+use crate::syntax::ast::*;
+use crate::types::{Scalar, Type};
+use std::collections::{BTreeSet, HashMap};
+
+/// Which kernel to write.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum KernelKind {
+    /// One invocation per coarse sample: coarse effects, refine flags, interface writes.
+    Coarse,
+    /// One invocation per pixel: resample or re-evaluate coarse effects, then fine effects and outputs.
+    Fine,
+    /// One invocation per pixel: every effect evaluated per pixel.
+    Reference,
+}
+
+impl KernelKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            KernelKind::Coarse => "coarse",
+            KernelKind::Fine => "fine",
+            KernelKind::Reference => "reference",
+        }
+    }
+    pub fn entry_point(self) -> &'static str {
+        match self {
+            KernelKind::Coarse => "coarse_main",
+            KernelKind::Fine => "fine_main",
+            KernelKind::Reference => "reference_main",
+        }
+    }
+    pub fn workgroup_size(self) -> [u32; 3] {
+        match self {
+            KernelKind::Coarse => [8, 8, 1],
+            _ => [layout::TILE * layout::TILE, 1, 1],
+        }
+    }
+}
+
+/// Everything the writer reads.
+pub struct Inputs<'a, 'b> {
+    pub checked: &'b Checked<'a>,
+    pub graph: &'b EffectGraph,
+    pub interface: &'b Interface,
+    pub deriv: &'b DerivInfo<'a>,
+    pub layout: &'b Layout,
+    pub file_name: &'b str,
+    pub source: &'b str,
+}
+
+/// Writes one kernel. `block` is the coarse block size (ignored by the reference kernel).
+pub fn write_string(inputs: &Inputs, kind: KernelKind, block: u32) -> String {
+    let mut w = Writer::new(
+        inputs,
+        kind,
+        if kind == KernelKind::Reference {
+            1
+        } else {
+            block
+        },
+    );
+    w.module();
+    w.out
+}
+
+/// Renames user identifiers that collide with WGSL keywords, WGSL builtins or
+/// the generated `mrsl_` namespace, so source names survive everywhere else.
+fn wgsl_ident(name: &str) -> String {
+    let reserved = naga::keywords::wgsl::RESERVED.contains(&name)
+        || naga::keywords::wgsl::BUILTIN_IDENTIFIERS.contains(&name)
+        || name.starts_with("mrsl_")
+        || name.starts_with("__")
+        || matches!(name, "u" | "pos");
+    if reserved {
+        format!("{name}_")
+    } else {
+        name.to_string()
+    }
+}
+
+/// Names of the module-scope values each kind of symbol becomes.
+fn local_name(checked: &Checked, id: LocalId) -> String {
+    let info = &checked.locals[id.index()];
+    // Locals may shadow module-scope user names (C allows it, WGSL would then
+    // hide the function or texture), so they are suffixed when they would.
+    let base = wgsl_ident(&info.name);
+    let clashes = checked.functions.iter().any(|f| f.name == info.name)
+        || checked.consts.iter().any(|c| c.name == info.name)
+        || checked
+            .uniforms
+            .iter()
+            .any(|u| u.name == info.name && !matches!(u.kind, UniformKind::Value { .. }));
+    if clashes { format!("{base}_l") } else { base }
+}
+
+#[derive(Clone, Copy)]
+enum Mode<'s> {
+    /// Inside an effect body or function: names are in scope.
+    Body,
+    /// Rebuilding a derivative operand at another position.
+    Neighbour(&'s crate::deriv::DerivSite<'s>),
+}
+
+struct Writer<'i, 'a, 'b> {
+    i: &'i Inputs<'a, 'b>,
+    kind: KernelKind,
+    block: u32,
+    out: String,
+    /// Live coarse effects, numbered for the fine kernel's refine masks.
+    coarse_index: HashMap<EffectId, u32>,
+}
+
+impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
+    fn new(i: &'i Inputs<'a, 'b>, kind: KernelKind, block: u32) -> Self {
+        let coarse_index = i
+            .graph
+            .order
+            .iter()
+            .filter(|e| i.checked.effects[e.index()].rate == Rate::Coarse)
+            .enumerate()
+            .map(|(k, e)| (*e, k as u32))
+            .collect();
+        Writer {
+            i,
+            kind,
+            block,
+            out: String::new(),
+            coarse_index,
+        }
+    }
+
+    fn checked(&self) -> &'b Checked<'a> {
+        self.i.checked
+    }
+
+    fn line(&mut self, indent: usize, text: impl AsRef<str>) {
+        for _ in 0..indent {
+            self.out.push_str("    ");
+        }
+        self.out.push_str(text.as_ref());
+        self.out.push('\n');
+    }
+
+    fn effect_name(&self, e: EffectId) -> String {
+        wgsl_ident(&self.checked().effects[e.index()].name)
+    }
+
+    fn line_of(&self, span: Span) -> usize {
+        self.i.source[..(span.start as usize).min(self.i.source.len())]
+            .matches('\n')
+            .count()
+            + 1
+    }
+
+    fn module(&mut self) {
+        let c = self.checked();
+        let what = match self.kind {
+            KernelKind::Coarse => format!(
+                "coarse kernel, {b}x{b} blocks: one invocation per coarse sample",
+                b = self.block
+            ),
+            KernelKind::Fine => format!(
+                "fine kernel, {b}x{b} blocks: one invocation per pixel",
+                b = self.block
+            ),
+            KernelKind::Reference => "reference kernel: every effect per pixel".to_string(),
+        };
+        self.line(
+            0,
+            format!(
+                "// Generated by mrslc {} from `{}`: {what}.",
+                env!("CARGO_PKG_VERSION"),
+                self.i.file_name
+            ),
+        );
+        self.line(0, "// Bindings and the interface layout are described by the layout JSON emitted alongside.");
+        self.line(0, "");
+        self.line(0, format!("const MRSL_BLOCK: i32 = {};", self.block));
+        if self.kind != KernelKind::Reference {
+            self.line(
+                0,
+                format!("const MRSL_STRIDE: u32 = {}u;", self.i.interface.stride),
+            );
+        }
+        self.line(0, "");
+        self.bindings();
+        // Constants.
+        for (k, info) in c.consts.iter().enumerate() {
+            let decl = c.const_decl(crate::check::ConstId(k as u32));
+            let value = self.expr(&decl.value, Mode::Body);
+            self.line(
+                0,
+                format!(
+                    "const {}: {} = {};",
+                    wgsl_ident(&info.name),
+                    info.ty.wgsl(),
+                    value
+                ),
+            );
+        }
+        if !c.consts.is_empty() {
+            self.line(0, "");
+        }
+        self.position_helpers();
+        self.input_loaders();
+        for (k, _) in c.functions.iter().enumerate() {
+            self.function(crate::check::FunctionId(k as u32));
+        }
+        let order = self.i.graph.order.clone();
+        for &e in &order {
+            self.eval_function(e);
+        }
+        self.derivative_helpers();
+        self.neighbour_functions();
+        match self.kind {
+            KernelKind::Coarse => self.coarse_entry(),
+            KernelKind::Fine => {
+                self.fine_support();
+                self.pixel_entry();
+            }
+            KernelKind::Reference => self.pixel_entry(),
+        }
+    }
+
+    fn bindings(&mut self) {
+        let l = self.i.layout;
+        self.line(0, "struct MrslControl {");
+        self.line(1, "size: vec2<u32>,");
+        self.line(1, "force_refine: u32,");
+        self.line(1, "frame: u32,");
+        self.line(0, "}");
+        self.line(
+            0,
+            format!(
+                "@group({}) @binding({}) var<uniform> mrsl_ctl: MrslControl;",
+                l.control.group, l.control.binding
+            ),
+        );
+        if let Some(u) = &l.uniforms {
+            self.line(0, "");
+            self.line(0, "struct MrslUniforms {");
+            for f in &u.fields {
+                self.line(
+                    1,
+                    format!(
+                        "{}: {}, // offset {}",
+                        wgsl_ident(&f.name),
+                        f.wgsl_type,
+                        f.offset
+                    ),
+                );
+            }
+            self.line(0, "}");
+            self.line(
+                0,
+                format!(
+                    "@group({}) @binding({}) var<uniform> mrsl_u: MrslUniforms;",
+                    u.group, u.binding
+                ),
+            );
+        }
+        for t in &l.textures {
+            self.line(
+                0,
+                format!(
+                    "@group({}) @binding({}) var {}: texture_2d<f32>;",
+                    t.group,
+                    t.binding,
+                    wgsl_ident(&t.name)
+                ),
+            );
+        }
+        for s in &l.samplers {
+            self.line(
+                0,
+                format!(
+                    "@group({}) @binding({}) var {}: sampler;",
+                    s.group,
+                    s.binding,
+                    wgsl_ident(&s.name)
+                ),
+            );
+        }
+        self.line(0, "");
+        self.line(0, "// G-buffer channels.");
+        for ch in &l.channels {
+            let sample = match ch.sample_type {
+                "uint" => "u32",
+                "sint" => "i32",
+                _ => "f32",
+            };
+            self.line(
+                0,
+                format!(
+                    "@group({}) @binding({}) var mrsl_gb_{}: texture_2d<{sample}>; // {}",
+                    ch.group, ch.binding, ch.name, ch.format
+                ),
+            );
+        }
+        self.line(0, "");
+        match self.kind {
+            KernelKind::Coarse => {
+                self.line(0, "// Interface: per coarse sample, refine flag words then value slots (see layout).");
+                self.line(0, format!("@group({}) @binding({}) var<storage, read_write> mrsl_interface: array<u32>;", l.interface.group, l.interface.binding));
+            }
+            KernelKind::Fine => {
+                self.line(0, "// Interface: per coarse sample, refine flag words then value slots (see layout).");
+                self.line(
+                    0,
+                    format!(
+                        "@group({}) @binding({}) var<storage, read> mrsl_interface: array<u32>;",
+                        l.interface.group, l.interface.binding
+                    ),
+                );
+            }
+            KernelKind::Reference => {}
+        }
+        if self.kind != KernelKind::Coarse {
+            for o in &l.outputs {
+                self.line(
+                    0,
+                    format!(
+                        "@group({}) @binding({}) var mrsl_out_{}: texture_storage_2d<{}, write>;",
+                        o.group, o.binding, o.name, o.format
+                    ),
+                );
+            }
+        }
+        self.line(0, "");
+    }
+
+    fn position_helpers(&mut self) {
+        self.line(
+            0,
+            "// A position is a coarse-sample index in the coarse kernel and a pixel elsewhere.",
+        );
+        self.line(0, "fn mrsl_grid() -> vec2<i32> {");
+        self.line(1, "let size = vec2<i32>(mrsl_ctl.size);");
+        if self.kind == KernelKind::Coarse {
+            self.line(
+                1,
+                "return (size + vec2<i32>(MRSL_BLOCK - 2)) / MRSL_BLOCK + vec2<i32>(1);",
+            );
+        } else {
+            self.line(1, "return size;");
+        }
+        self.line(0, "}");
+        self.line(0, "");
+        self.line(0, "fn mrsl_pixel(pos: vec2<i32>) -> vec2<i32> {");
+        if self.kind == KernelKind::Coarse {
+            self.line(
+                1,
+                "return min(pos * MRSL_BLOCK, vec2<i32>(mrsl_ctl.size) - vec2<i32>(1));",
+            );
+        } else {
+            self.line(1, "return pos;");
+        }
+        self.line(0, "}");
+        self.line(0, "");
+        self.line(
+            0,
+            "// The two positions of pos's quad along x (xy, zw), as hardware 2x2 quads pair them;",
+        );
+        self.line(
+            0,
+            "// at the last odd column the pair is taken to the left instead.",
+        );
+        for (axis, comp) in [("x", "x"), ("y", "y")] {
+            self.line(
+                0,
+                format!("fn mrsl_pair_{axis}(pos: vec2<i32>) -> vec4<i32> {{"),
+            );
+            self.line(1, "let n = mrsl_grid();");
+            self.line(1, format!("var a = pos.{comp} & ~1;"));
+            self.line(1, "var b = a + 1;");
+            self.line(
+                1,
+                format!("if (b >= n.{comp}) {{ a = max(pos.{comp} - 1, 0); b = pos.{comp}; }}"),
+            );
+            if axis == "x" {
+                self.line(1, "return vec4<i32>(a, pos.y, b, pos.y);");
+            } else {
+                self.line(1, "return vec4<i32>(pos.x, a, pos.x, b);");
+            }
+            self.line(0, "}");
+            self.line(0, "");
+        }
+    }
+
+    fn input_loaders(&mut self) {
+        for input in &self.checked().inputs {
+            let swizzle = match input.ty.components() {
+                1 => ".x",
+                2 => ".xy",
+                3 => ".xyz",
+                _ => "",
+            };
+            self.line(
+                0,
+                format!(
+                    "fn mrsl_load_{}(pos: vec2<i32>) -> {} {{",
+                    input.name,
+                    input.ty.wgsl()
+                ),
+            );
+            self.line(
+                1,
+                format!(
+                    "return textureLoad(mrsl_gb_{}, mrsl_pixel(pos), 0){swizzle};",
+                    input.name
+                ),
+            );
+            self.line(0, "}");
+            self.line(0, "");
+        }
+    }
+
+    fn function(&mut self, id: crate::check::FunctionId) {
+        let c = self.checked();
+        let f = c.function_decl(id);
+        let info = &c.functions[id.index()];
+        let params: Vec<String> = info
+            .params
+            .iter()
+            .map(|p| {
+                let l = &c.locals[p.index()];
+                let name = local_name(c, *p);
+                if l.reassigned {
+                    format!("{name}_in: {}", l.ty.wgsl())
+                } else {
+                    format!("{name}: {}", l.ty.wgsl())
+                }
+            })
+            .collect();
+        self.line(
+            0,
+            format!(
+                "// function `{}` (line {})",
+                f.name.name,
+                self.line_of(f.span)
+            ),
+        );
+        self.line(
+            0,
+            format!(
+                "fn {}({}) -> {} {{",
+                wgsl_ident(&f.name.name),
+                params.join(", "),
+                info.ret.wgsl()
+            ),
+        );
+        for p in &info.params {
+            if c.locals[p.index()].reassigned {
+                let name = local_name(c, *p);
+                self.line(1, format!("var {name} = {name}_in;"));
+            }
+        }
+        for s in &f.body.stmts {
+            self.stmt(s, 1);
+        }
+        self.line(0, "}");
+        self.line(0, "");
+    }
+
+    fn deps_params(&self, e: EffectId) -> Vec<EffectId> {
+        self.checked().effects[e.index()]
+            .deps
+            .iter()
+            .map(|(d, _)| *d)
+            .collect()
+    }
+
+    fn eval_signature(&self, e: EffectId) -> String {
+        let c = self.checked();
+        let info = &c.effects[e.index()];
+        let mut params = vec!["mrsl_pos: vec2<i32>".to_string()];
+        if info.has_refine {
+            params.push("mrsl_refine: ptr<function, bool>".into());
+        }
+        for d in self.deps_params(e) {
+            params.push(format!(
+                "{}: {}",
+                self.effect_name(d),
+                c.effects[d.index()].ty.wgsl()
+            ));
+        }
+        format!(
+            "fn mrsl_eval_{}({}) -> {}",
+            info.name,
+            params.join(", "),
+            info.ty.wgsl()
+        )
+    }
+
+    /// Inputs an effect body reads directly.
+    fn inputs_read(&self, decl: &EffectDecl) -> BTreeSet<usize> {
+        let c = self.checked();
+        let mut read = BTreeSet::new();
+        let mut visit = |e: &Expr| {
+            visit_expr(e, &mut |x| {
+                if let Some(Symbol::Input(i)) = c.symbols.get(&x.id) {
+                    read.insert(i.index());
+                }
+            })
+        };
+        match &decl.body {
+            EffectBody::Expr(e) => visit(e),
+            EffectBody::Block(b) => b.stmts.iter().for_each(|s| visit_stmt_exprs(s, &mut visit)),
+        }
+        read
+    }
+
+    fn eval_function(&mut self, e: EffectId) {
+        let c = self.checked();
+        let info = &c.effects[e.index()];
+        let decl = c.effect_decl(e);
+        let rate = match info.rate {
+            Rate::Coarse => "coarse effect",
+            Rate::Fine => "fine effect",
+            Rate::Out => "fine out",
+        };
+        self.line(
+            0,
+            format!(
+                "// ---- {rate} `{}` (line {}) ----",
+                info.name,
+                self.line_of(decl.span)
+            ),
+        );
+        let sig = self.eval_signature(e);
+        self.line(0, format!("{sig} {{"));
+        for i in self.inputs_read(decl) {
+            let name = &c.inputs[i].name;
+            self.line(
+                1,
+                format!("let {} = mrsl_load_{name}(mrsl_pos);", wgsl_ident(name)),
+            );
+        }
+        match &decl.body {
+            EffectBody::Expr(x) => {
+                let v = self.expr(x, Mode::Body);
+                self.line(1, format!("return {v};"));
+            }
+            EffectBody::Block(b) => {
+                let result = info.result.expect("block effects have a result local");
+                let name = local_name(c, result);
+                self.line(1, format!("var {name}: {};", info.ty.wgsl()));
+                self.line(1, "{");
+                for s in &b.stmts {
+                    self.stmt(s, 2);
+                }
+                self.line(1, "}");
+                self.line(1, format!("return {name};"));
+            }
+        }
+        self.line(0, "}");
+        self.line(0, "");
+    }
+
+    fn stmt(&mut self, s: &Stmt, indent: usize) {
+        let c = self.checked();
+        match &s.kind {
+            StmtKind::Local { init, .. } => {
+                let id = c.local_decls[&s.id];
+                let info = &c.locals[id.index()];
+                let name = local_name(c, id);
+                match init {
+                    Some(v) => {
+                        let keyword = if info.reassigned { "var" } else { "let" };
+                        let value = self.expr(v, Mode::Body);
+                        self.line(
+                            indent,
+                            format!("{keyword} {name}: {} = {value};", info.ty.wgsl()),
+                        );
+                    }
+                    None => self.line(indent, format!("var {name}: {};", info.ty.wgsl())),
+                }
+            }
+            StmtKind::Assign { .. } | StmtKind::Step { .. } => {
+                let text = self.simple_stmt(s);
+                self.line(indent, format!("{text};"));
+            }
+            StmtKind::If {
+                cond,
+                then,
+                otherwise,
+            } => {
+                let cond = self.expr(cond, Mode::Body);
+                self.line(indent, format!("if ({cond}) {{"));
+                self.body(then, indent + 1);
+                if let Some(o) = otherwise {
+                    self.line(indent, "} else {");
+                    self.body(o, indent + 1);
+                }
+                self.line(indent, "}");
+            }
+            StmtKind::For {
+                init,
+                cond,
+                step,
+                body,
+            } => {
+                let init = init.as_ref().map(|i| self.for_init(i)).unwrap_or_default();
+                let cond = cond
+                    .as_ref()
+                    .map(|x| self.expr(x, Mode::Body))
+                    .unwrap_or_default();
+                let step = step
+                    .as_ref()
+                    .map(|st| self.simple_stmt(st))
+                    .unwrap_or_default();
+                self.line(indent, format!("for ({init}; {cond}; {step}) {{"));
+                self.body(body, indent + 1);
+                self.line(indent, "}");
+            }
+            StmtKind::Block(b) => {
+                self.line(indent, "{");
+                for s in &b.stmts {
+                    self.stmt(s, indent + 1);
+                }
+                self.line(indent, "}");
+            }
+            StmtKind::Refine => self.line(indent, "*mrsl_refine = true; // refine"),
+            StmtKind::Return(Some(v)) => {
+                let v = self.expr(v, Mode::Body);
+                self.line(indent, format!("return {v};"));
+            }
+            StmtKind::Return(None) => self.line(indent, "return;"),
+            StmtKind::Break => self.line(indent, "break;"),
+            StmtKind::Continue => self.line(indent, "continue;"),
+        }
+    }
+
+    fn body(&mut self, s: &Stmt, indent: usize) {
+        match &s.kind {
+            StmtKind::Block(b) => b.stmts.iter().for_each(|s| self.stmt(s, indent)),
+            _ => self.stmt(s, indent),
+        }
+    }
+
+    fn for_init(&mut self, s: &Stmt) -> String {
+        let c = self.checked();
+        match &s.kind {
+            StmtKind::Local { init, .. } => {
+                let id = c.local_decls[&s.id];
+                let info = &c.locals[id.index()];
+                let value = init
+                    .as_ref()
+                    .map(|v| format!(" = {}", self.expr(v, Mode::Body)))
+                    .unwrap_or_default();
+                format!("var {}: {}{value}", local_name(c, id), info.ty.wgsl())
+            }
+            _ => self.simple_stmt(s),
+        }
+    }
+
+    fn simple_stmt(&mut self, s: &Stmt) -> String {
+        match &s.kind {
+            StmtKind::Assign { target, op, value } => {
+                let t = self.expr(target, Mode::Body);
+                let v = self.expr(value, Mode::Body);
+                let op = match op {
+                    AssignOp::Set => "=",
+                    AssignOp::Add => "+=",
+                    AssignOp::Sub => "-=",
+                    AssignOp::Mul => "*=",
+                    AssignOp::Div => "/=",
+                };
+                format!("{t} {op} {v}")
+            }
+            StmtKind::Step { target, increment } => {
+                // `++` is integer-only in WGSL; `+= 1` works for every numeric type.
+                let t = self.expr(target, Mode::Body);
+                format!("{t} {} 1", if *increment { "+=" } else { "-=" })
+            }
+            StmtKind::Local { .. } => self.for_init(s),
+            _ => String::new(),
+        }
+    }
+
+    // ---- Expressions --------------------------------------------------------
+
+    fn expr(&self, e: &Expr, mode: Mode) -> String {
+        let c = self.checked();
+        match &e.kind {
+            ExprKind::Int(v, IntSuffix::None) => v.to_string(),
+            ExprKind::Int(v, IntSuffix::U) => format!("{v}u"),
+            ExprKind::Int(v, IntSuffix::I) => format!("{v}i"),
+            ExprKind::Float(v) => float_literal(*v),
+            ExprKind::Bool(b) => b.to_string(),
+            ExprKind::Name(name) => self.name(e, name, mode),
+            ExprKind::Unary(op, inner) => {
+                let x = self.expr(inner, mode);
+                let sym = match op {
+                    UnaryOp::Neg => "-",
+                    UnaryOp::Not => "!",
+                    UnaryOp::BitNot => "~",
+                };
+                format!("{sym}({x})")
+            }
+            ExprKind::Binary(op, a, b) => {
+                let x = self.expr(a, mode);
+                let mut y = self.expr(b, mode);
+                match op {
+                    BinaryOp::Shl | BinaryOp::Shr => {
+                        // WGSL shifts take an unsigned amount.
+                        match c.ty(b) {
+                            Type::Scalar(Scalar::Int) => y = format!("u32({y})"),
+                            Type::Vector(Scalar::Int, n) => y = format!("vec{n}<u32>({y})"),
+                            _ => {}
+                        }
+                        format!("({x} {} {y})", op.symbol())
+                    }
+                    BinaryOp::BitXor if c.ty(a).scalar() == Some(Scalar::Bool) => {
+                        format!("({x} != {y})")
+                    }
+                    _ => format!("({x} {} {y})", op.symbol()),
+                }
+            }
+            ExprKind::Ternary(cond, a, b) => {
+                let cond = self.expr(cond, mode);
+                let x = self.expr(a, mode);
+                let y = self.expr(b, mode);
+                format!("select({y}, {x}, {cond})")
+            }
+            ExprKind::Field { base, field } => format!("{}.{}", self.expr(base, mode), field.name),
+            ExprKind::Index { base, index } => {
+                format!("{}[{}]", self.expr(base, mode), self.expr(index, mode))
+            }
+            ExprKind::Call { callee, args } => self.call(e, callee, args, mode),
+        }
+    }
+
+    fn name(&self, e: &Expr, name: &str, mode: Mode) -> String {
+        let c = self.checked();
+        match c.symbols.get(&e.id) {
+            Some(Symbol::Local(l)) => match mode {
+                Mode::Neighbour(site) if !site.params.contains(l) => {
+                    match self.i.deriv.definitions.get(l) {
+                        Some(def) => format!("({})", self.expr(def, mode)),
+                        None => local_name(c, *l),
+                    }
+                }
+                _ => local_name(c, *l),
+            },
+            Some(Symbol::Input(i)) => match mode {
+                Mode::Body => wgsl_ident(name),
+                Mode::Neighbour(_) => format!("mrsl_load_{}(mrsl_pos)", c.inputs[i.index()].name),
+            },
+            Some(Symbol::Uniform(u)) => {
+                let info = &c.uniforms[u.index()];
+                match (&info.kind, &info.ty) {
+                    (UniformKind::Value { .. }, Type::Scalar(Scalar::Bool)) => {
+                        format!("(mrsl_u.{} != 0u)", wgsl_ident(name))
+                    }
+                    (UniformKind::Value { .. }, Type::Vector(Scalar::Bool, n)) => {
+                        format!("(mrsl_u.{} != vec{n}<u32>(0u))", wgsl_ident(name))
+                    }
+                    (UniformKind::Value { .. }, _) => format!("mrsl_u.{}", wgsl_ident(name)),
+                    _ => wgsl_ident(name),
+                }
+            }
+            Some(Symbol::Const(_)) => wgsl_ident(name),
+            Some(Symbol::Effect(id)) => match mode {
+                Mode::Body => self.effect_name(*id),
+                Mode::Neighbour(_) => format!("mrsl_at_{}(mrsl_pos)", c.effects[id.index()].name),
+            },
+            None => wgsl_ident(name),
+        }
+    }
+
+    fn call(&self, e: &Expr, callee: &Ident, args: &[Expr], mode: Mode) -> String {
+        let c = self.checked();
+        let arg = |k: usize| {
+            let text = self.expr(&args[k], mode);
+            match c.splats.get(&args[k].id) {
+                Some(target) => format!("{}({text})", target.wgsl()),
+                None => text,
+            }
+        };
+        let all = || (0..args.len()).map(arg).collect::<Vec<_>>().join(", ");
+        match c.callees.get(&e.id) {
+            Some(Callee::Construct(ty)) => format!("{}({})", ty.wgsl(), all()),
+            Some(Callee::Function(_)) => format!("{}({})", wgsl_ident(&callee.name), all()),
+            Some(Callee::Builtin(name)) => match *name {
+                "ddx" | "ddy" | "fwidth" | "sample" => {
+                    let site_index = self.i.deriv.site_of[&e.id];
+                    let site = &self.i.deriv.sites[site_index];
+                    let mut call_args = vec!["mrsl_pos".to_string()];
+                    call_args.extend(site.params.iter().map(|p| local_name(c, *p)));
+                    let call_args = call_args.join(", ");
+                    let dx = format!("mrsl_ddx_{site_index}({call_args})");
+                    let dy = format!("mrsl_ddy_{site_index}({call_args})");
+                    match *name {
+                        "ddx" => dx,
+                        "ddy" => dy,
+                        "fwidth" => format!("(abs({dx}) + abs({dy}))"),
+                        _ => format!(
+                            "textureSampleGrad({}, {}, {}, {dx}, {dy})",
+                            arg(0),
+                            arg(1),
+                            arg(2)
+                        ),
+                    }
+                }
+                "sample_level" => format!("textureSampleLevel({})", all()),
+                "sample_grad" => format!("textureSampleGrad({})", all()),
+                "load" if args.len() == 2 => format!("textureLoad({}, {}, 0)", arg(0), arg(1)),
+                "load" => format!("textureLoad({})", all()),
+                "texture_size" => format!("vec2<i32>(textureDimensions({}))", arg(0)),
+                "lerp" => format!("mix({})", all()),
+                "faceforward" => format!("faceForward({})", all()),
+                "inversesqrt" => format!("inverseSqrt({})", all()),
+                other => format!("{other}({})", all()),
+            },
+            None => format!("{}({})", wgsl_ident(&callee.name), all()),
+        }
+    }
+
+    // ---- Derivatives and values at other positions ------------------------------
+
+    fn live_sites(&self) -> Vec<usize> {
+        (0..self.i.deriv.sites.len())
+            .filter(|&k| self.i.graph.live[self.i.deriv.sites[k].effect.index()])
+            .collect()
+    }
+
+    fn derivative_helpers(&mut self) {
+        let c = self.checked();
+        for k in self.live_sites() {
+            let site = &self.i.deriv.sites[k];
+            let ty = c.ty(site.operand).concretize();
+            let mut params = vec!["mrsl_pos: vec2<i32>".to_string()];
+            params.extend(
+                site.params
+                    .iter()
+                    .map(|p| format!("{}: {}", local_name(c, *p), c.locals[p.index()].ty.wgsl())),
+            );
+            let mut args = vec![];
+            args.extend(site.params.iter().map(|p| local_name(c, *p)));
+            let effect = &c.effects[site.effect.index()].name;
+            let operand_span = site.operand.span;
+            let text = &self.i.source[operand_span.range()];
+            let text: String = text.split_whitespace().collect::<Vec<_>>().join(" ");
+            self.line(
+                0,
+                format!("// derivative operand #{k} in `{effect}`: {text}"),
+            );
+            let operand = self.expr(site.operand, Mode::Neighbour(site));
+            self.line(
+                0,
+                format!("fn mrsl_d{k}({}) -> {} {{", params.join(", "), ty.wgsl()),
+            );
+            self.line(1, format!("return {operand};"));
+            self.line(0, "}");
+            let rest = if args.is_empty() {
+                String::new()
+            } else {
+                format!(", {}", args.join(", "))
+            };
+            for axis in ["x", "y"] {
+                self.line(
+                    0,
+                    format!(
+                        "fn mrsl_dd{axis}_{k}({}) -> {} {{",
+                        params.join(", "),
+                        ty.wgsl()
+                    ),
+                );
+                self.line(1, format!("let q = mrsl_pair_{axis}(mrsl_pos);"));
+                self.line(
+                    1,
+                    format!("return mrsl_d{k}(q.zw{rest}) - mrsl_d{k}(q.xy{rest});"),
+                );
+                self.line(0, "}");
+            }
+            self.line(0, "");
+        }
+    }
+
+    /// `mrsl_at_<effect>(pos)`: the effect's value at another position, as this kernel sees it.
+    fn neighbour_functions(&mut self) {
+        let c = self.checked();
+        let mut needed: BTreeSet<EffectId> = BTreeSet::new();
+        for k in self.live_sites() {
+            let site = &self.i.deriv.sites[k];
+            needed.extend(
+                site.effects
+                    .iter()
+                    .copied()
+                    .filter(|e| self.i.graph.live[e.index()]),
+            );
+        }
+        for e in needed {
+            let info = &c.effects[e.index()];
+            self.line(
+                0,
+                format!(
+                    "// `{}` at another position, as the {} kernel computes it there.",
+                    info.name,
+                    self.kind.name()
+                ),
+            );
+            self.line(
+                0,
+                format!(
+                    "fn mrsl_at_{}(mrsl_pos: vec2<i32>) -> {} {{",
+                    info.name,
+                    info.ty.wgsl()
+                ),
+            );
+            let chain = self.i.graph.closure(e, c);
+            if self.kind == KernelKind::Fine
+                && chain
+                    .iter()
+                    .any(|x| c.effects[x.index()].rate == Rate::Coarse)
+            {
+                self.line(1, "let mrsl_b = mrsl_resolve(mrsl_pos);");
+            }
+            self.effect_chain(&chain, 1);
+            self.line(1, format!("return {};", self.effect_name(e)));
+            self.line(0, "}");
+            self.line(0, "");
+        }
+    }
+
+    /// Computes `effects` (in dependency order) into locals named after them.
+    fn effect_chain(&mut self, effects: &[EffectId], indent: usize) {
+        let c = self.checked();
+        for &e in effects {
+            let info = &c.effects[e.index()];
+            let name = self.effect_name(e);
+            let mut args = vec!["mrsl_pos".to_string()];
+            if info.has_refine {
+                args.push(format!("&mrsl_r_{}", info.name));
+            }
+            args.extend(self.deps_params(e).into_iter().map(|d| self.effect_name(d)));
+            let call = format!("mrsl_eval_{}({})", info.name, args.join(", "));
+            let declare_flag = |w: &mut Self| {
+                if info.has_refine {
+                    w.line(indent + 1, format!("var mrsl_r_{} = false;", info.name));
+                }
+            };
+            match (self.kind, info.rate) {
+                (KernelKind::Fine, Rate::Coarse) => {
+                    let index = self.coarse_index[&e];
+                    self.line(indent, format!("var {name}: {};", info.ty.wgsl()));
+                    self.line(indent, format!("if (mrsl_is_refined(mrsl_b, {index}u)) {{"));
+                    declare_flag(self);
+                    self.line(indent + 1, format!("{name} = {call};"));
+                    if self.i.interface.is_passed(e) {
+                        self.line(indent, "} else {");
+                        self.line(
+                            indent + 1,
+                            format!("{name} = mrsl_resample_{}(mrsl_b);", info.name),
+                        );
+                    }
+                    self.line(indent, "}");
+                }
+                _ => {
+                    if info.has_refine {
+                        self.line(indent, format!("var mrsl_r_{} = false;", info.name));
+                    }
+                    self.line(indent, format!("let {name} = {call};"));
+                }
+            }
+        }
+    }
+
+    // ---- Coarse kernel ----------------------------------------------------------
+
+    fn coarse_entry(&mut self) {
+        let c = self.checked();
+        let iface = self.i.interface;
+        let [wx, wy, wz] = self.kind.workgroup_size();
+        self.line(0, format!("@compute @workgroup_size({wx}, {wy}, {wz})"));
+        self.line(
+            0,
+            "fn coarse_main(@builtin(global_invocation_id) mrsl_gid: vec3<u32>) {",
+        );
+        self.line(1, "let mrsl_n = mrsl_grid();");
+        self.line(
+            1,
+            "if (mrsl_gid.x >= u32(mrsl_n.x) || mrsl_gid.y >= u32(mrsl_n.y)) { return; }",
+        );
+        self.line(1, "let mrsl_pos = vec2<i32>(mrsl_gid.xy);");
+        self.line(
+            1,
+            "let mrsl_rec = (mrsl_gid.y * u32(mrsl_n.x) + mrsl_gid.x) * MRSL_STRIDE;",
+        );
+        let coarse: Vec<EffectId> = self
+            .i
+            .graph
+            .order
+            .iter()
+            .copied()
+            .filter(|e| c.effects[e.index()].rate == Rate::Coarse)
+            .collect();
+        for &e in &coarse {
+            self.line(
+                1,
+                format!("// coarse effect `{}`", c.effects[e.index()].name),
+            );
+            self.effect_chain(&[e], 1);
+        }
+        if iface.flag_words > 0 {
+            self.line(
+                1,
+                "// Refine flags (all set when the runtime forces refinement).",
+            );
+            self.line(1, "let mrsl_force = mrsl_ctl.force_refine != 0u;");
+            for w in 0..iface.flag_words {
+                self.line(1, format!("var mrsl_flags{w} = 0u;"));
+            }
+            for &e in &coarse {
+                if let Some(bit) = iface.refine_bit[e.index()] {
+                    let name = &c.effects[e.index()].name;
+                    self.line(
+                        1,
+                        format!(
+                            "if (mrsl_r_{name} || mrsl_force) {{ mrsl_flags{} |= {}u; }}",
+                            bit / 32,
+                            1u32 << (bit % 32)
+                        ),
+                    );
+                }
+            }
+            for w in 0..iface.flag_words {
+                self.line(
+                    1,
+                    format!("mrsl_interface[mrsl_rec + {w}u] = mrsl_flags{w};"),
+                );
+            }
+        }
+        for (k, slot) in iface.slots.iter().enumerate() {
+            let names: Vec<&str> = slot
+                .effects
+                .iter()
+                .map(|e| c.effects[e.index()].name.as_str())
+                .collect();
+            self.line(
+                1,
+                format!(
+                    "// slot {k}: words {}..{} ({})",
+                    slot.offset,
+                    slot.offset + slot.size,
+                    names.join(", ")
+                ),
+            );
+            for &e in &slot.effects {
+                let words = pack_words(&self.effect_name(e), &c.effects[e.index()].ty);
+                let writes: Vec<String> = words
+                    .iter()
+                    .enumerate()
+                    .map(|(j, w)| {
+                        format!(
+                            "mrsl_interface[mrsl_rec + {}u] = {w};",
+                            slot.offset as usize + j
+                        )
+                    })
+                    .collect();
+                if slot.effects.len() > 1 {
+                    // A shared slot holds whichever effect this sample's own flags say is passed.
+                    let cond = self.store_condition(e, &|bit| {
+                        format!("((mrsl_flags{} & {}u) != 0u)", bit / 32, 1u32 << (bit % 32))
+                    });
+                    self.line(1, format!("if ({cond}) {{"));
+                    for wline in writes {
+                        self.line(2, wline);
+                    }
+                    self.line(1, "}");
+                } else {
+                    for wline in writes {
+                        self.line(1, wline);
+                    }
+                }
+            }
+        }
+        self.line(0, "}");
+    }
+
+    /// The pass condition of `e` as WGSL, over flag bits rendered by `bit`.
+    fn store_condition(&self, e: EffectId, bit: &dyn Fn(u32) -> String) -> String {
+        let iface = self.i.interface;
+        let cond = iface.conditions[e.index()]
+            .as_ref()
+            .expect("passed effects have a condition");
+        let mut any = vec![];
+        if cond.fine_user {
+            any.push("true".to_string());
+        }
+        for u in &cond.refining_users {
+            any.push(bit(
+                iface.refine_bit[u.index()].expect("refining users have a bit")
+            ));
+        }
+        let any = if any.is_empty() {
+            "false".to_string()
+        } else {
+            any.join(" || ")
+        };
+        match iface.refine_bit[e.index()] {
+            Some(b) if cond.self_refines => format!("!{} && ({any})", bit(b)),
+            _ => format!("({any})"),
+        }
+    }
+
+    // ---- Fine kernel ------------------------------------------------------------
+
+    fn coarse_live(&self) -> Vec<EffectId> {
+        self.i
+            .graph
+            .order
+            .iter()
+            .copied()
+            .filter(|e| self.checked().effects[e.index()].rate == Rate::Coarse)
+            .collect()
+    }
+
+    fn fine_support(&mut self) {
+        let c = self.checked();
+        let coarse = self.coarse_live();
+        if coarse.is_empty() {
+            return;
+        }
+        let iface = self.i.interface;
+        let mask_words = (coarse.len() as u32).div_ceil(32);
+        self.line(0, "// Where a pixel takes its coarse values from, and which coarse effects it re-evaluates.");
+        self.line(0, "struct MrslBlock {");
+        self.line(
+            1,
+            "corners: vec4<u32>, // coarse samples c00, c10, c01, c11",
+        );
+        self.line(1, "weights: vec4<f32>, // bilinear weights of the corners");
+        self.line(1, "nearest: u32,       // index of the nearest corner");
+        self.line(1, format!("refined: array<u32, {mask_words}>, // bit k: coarse effect k is evaluated per pixel"));
+        self.line(0, "}");
+        self.line(0, "");
+        self.line(0, "fn mrsl_is_refined(b: MrslBlock, k: u32) -> bool {");
+        self.line(1, "return ((b.refined[k / 32u] >> (k % 32u)) & 1u) != 0u;");
+        self.line(0, "}");
+        self.line(0, "");
+        // Key comparisons.
+        let keys: Vec<(usize, KeyCompare)> = c
+            .inputs
+            .iter()
+            .enumerate()
+            .filter_map(|(i, x)| x.key.map(|k| (i, k)))
+            .collect();
+        self.line(0, "fn mrsl_resolve(pos: vec2<i32>) -> MrslBlock {");
+        self.line(1, "let size = vec2<i32>(mrsl_ctl.size);");
+        self.line(
+            1,
+            "let n = (size + vec2<i32>(MRSL_BLOCK - 2)) / MRSL_BLOCK + vec2<i32>(1);",
+        );
+        self.line(1, "let i0 = pos / MRSL_BLOCK;");
+        self.line(1, "let i1 = min(i0 + vec2<i32>(1), n - vec2<i32>(1));");
+        self.line(1, "let p0 = min(i0 * MRSL_BLOCK, size - vec2<i32>(1));");
+        self.line(1, "let p1 = min(i1 * MRSL_BLOCK, size - vec2<i32>(1));");
+        self.line(1, "let extent = p1 - p0;");
+        self.line(1, "let t = select(vec2<f32>(0.0), vec2<f32>(pos - p0) / vec2<f32>(max(extent, vec2<i32>(1))), extent > vec2<i32>(0));");
+        self.line(1, "var b: MrslBlock;");
+        self.line(1, "b.corners = vec4<u32>(u32(i0.y * n.x + i0.x), u32(i0.y * n.x + i1.x), u32(i1.y * n.x + i0.x), u32(i1.y * n.x + i1.x));");
+        self.line(1, "b.weights = vec4<f32>((1.0 - t.x) * (1.0 - t.y), t.x * (1.0 - t.y), (1.0 - t.x) * t.y, t.x * t.y);");
+        self.line(
+            1,
+            "b.nearest = select(0u, 1u, t.x > 0.5) + select(0u, 2u, t.y > 0.5);",
+        );
+        self.line(1, "var disc = mrsl_ctl.force_refine != 0u;");
+        for (i, key) in &keys {
+            let name = &c.inputs[*i].name;
+            let differs = |a: &str, b: &str| match key {
+                KeyCompare::Exact if c.inputs[*i].ty.components() == 1 => format!("({a} != {b})"),
+                KeyCompare::Exact => format!("any({a} != {b})"),
+                KeyCompare::Threshold { threshold } => {
+                    format!("(distance({a}, {b}) > {})", float_literal(*threshold))
+                }
+            };
+            self.line(1, format!("// discontinuity key `{name}`"));
+            self.line(1, format!("let k_{name} = mrsl_load_{name}(pos);"));
+            self.line(1, format!("let k00_{name} = mrsl_load_{name}(p0);"));
+            self.line(
+                1,
+                format!("let k10_{name} = mrsl_load_{name}(vec2<i32>(p1.x, p0.y));"),
+            );
+            self.line(
+                1,
+                format!("let k01_{name} = mrsl_load_{name}(vec2<i32>(p0.x, p1.y));"),
+            );
+            self.line(1, format!("let k11_{name} = mrsl_load_{name}(p1);"));
+            let mut tests = vec![];
+            for corner in ["k00", "k10", "k01", "k11"] {
+                tests.push(differs(&format!("k_{name}"), &format!("{corner}_{name}")));
+            }
+            for corner in ["k10", "k01", "k11"] {
+                tests.push(differs(&format!("k00_{name}"), &format!("{corner}_{name}")));
+            }
+            self.line(1, format!("disc = disc || {};", tests.join(" || ")));
+        }
+        if iface.flag_words > 0 {
+            for (ci, corner) in ["x", "y", "z", "w"].iter().enumerate() {
+                for w in 0..iface.flag_words {
+                    self.line(1, format!("let f{ci}_{w} = mrsl_interface[b.corners.{corner} * MRSL_STRIDE + {w}u];"));
+                }
+            }
+        }
+        self.line(
+            1,
+            "// Effective refinement, users before what they use: an effect is evaluated per pixel",
+        );
+        self.line(
+            1,
+            "// when a corner flagged it, at a discontinuity, or when it is needed coarsely but a",
+        );
+        self.line(
+            1,
+            "// corner's shared slot holds another effect (an interface miss).",
+        );
+        let bit_of_corner =
+            |ci: usize, bit: u32| format!("((f{ci}_{} & {}u) != 0u)", bit / 32, 1u32 << (bit % 32));
+        for &e in coarse.iter().rev() {
+            let info = &c.effects[e.index()];
+            let k = self.coarse_index[&e];
+            let mut terms = vec!["disc".to_string()];
+            if let Some(bit) = iface.refine_bit[e.index()] {
+                let words: Vec<String> = (0..4).map(|ci| format!("f{ci}_{}", bit / 32)).collect();
+                terms.push(format!(
+                    "((({}) & {}u) != 0u)",
+                    words.join(" | "),
+                    1u32 << (bit % 32)
+                ));
+            }
+            // Needed coarsely: some live user runs per pixel here.
+            let mut needed = vec![];
+            for &u in &self.i.graph.users[e.index()] {
+                if !self.i.graph.live[u.index()] {
+                    continue;
+                }
+                match c.effects[u.index()].rate {
+                    Rate::Coarse => needed.push(format!("mrsl_r{}", self.coarse_index[&u])),
+                    _ => needed.push("true".into()),
+                }
+            }
+            needed.sort();
+            needed.dedup();
+            let needed = if needed.is_empty() {
+                "false".to_string()
+            } else {
+                needed.join(" || ")
+            };
+            if !iface.is_passed(e) {
+                terms.push(format!("({needed})"));
+            } else if iface.is_shared(e) {
+                let misses: Vec<String> = (0..4)
+                    .map(|ci| {
+                        format!(
+                            "!({})",
+                            self.store_condition(e, &|bit| bit_of_corner(ci, bit))
+                        )
+                    })
+                    .collect();
+                terms.push(format!("(({needed}) && ({}))", misses.join(" || ")));
+            }
+            self.line(
+                1,
+                format!("let mrsl_r{k} = {}; // `{}`", terms.join(" || "), info.name),
+            );
+            self.line(
+                1,
+                format!(
+                    "if (mrsl_r{k}) {{ b.refined[{}] |= {}u; }}",
+                    k / 32,
+                    1u32 << (k % 32)
+                ),
+            );
+        }
+        self.line(1, "return b;");
+        self.line(0, "}");
+        self.line(0, "");
+        for &e in &coarse {
+            let Some(slot) = iface.slot_of[e.index()].map(|s| &iface.slots[s]) else {
+                continue;
+            };
+            let info = &c.effects[e.index()];
+            let ty = &info.ty;
+            self.line(
+                0,
+                format!("fn mrsl_get_{}(s: u32) -> {} {{", info.name, ty.wgsl()),
+            );
+            self.line(1, format!("let base = s * MRSL_STRIDE + {}u;", slot.offset));
+            self.line(1, format!("return {};", unpack_words(ty)));
+            self.line(0, "}");
+            let nearest = layout::uses_nearest(c, e);
+            self.line(
+                0,
+                format!(
+                    "fn mrsl_resample_{}(b: MrslBlock) -> {} {{",
+                    info.name,
+                    ty.wgsl()
+                ),
+            );
+            for (k, corner) in ["x", "y", "z", "w"].iter().enumerate() {
+                self.line(
+                    1,
+                    format!("let v{k} = mrsl_get_{}(b.corners.{corner});", info.name),
+                );
+            }
+            if nearest {
+                self.line(1, "// nearest corner");
+                self.line(1, "return select(select(v0, v1, b.nearest == 1u), select(v2, v3, b.nearest == 3u), b.nearest >= 2u);");
+            } else {
+                self.line(1, "// bilinear");
+                self.line(1, "return v0 * b.weights.x + v1 * b.weights.y + v2 * b.weights.z + v3 * b.weights.w;");
+            }
+            self.line(0, "}");
+            self.line(0, "");
+        }
+    }
+
+    /// Entry point of the fine and reference kernels.
+    fn pixel_entry(&mut self) {
+        let c = self.checked();
+        let tile = layout::TILE;
+        let b = if self.kind == KernelKind::Fine {
+            self.block
+        } else {
+            2
+        };
+        self.line(0, format!("// Pixel of a {tile}x{tile} tile for lane `li`: {b}x{b} blocks are laid out so that"));
+        self.line(0, "// consecutive lanes (a SIMD group) cover whole blocks and share their refine decisions.");
+        self.line(
+            0,
+            "fn mrsl_tile_pixel(wg: vec2<u32>, li: u32) -> vec2<i32> {",
+        );
+        self.line(1, format!("let per_block = {}u;", b * b));
+        self.line(1, format!("let blocks_x = {}u;", tile / b));
+        self.line(1, "let blk = li / per_block;");
+        self.line(1, "let within = li % per_block;");
+        self.line(
+            1,
+            format!("let x = (blk % blocks_x) * {b}u + within % {b}u;"),
+        );
+        self.line(
+            1,
+            format!("let y = (blk / blocks_x) * {b}u + within / {b}u;"),
+        );
+        self.line(
+            1,
+            format!("return vec2<i32>(wg * {tile}u + vec2<u32>(x, y));"),
+        );
+        self.line(0, "}");
+        self.line(0, "");
+        let [wx, wy, wz] = self.kind.workgroup_size();
+        self.line(0, format!("@compute @workgroup_size({wx}, {wy}, {wz})"));
+        self.line(0, format!("fn {}(@builtin(workgroup_id) mrsl_wg: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {{", self.kind.entry_point()));
+        self.line(1, "let mrsl_pos = mrsl_tile_pixel(mrsl_wg.xy, mrsl_li);");
+        self.line(1, "if (any(mrsl_pos >= mrsl_grid())) { return; }");
+        let order = self.i.graph.order.clone();
+        if self.kind == KernelKind::Fine && !self.coarse_live().is_empty() {
+            self.line(1, "let mrsl_b = mrsl_resolve(mrsl_pos);");
+        }
+        self.effect_chain(&order, 1);
+        for e in &order {
+            let info = &c.effects[e.index()];
+            if info.rate != Rate::Out {
+                continue;
+            }
+            let value = to_vec4(&self.effect_name(*e), &info.ty);
+            self.line(
+                1,
+                format!("textureStore(mrsl_out_{}, mrsl_pos, {value});", info.name),
+            );
+        }
+        self.line(0, "}");
+    }
+}
+
+fn float_literal(v: f64) -> String {
+    let text = format!("{v:?}");
+    if text.contains('.') || text.contains('e') || text.contains("inf") || text.contains("NaN") {
+        text
+    } else {
+        format!("{text}.0")
+    }
+}
+
+/// WGSL expressions for the 32-bit words of a value, in order.
+fn pack_words(value: &str, ty: &Type) -> Vec<String> {
+    let scalar = |x: String, s: Scalar| match s {
+        Scalar::Float | Scalar::Int => format!("bitcast<u32>({x})"),
+        Scalar::Uint => x,
+        Scalar::Bool => format!("select(0u, 1u, {x})"),
+    };
+    match ty {
+        Type::Scalar(s) => vec![scalar(value.to_string(), *s)],
+        Type::Vector(s, n) => (0..*n)
+            .map(|k| scalar(format!("{value}[{k}]"), *s))
+            .collect(),
+        Type::Matrix(n) => (0..*n)
+            .flat_map(|col| (0..*n).map(move |row| format!("bitcast<u32>({value}[{col}][{row}])")))
+            .collect(),
+        _ => vec![],
+    }
+}
+
+/// A WGSL expression reading a value from `mrsl_interface` at word `base`.
+fn unpack_words(ty: &Type) -> String {
+    let word = |k: u32| format!("mrsl_interface[base + {k}u]");
+    let scalar = |k: u32, s: Scalar| match s {
+        Scalar::Float => format!("bitcast<f32>({})", word(k)),
+        Scalar::Int => format!("bitcast<i32>({})", word(k)),
+        Scalar::Uint => word(k),
+        Scalar::Bool => format!("({} != 0u)", word(k)),
+    };
+    match ty {
+        Type::Scalar(s) => scalar(0, *s),
+        Type::Vector(s, n) => format!(
+            "{}({})",
+            ty.wgsl(),
+            (0..*n as u32)
+                .map(|k| scalar(k, *s))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+        Type::Matrix(n) => {
+            let n = *n as u32;
+            let cols: Vec<String> = (0..n)
+                .map(|col| {
+                    format!(
+                        "vec{n}<f32>({})",
+                        (0..n)
+                            .map(|row| scalar(col * n + row, Scalar::Float))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                })
+                .collect();
+            format!("{}({})", ty.wgsl(), cols.join(", "))
+        }
+        _ => "0u".into(),
+    }
+}
+
+/// Widens an output value to the `vec4` that `textureStore` takes.
+fn to_vec4(value: &str, ty: &Type) -> String {
+    let (s, one) = match ty.scalar() {
+        Some(Scalar::Uint) => ("u32", "1u"),
+        Some(Scalar::Int) => ("i32", "1i"),
+        _ => ("f32", "1.0"),
+    };
+    match ty.components() {
+        1 => format!("vec4<{s}>({value}, 0, 0, {one})"),
+        2 => format!("vec4<{s}>({value}, 0, {one})"),
+        3 => format!("vec4<{s}>({value}, {one})"),
+        _ => value.to_string(),
+    }
+}
