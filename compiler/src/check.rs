@@ -406,14 +406,16 @@ impl<'a> Checker<'a> {
         // Pass 1: names, so that items may refer to each other in any order.
         for (index, item) in program.items.iter().enumerate() {
             let name = item.name();
-            if BUILTINS.contains(&name.name.as_str()) || Type::from_name(&name.name).is_some() {
+            // A reserved name is reported but still registered (unbound), so
+            // that ids stay aligned with the items they index.
+            let reserved = BUILTINS.contains(&name.name.as_str()) || Type::from_name(&name.name).is_some();
+            if reserved {
                 self.error(err(
                     "E0103",
                     format!("`{}` is a reserved name", name.name),
                     name.span,
                     "reserved: a builtin function or type",
                 ));
-                continue;
             }
             let global = match item {
                 Item::Input(_) => Global::Input(InputId(self.out.inputs.len() as u32)),
@@ -422,7 +424,8 @@ impl<'a> Checker<'a> {
                 Item::Function(_) => Global::Function(FunctionId(self.out.functions.len() as u32)),
                 Item::Effect(_) => Global::Effect(EffectId(self.out.effects.len() as u32)),
             };
-            if let Some((_, first)) = self.globals.get(&name.name) {
+            if reserved {
+            } else if let Some((_, first)) = self.globals.get(&name.name) {
                 self.error(
                     Diagnostic::error("E0101", format!("`{}` is defined twice", name.name))
                         .with_label(Label::primary(name.span, "defined again here"))
@@ -961,7 +964,7 @@ impl<'a> Checker<'a> {
             ));
         }
         self.block(&f.body);
-        if !block_returns(&f.body) {
+        if !block_returns(&f.body) && !ret.is_error() {
             self.error(
                 err(
                     "E0303",
@@ -2245,17 +2248,35 @@ fn construct_check(ty: &Type, args: &[Type]) -> Result<(), String> {
                 ));
             }
             let is_matrix = matches!(ty, Type::Matrix(_));
+            let target = ty.scalar().unwrap_or(Scalar::Float);
+            // Components must already have the target's element type (or be
+            // literals that adapt), as in WGSL; only a whole-vector
+            // conversion `float3(int3)` changes element types.
+            let component_fits = |a: &Type| match a {
+                Type::AbstractInt => target != Scalar::Bool,
+                Type::AbstractFloat => target == Scalar::Float,
+                other => other.scalar() == Some(target),
+            };
             if let [single] = args {
-                // Splat (vectors) or conversion/copy of the same shape.
-                if (!is_matrix && single.components() == 1)
-                    || (single.components() == ty.components()
-                        && !matches!(single, Type::Matrix(_)) != is_matrix)
-                {
-                    return Ok(());
-                }
                 if single == ty {
                     return Ok(());
                 }
+                if !is_matrix && single.vector_len() == ty.vector_len() && single.vector_len().is_some() {
+                    return Ok(());
+                }
+                if !is_matrix && single.components() == 1 {
+                    return if component_fits(single) {
+                        Ok(())
+                    } else {
+                        Err(format!("cannot splat `{single}` into `{name}`: convert it first, e.g. `{}(x)`", target.name()))
+                    };
+                }
+            }
+            if let Some(bad) = args.iter().find(|a| !component_fits(a)) {
+                return Err(format!(
+                    "`{name}` is built from `{}` components, but one argument is `{bad}` (convert it explicitly)",
+                    target.name()
+                ));
             }
             if is_matrix
                 && args

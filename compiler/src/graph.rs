@@ -75,7 +75,10 @@ pub fn build(checked: &Checked) -> (EffectGraph, Vec<Diagnostic>) {
             continue;
         }
         cyclic = true;
-        let path = cycle_path(&graph, &scc);
+        // Edges run from the used effect to its user; report the cycle the way
+        // it reads in the source ("a -> b": `a` reads `b`).
+        let mut path = cycle_path(&graph, &scc);
+        path[1..].reverse();
         let names: Vec<&str> = path
             .iter()
             .map(|n| effects[graph[*n].index()].name.as_str())
@@ -91,14 +94,14 @@ pub fn build(checked: &Checked) -> (EffectGraph, Vec<Diagnostic>) {
         );
         for (k, &n) in path.iter().enumerate() {
             let next = path[(k + 1) % path.len()];
-            let user = &effects[graph[next].index()];
+            let user = &effects[graph[n].index()];
             let span = user
                 .deps
                 .iter()
-                .find(|(dep, _)| *dep == graph[n])
+                .find(|(dep, _)| *dep == graph[next])
                 .map(|(_, s)| *s)
                 .unwrap_or(user.name_span);
-            let message = format!("`{}` reads `{}`", user.name, effects[graph[n].index()].name);
+            let message = format!("`{}` reads `{}`", user.name, effects[graph[next].index()].name);
             d = d.with_label(if k == 0 {
                 Label::primary(span, message)
             } else {
