@@ -78,33 +78,17 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
             let errors = diagnostics.iter().filter(|d| d.is_error()).count();
             let warnings = diagnostics.len() - errors;
             if errors > 0 {
-                eprintln!(
-                    "{name}: {errors} error{}, {warnings} warning{}",
-                    plural(errors),
-                    plural(warnings)
-                );
+                eprintln!("{name}: {errors} error{}, {warnings} warning{}", plural(errors), plural(warnings));
                 Ok(ExitCode::from(1))
             } else {
                 eprintln!("{name}: ok ({warnings} warning{})", plural(warnings));
                 Ok(ExitCode::SUCCESS)
             }
         }
-        Command::Compile {
-            file,
-            out_dir,
-            emit,
-            blocks,
-        } => {
+        Command::Compile { file, out_dir, emit, blocks } => {
             let (name, source) = read(file)?;
-            let block_sizes: Vec<u32> = blocks
-                .iter()
-                .map(|b| b.parse().expect("clap restricts block sizes"))
-                .collect();
-            let options = Options {
-                block_sizes: block_sizes.clone(),
-                file_name: name.clone(),
-                ..Options::default()
-            };
+            let block_sizes: Vec<u32> = blocks.iter().map(|b| b.parse().expect("clap restricts block sizes")).collect();
+            let options = Options { block_sizes: block_sizes.clone(), file_name: name.clone(), ..Options::default() };
             let program = match mrsl::compile(&source, &options) {
                 Ok(p) => p,
                 Err(diagnostics) => {
@@ -113,36 +97,24 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
                 }
             };
             report(cli.color, &program.warnings, &name, &source);
-            let layout =
-                serde_json::to_string_pretty(&program.layout).map_err(|e| e.to_string())?;
+            let layout = serde_json::to_string_pretty(&program.layout).map_err(|e| e.to_string())?;
             if let Some(emit) = emit {
                 let block = *block_sizes.last().unwrap_or(&4);
                 let text = match emit {
                     Emit::Layout => layout,
-                    Emit::Coarse => program
-                        .kernel(KernelKind::Coarse, block)
-                        .map(|k| k.wgsl.clone())
-                        .unwrap_or_default(),
-                    Emit::Fine => program
-                        .kernel(KernelKind::Fine, block)
-                        .map(|k| k.wgsl.clone())
-                        .unwrap_or_default(),
-                    Emit::Reference => program
-                        .kernel(KernelKind::Reference, block)
-                        .map(|k| k.wgsl.clone())
-                        .unwrap_or_default(),
+                    Emit::Coarse => {
+                        program.kernel(KernelKind::Coarse, block).map(|k| k.wgsl.clone()).unwrap_or_default()
+                    }
+                    Emit::Fine => program.kernel(KernelKind::Fine, block).map(|k| k.wgsl.clone()).unwrap_or_default(),
+                    Emit::Reference => {
+                        program.kernel(KernelKind::Reference, block).map(|k| k.wgsl.clone()).unwrap_or_default()
+                    }
                 };
-                std::io::stdout()
-                    .write_all(text.as_bytes())
-                    .map_err(|e| e.to_string())?;
+                std::io::stdout().write_all(text.as_bytes()).map_err(|e| e.to_string())?;
                 return Ok(ExitCode::SUCCESS);
             }
-            std::fs::create_dir_all(out_dir)
-                .map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
-            let stem = file
-                .file_stem()
-                .and_then(|s| s.to_str())
-                .unwrap_or("program");
+            std::fs::create_dir_all(out_dir).map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
+            let stem = file.file_stem().and_then(|s| s.to_str()).unwrap_or("program");
             let mut written = vec![];
             for k in &program.kernels {
                 let file_name = match k.block_size {
@@ -161,8 +133,7 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
 }
 
 fn read(file: &Path) -> Result<(String, String), String> {
-    let source = std::fs::read_to_string(file)
-        .map_err(|e| format!("cannot read {}: {e}", file.display()))?;
+    let source = std::fs::read_to_string(file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
     Ok((file.display().to_string(), source))
 }
 

@@ -46,8 +46,7 @@ fn examples() -> Vec<(String, String)> {
         .into_iter()
         .map(|p| {
             let name = p.file_stem().unwrap().to_string_lossy().into_owned();
-            let source = std::fs::read_to_string(&p)
-                .unwrap_or_else(|e| panic!("reading {}: {e}", p.display()));
+            let source = std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("reading {}: {e}", p.display()));
             (name, source)
         })
         .collect()
@@ -135,12 +134,7 @@ fn generate(n: usize) -> String {
                 (g, 1, vec![base + 6, base + 4], decl)
             }
         };
-        effects.push(Generated {
-            name,
-            components,
-            reads,
-            decl,
-        });
+        effects.push(Generated { name, components, reads, decl });
     }
     let mut read = vec![false; n];
     for e in &effects {
@@ -168,27 +162,18 @@ fn generate(n: usize) -> String {
             _ => e.name.clone(),
         })
         .collect();
-    src.push_str(&format!(
-        "fine out float4 color = float4({}, 1.0);\n",
-        leaves.join(" + ")
-    ));
+    src.push_str(&format!("fine out float4 color = float4({}, 1.0);\n", leaves.join(" + ")));
     src
 }
 
 fn options_b4() -> mrsl::Options {
-    mrsl::Options {
-        block_sizes: vec![4],
-        ..Default::default()
-    }
+    mrsl::Options { block_sizes: vec![4], ..Default::default() }
 }
 
 /// Panics with the rendered diagnostics if `source` does not compile.
 fn assert_compiles(name: &str, source: &str, options: &mrsl::Options) {
     if let Err(diagnostics) = mrsl::compile(source, options) {
-        panic!(
-            "benchmark program {name} does not compile:\n{}",
-            mrsl::render_all(&diagnostics, name, source)
-        );
+        panic!("benchmark program {name} does not compile:\n{}", mrsl::render_all(&diagnostics, name, source));
     }
 }
 
@@ -200,11 +185,9 @@ fn bench_examples(c: &mut Criterion) {
     configure(&mut group);
     for (name, source) in &examples {
         assert_compiles(name, source, &options);
-        group.bench_with_input(
-            BenchmarkId::from_parameter(name),
-            source,
-            |bench, source| bench.iter(|| mrsl::compile(black_box(source), black_box(&options))),
-        );
+        group.bench_with_input(BenchmarkId::from_parameter(name), source, |bench, source| {
+            bench.iter(|| mrsl::compile(black_box(source), black_box(&options)))
+        });
     }
     group.finish();
 }
@@ -241,16 +224,12 @@ fn bench_generated(c: &mut Criterion) {
             bench.iter(|| mrsl::interface::allocate(black_box(&checked), black_box(&graph)))
         });
 
-        group.bench_with_input(
-            BenchmarkId::new("compile_b4", n),
-            &source,
-            |bench, source| bench.iter(|| mrsl::compile(black_box(source), black_box(&b4))),
-        );
-        group.bench_with_input(
-            BenchmarkId::new("compile_default", n),
-            &source,
-            |bench, source| bench.iter(|| mrsl::compile(black_box(source), black_box(&default))),
-        );
+        group.bench_with_input(BenchmarkId::new("compile_b4", n), &source, |bench, source| {
+            bench.iter(|| mrsl::compile(black_box(source), black_box(&b4)))
+        });
+        group.bench_with_input(BenchmarkId::new("compile_default", n), &source, |bench, source| {
+            bench.iter(|| mrsl::compile(black_box(source), black_box(&default)))
+        });
 
         // naga's share of `compile_default`: parsing and validating the five kernels.
         let kernels: Vec<String> = mrsl::compile(&source, &default)
@@ -259,17 +238,13 @@ fn bench_generated(c: &mut Criterion) {
             .into_iter()
             .map(|k| k.wgsl)
             .collect();
-        group.bench_with_input(
-            BenchmarkId::new("naga_validate", n),
-            &kernels,
-            |bench, kernels| {
-                bench.iter(|| {
-                    for wgsl in kernels {
-                        mrsl::validate_wgsl(black_box(wgsl)).expect("valid WGSL");
-                    }
-                })
-            },
-        );
+        group.bench_with_input(BenchmarkId::new("naga_validate", n), &kernels, |bench, kernels| {
+            bench.iter(|| {
+                for wgsl in kernels {
+                    mrsl::validate_wgsl(black_box(wgsl)).expect("valid WGSL");
+                }
+            })
+        });
     }
     group.finish();
 }
@@ -304,19 +279,10 @@ fn bench_colouring(c: &mut Criterion) {
     for n in COLOUR_SIZES {
         let (nodes, sizes, edges) = random_graph(n, 0x2545_F491_4F6C_DD1D ^ n as u64);
         let (classes, exact) = mrsl::interface::colour(&nodes, &sizes, &edges);
-        let width: u32 = classes
-            .iter()
-            .map(|c| c.iter().map(|&k| sizes[k]).max().unwrap_or(0))
-            .sum();
-        eprintln!(
-            "colouring/{n}: {} edges, {} slots, {width} words, exact: {exact}",
-            edges.len(),
-            classes.len()
-        );
+        let width: u32 = classes.iter().map(|c| c.iter().map(|&k| sizes[k]).max().unwrap_or(0)).sum();
+        eprintln!("colouring/{n}: {} edges, {} slots, {width} words, exact: {exact}", edges.len(), classes.len());
         group.bench_function(BenchmarkId::from_parameter(n), |bench| {
-            bench.iter(|| {
-                mrsl::interface::colour(black_box(&nodes), black_box(&sizes), black_box(&edges))
-            })
+            bench.iter(|| mrsl::interface::colour(black_box(&nodes), black_box(&sizes), black_box(&edges)))
         });
     }
     group.finish();

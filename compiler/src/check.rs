@@ -182,10 +182,7 @@ impl Checked<'_> {
         }
     }
     pub fn effect_by_name(&self, name: &str) -> Option<EffectId> {
-        self.effects
-            .iter()
-            .position(|e| e.name == name)
-            .map(|i| EffectId(i as u32))
+        self.effects.iter().position(|e| e.name == name).map(|i| EffectId(i as u32))
     }
 }
 
@@ -260,9 +257,7 @@ pub fn check(program: &Program) -> (Checked<'_>, Vec<Diagnostic>) {
     checker.check_bodies();
     checker.check_function_recursion();
     checker.check_outputs_and_usage();
-    let Checker {
-        out, diagnostics, ..
-    } = checker;
+    let Checker { out, diagnostics, .. } = checker;
     (out, diagnostics)
 }
 
@@ -295,12 +290,7 @@ struct Checker<'a> {
     evaluating_consts: HashSet<u32>,
 }
 
-fn err(
-    code: &'static str,
-    message: impl Into<String>,
-    span: Span,
-    label: impl Into<String>,
-) -> Diagnostic {
+fn err(code: &'static str, message: impl Into<String>, span: Span, label: impl Into<String>) -> Diagnostic {
     Diagnostic::error(code, message).with_label(Label::primary(span, label))
 }
 
@@ -340,12 +330,7 @@ impl<'a> Checker<'a> {
         match Type::from_name(&name.name) {
             Some(t) => t,
             None => {
-                let mut d = err(
-                    "E0102",
-                    format!("unknown type `{}`", name.name),
-                    name.span,
-                    "not a type",
-                );
+                let mut d = err("E0102", format!("unknown type `{}`", name.name), name.span, "not a type");
                 if let Some(s) = suggest(&name.name, TYPE_NAMES.iter().copied()) {
                     d = d.with_note(format!("did you mean `{s}`?"));
                 }
@@ -357,13 +342,7 @@ impl<'a> Checker<'a> {
 
     fn new_local(&mut self, name: &Ident, ty: Type, is_param: bool) -> LocalId {
         let id = LocalId(self.out.locals.len() as u32);
-        self.out.locals.push(LocalInfo {
-            name: name.name.clone(),
-            ty,
-            span: name.span,
-            reassigned: false,
-            is_param,
-        });
+        self.out.locals.push(LocalInfo { name: name.name.clone(), ty, span: name.span, reassigned: false, is_param });
         id
     }
 
@@ -381,19 +360,13 @@ impl<'a> Checker<'a> {
                 ));
             }
         }
-        let scope = self
-            .scopes
-            .last_mut()
-            .expect("locals are declared inside a scope");
+        let scope = self.scopes.last_mut().expect("locals are declared inside a scope");
         if let Some(previous) = scope.insert(name.name.clone(), id) {
             let previous_span = self.out.locals[previous.index()].span;
             self.error(
-                Diagnostic::error(
-                    "E0101",
-                    format!("`{}` is defined twice in the same scope", name.name),
-                )
-                .with_label(Label::primary(name.span, "defined again here"))
-                .with_label(Label::secondary(previous_span, "first defined here")),
+                Diagnostic::error("E0101", format!("`{}` is defined twice in the same scope", name.name))
+                    .with_label(Label::primary(name.span, "defined again here"))
+                    .with_label(Label::secondary(previous_span, "first defined here")),
             );
         }
         id
@@ -437,12 +410,7 @@ impl<'a> Checker<'a> {
             match item {
                 Item::Input(d) => {
                     let ty = self.resolve_type(&d.ty);
-                    self.out.inputs.push(InputInfo {
-                        name: d.name.name.clone(),
-                        ty,
-                        key: None,
-                        span: d.span,
-                    });
+                    self.out.inputs.push(InputInfo { name: d.name.name.clone(), ty, key: None, span: d.span });
                 }
                 Item::Uniform(d) => {
                     let ty = self.resolve_type(&d.ty);
@@ -451,21 +419,11 @@ impl<'a> Checker<'a> {
                         Type::Sampler => UniformKind::Sampler,
                         _ => UniformKind::Value { default: None },
                     };
-                    self.out.uniforms.push(UniformInfo {
-                        name: d.name.name.clone(),
-                        ty,
-                        kind,
-                        span: d.span,
-                    });
+                    self.out.uniforms.push(UniformInfo { name: d.name.name.clone(), ty, kind, span: d.span });
                 }
                 Item::Const(d) => {
                     let ty = self.resolve_type(&d.ty);
-                    self.out.consts.push(ConstInfo {
-                        name: d.name.name.clone(),
-                        ty,
-                        value: None,
-                        item: index,
-                    });
+                    self.out.consts.push(ConstInfo { name: d.name.name.clone(), ty, value: None, item: index });
                 }
                 Item::Function(d) => {
                     let ret = self.resolve_type(&d.ret);
@@ -529,13 +487,8 @@ impl<'a> Checker<'a> {
         );
         if !allowed && !ty.is_error() {
             self.error(
-                err(
-                    "E0104",
-                    format!("a G-buffer channel cannot have type `{ty}`"),
-                    d.ty.span,
-                    "not a channel type",
-                )
-                .with_note("channels are scalars or vectors of float, int or uint"),
+                err("E0104", format!("a G-buffer channel cannot have type `{ty}`"), d.ty.span, "not a channel type")
+                    .with_note("channels are scalars or vectors of float, int or uint"),
             );
         }
         for attr in &d.attrs {
@@ -545,9 +498,7 @@ impl<'a> Checker<'a> {
                         [] => Some(KeyCompare::Exact),
                         [arg] => match self.const_eval(arg) {
                             Some(v) if v.values.len() == 1 && v.values[0] >= 0.0 => {
-                                Some(KeyCompare::Threshold {
-                                    threshold: v.values[0],
-                                })
+                                Some(KeyCompare::Threshold { threshold: v.values[0] })
                             }
                             _ => {
                                 self.error(err(
@@ -588,19 +539,14 @@ impl<'a> Checker<'a> {
     }
 
     fn unknown_attribute(&mut self, attr: &Attribute, name: &str, known: &[&str]) {
-        let list = known
-            .iter()
-            .map(|k| format!("`@{k}`"))
-            .collect::<Vec<_>>()
-            .join(", ");
+        let list = known.iter().map(|k| format!("`@{k}`")).collect::<Vec<_>>().join(", ");
         self.error(
-            err(
-                "E0110",
-                format!("unknown attribute `@{name}` here"),
-                attr.span,
-                "not allowed on this declaration",
-            )
-            .with_note(format!("allowed here: {list}")),
+            err("E0110", format!("unknown attribute `@{name}` here"), attr.span, "not allowed on this declaration")
+                .with_note(if known.is_empty() {
+                    "this declaration takes no attributes".to_string()
+                } else {
+                    format!("allowed here: {list}")
+                }),
         );
     }
 
@@ -632,10 +578,7 @@ impl<'a> Checker<'a> {
                     1
                 }
             };
-            let sixteen = matches!(
-                ty,
-                Type::Vector(Scalar::Float | Scalar::Int | Scalar::Uint, 4) | Type::Matrix(4)
-            );
+            let sixteen = matches!(ty, Type::Vector(Scalar::Float | Scalar::Int | Scalar::Uint, 4) | Type::Matrix(4));
             if !sixteen && !ty.is_error() {
                 self.error(
                     err("E0113", format!("uniform arrays of `{ty}` are not supported"), d.ty.span, "element type")
@@ -659,19 +602,12 @@ impl<'a> Checker<'a> {
                     let value = self.const_eval(default);
                     match value {
                         Some(v) if v.ty.converts_to(&ty) || v.ty == ty => {
-                            self.out.uniforms[id.index()].kind = UniformKind::Value {
-                                default: Some(ConstValue {
-                                    ty: ty.clone(),
-                                    values: v.values,
-                                }),
-                            };
+                            self.out.uniforms[id.index()].kind =
+                                UniformKind::Value { default: Some(ConstValue { ty: ty.clone(), values: v.values }) };
                         }
                         Some(v) => self.error(err(
                             "E0201",
-                            format!(
-                                "default value has type `{}`, but the uniform is `{ty}`",
-                                v.ty
-                            ),
+                            format!("default value has type `{}`, but the uniform is `{ty}`", v.ty),
                             default.span,
                             "wrong type",
                         )),
@@ -698,44 +634,30 @@ impl<'a> Checker<'a> {
             _ => ty.is_value(),
         };
         if !ok && !ty.is_error() {
-            let what = if d.rate == Rate::Out {
-                "an output"
-            } else {
-                "an effect"
-            };
+            let what = if d.rate == Rate::Out { "an output" } else { "an effect" };
             self.error(
-                err(
-                    "E0104",
-                    format!("{what} cannot have type `{ty}`"),
-                    d.ty.span,
-                    "unsupported type",
-                )
-                .with_note(if d.rate == Rate::Out {
-                    "outputs are scalars or vectors of float, int or uint"
-                } else {
-                    "effects are scalars, vectors or matrices"
-                }),
+                err("E0104", format!("{what} cannot have type `{ty}`"), d.ty.span, "unsupported type").with_note(
+                    if d.rate == Rate::Out {
+                        "outputs are scalars or vectors of float, int or uint"
+                    } else {
+                        "effects are scalars, vectors or matrices"
+                    },
+                ),
             );
         }
         for attr in &d.attrs {
             match (attr.name.name.as_str(), d.rate) {
-                ("nearest", Rate::Coarse) if attr.args.is_empty() => {
-                    self.out.effects[id.index()].nearest = true
+                ("nearest", Rate::Coarse) if !attr.args.is_empty() => {
+                    self.error(err("E0110", "`@nearest` takes no arguments", attr.span, "remove the arguments"))
                 }
+                ("nearest", Rate::Coarse) => self.out.effects[id.index()].nearest = true,
                 ("format", Rate::Out) => {
                     let format = match attr.args.as_slice() {
-                        [
-                            Expr {
-                                kind: ExprKind::Name(n),
-                                ..
-                            },
-                        ] => Some(n.clone()),
+                        [Expr { kind: ExprKind::Name(n), .. }] => Some(n.clone()),
                         _ => None,
                     };
                     match format {
-                        Some(f) if output_format_fits(&f, &ty) => {
-                            self.out.effects[id.index()].format = Some(f)
-                        }
+                        Some(f) if output_format_fits(&f, &ty) => self.out.effects[id.index()].format = Some(f),
                         Some(f) => self.error(
                             err(
                                 "E0116",
@@ -743,10 +665,7 @@ impl<'a> Checker<'a> {
                                 attr.span,
                                 "unsupported format",
                             )
-                            .with_note(format!(
-                                "formats for `{ty}`: {}",
-                                formats_for(&ty).join(", ")
-                            )),
+                            .with_note(format!("formats for `{ty}`: {}", formats_for(&ty).join(", "))),
                         ),
                         None => self.error(err(
                             "E0116",
@@ -776,10 +695,7 @@ impl<'a> Checker<'a> {
             let decl = self.out.const_decl(id);
             self.error(err(
                 "E0301",
-                format!(
-                    "constant `{}` is defined in terms of itself",
-                    decl.name.name
-                ),
+                format!("constant `{}` is defined in terms of itself", decl.name.name),
                 decl.name.span,
                 "cyclic constant",
             ));
@@ -799,10 +715,7 @@ impl<'a> Checker<'a> {
         self.ctx = saved;
         self.expect_type(&init_ty, &ty, decl.value.span, "constant initialiser");
         let value = match value {
-            Some(v) => Some(ConstValue {
-                ty: ty.clone(),
-                values: v.values,
-            }),
+            Some(v) => Some(ConstValue { ty: ty.clone(), values: v.values }),
             None => {
                 if !init_ty.is_error() {
                     self.error(err(
@@ -822,12 +735,7 @@ impl<'a> Checker<'a> {
 
     /// Evaluates literals, constants, arithmetic and constructors at compile time.
     fn const_eval(&mut self, e: &Expr) -> Option<ConstValue> {
-        let scalar = |ty: Type, v: f64| {
-            Some(ConstValue {
-                ty,
-                values: vec![v],
-            })
-        };
+        let scalar = |ty: Type, v: f64| Some(ConstValue { ty, values: vec![v] });
         match &e.kind {
             ExprKind::Int(v, IntSuffix::None) => scalar(Type::AbstractInt, *v as f64),
             ExprKind::Int(v, IntSuffix::U) => scalar(types::UINT, *v as f64),
@@ -843,16 +751,9 @@ impl<'a> Checker<'a> {
             },
             ExprKind::Unary(UnaryOp::Neg, inner) => {
                 let v = self.const_eval(inner)?;
-                Some(ConstValue {
-                    ty: v.ty,
-                    values: v.values.iter().map(|x| -x).collect(),
-                })
+                Some(ConstValue { ty: v.ty, values: v.values.iter().map(|x| -x).collect() })
             }
-            ExprKind::Binary(
-                op @ (BinaryOp::Add | BinaryOp::Sub | BinaryOp::Mul | BinaryOp::Div),
-                a,
-                b,
-            ) => {
+            ExprKind::Binary(op @ (BinaryOp::Add | BinaryOp::Sub | BinaryOp::Mul | BinaryOp::Div), a, b) => {
                 let a = self.const_eval(a)?;
                 let b = self.const_eval(b)?;
                 if a.values.len() != b.values.len() && a.values.len() != 1 && b.values.len() != 1 {
@@ -861,21 +762,12 @@ impl<'a> Checker<'a> {
                 if matches!(a.ty, Type::Matrix(_)) || matches!(b.ty, Type::Matrix(_)) {
                     return None;
                 }
-                let ty = if a.values.len() >= b.values.len() {
-                    a.ty.clone()
-                } else {
-                    b.ty.clone()
-                };
+                let ty = if a.values.len() >= b.values.len() { a.ty.clone() } else { b.ty.clone() };
                 let ty = match (&a.ty, &b.ty) {
-                    (Type::AbstractInt, Type::AbstractFloat)
-                    | (Type::AbstractFloat, Type::AbstractInt) => Type::AbstractFloat,
-                    (x, y)
-                        if x.is_abstract()
-                            && !y.is_abstract()
-                            && b.values.len() >= a.values.len() =>
-                    {
-                        y.clone()
+                    (Type::AbstractInt, Type::AbstractFloat) | (Type::AbstractFloat, Type::AbstractInt) => {
+                        Type::AbstractFloat
                     }
+                    (x, y) if x.is_abstract() && !y.is_abstract() && b.values.len() >= a.values.len() => y.clone(),
                     _ => ty,
                 };
                 let integer = matches!(ty.scalar(), Some(Scalar::Int | Scalar::Uint));
@@ -944,42 +836,26 @@ impl<'a> Checker<'a> {
         for p in &f.params {
             let ty = self.resolve_type(&p.ty);
             if matches!(ty, Type::Array(..)) {
-                self.error(err(
-                    "E0104",
-                    "functions cannot take arrays",
-                    p.ty.span,
-                    "unsupported parameter type",
-                ));
+                self.error(err("E0104", "functions cannot take arrays", p.ty.span, "unsupported parameter type"));
             }
             params.push(self.declare_local(&p.name, ty, true));
         }
         self.out.functions[id.index()].params = params;
         let ret = self.out.functions[id.index()].ret.clone();
         if !ret.is_value() && !ret.is_error() {
-            self.error(err(
-                "E0104",
-                format!("functions cannot return `{ret}`"),
-                f.ret.span,
-                "unsupported return type",
-            ));
+            self.error(err("E0104", format!("functions cannot return `{ret}`"), f.ret.span, "unsupported return type"));
         }
         self.block(&f.body);
         if !block_returns(&f.body) && !ret.is_error() {
             self.error(
                 err(
                     "E0303",
-                    format!(
-                        "function `{}` may end without returning a value",
-                        f.name.name
-                    ),
+                    format!("function `{}` may end without returning a value", f.name.name),
                     f.name.span,
                     "not every path returns",
                 )
                 .with_label(Label::secondary(
-                    Span {
-                        start: f.body.span.end.saturating_sub(1),
-                        end: f.body.span.end,
-                    },
+                    Span { start: f.body.span.end.saturating_sub(1), end: f.body.span.end },
                     "can reach the end here",
                 )),
             );
@@ -1004,11 +880,7 @@ impl<'a> Checker<'a> {
                 self.out.effects[id.index()].result = Some(result);
                 self.block(block);
                 if !block_assigns(block, &e.name.name) {
-                    let what = if e.rate == Rate::Out {
-                        "output"
-                    } else {
-                        "effect"
-                    };
+                    let what = if e.rate == Rate::Out { "output" } else { "effect" };
                     self.error(
                         err(
                             "E0302",
@@ -1017,16 +889,10 @@ impl<'a> Checker<'a> {
                             "declared here",
                         )
                         .with_label(Label::secondary(
-                            Span {
-                                start: block.span.end.saturating_sub(1),
-                                end: block.span.end,
-                            },
+                            Span { start: block.span.end.saturating_sub(1), end: block.span.end },
                             "may reach the end unassigned",
                         ))
-                        .with_note(format!(
-                            "assign `{} = ...;` on every path through the body",
-                            e.name.name
-                        )),
+                        .with_note(format!("assign `{} = ...;` on every path through the body", e.name.name)),
                     );
                 }
             }
@@ -1048,7 +914,12 @@ impl<'a> Checker<'a> {
             StmtKind::Local { ty, name, init } => {
                 let declared = self.resolve_type(ty);
                 if !declared.is_value() && !declared.is_error() {
-                    self.error(err("E0104", format!("a local variable cannot have type `{declared}`"), ty.span, "unsupported type"));
+                    self.error(err(
+                        "E0104",
+                        format!("a local variable cannot have type `{declared}`"),
+                        ty.span,
+                        "unsupported type",
+                    ));
                 }
                 if let Some(init) = init {
                     let t = self.expr(init);
@@ -1085,7 +956,12 @@ impl<'a> Checker<'a> {
             StmtKind::Step { target, .. } => {
                 let t = self.lvalue(target);
                 if !matches!(t, Type::Scalar(Scalar::Int | Scalar::Uint | Scalar::Float) | Type::Error) {
-                    self.error(err("E0201", format!("`++`/`--` needs a numeric scalar, found `{t}`"), target.span, "not a number"));
+                    self.error(err(
+                        "E0201",
+                        format!("`++`/`--` needs a numeric scalar, found `{t}`"),
+                        target.span,
+                        "not a number",
+                    ));
                 }
             }
             StmtKind::If { cond, then, otherwise } => {
@@ -1121,8 +997,13 @@ impl<'a> Checker<'a> {
                     let e = &self.out.effects[id.index()];
                     let (name, rate_span) = (e.name.clone(), self.out.effect_decl(id).rate_span);
                     self.error(
-                        err("E0304", "`refine` outside a coarse effect", s.span, "refine is only meaningful at coarse rate")
-                            .with_label(Label::secondary(rate_span, format!("`{name}` is computed per pixel"))),
+                        err(
+                            "E0304",
+                            "`refine` outside a coarse effect",
+                            s.span,
+                            "refine is only meaningful at coarse rate",
+                        )
+                        .with_label(Label::secondary(rate_span, format!("`{name}` is computed per pixel"))),
                     );
                 }
                 _ => self.error(
@@ -1138,7 +1019,12 @@ impl<'a> Checker<'a> {
                             let t = self.expr(v);
                             self.expect_type(&t, &ret, v.span, "return value");
                         }
-                        None => self.error(err("E0201", format!("this function must return a `{ret}`"), s.span, "missing value")),
+                        None => self.error(err(
+                            "E0201",
+                            format!("this function must return a `{ret}`"),
+                            s.span,
+                            "missing value",
+                        )),
                     }
                 }
                 _ => {
@@ -1169,12 +1055,7 @@ impl<'a> Checker<'a> {
     fn condition(&mut self, cond: &Expr, what: &str) {
         let t = self.expr(cond);
         if t != types::BOOL && !t.is_error() {
-            let mut d = err(
-                "E0202",
-                format!("{what} must be `bool`, found `{t}`"),
-                cond.span,
-                "not a bool",
-            );
+            let mut d = err("E0202", format!("{what} must be `bool`, found `{t}`"), cond.span, "not a bool");
             if matches!(t, Type::Vector(Scalar::Bool, _)) {
                 d = d.with_note("use `any(...)` or `all(...)` to reduce a vector of bools");
             }
@@ -1194,24 +1075,12 @@ impl<'a> Checker<'a> {
         body: &Stmt,
     ) {
         let var = match init.map(|i| &i.kind) {
-            Some(StmtKind::Local {
-                name,
-                init: Some(v),
-                ty,
-            }) => {
+            Some(StmtKind::Local { name, init: Some(v), ty }) => {
                 if self.const_eval(v).is_none() {
-                    self.error(err(
-                        "E0401",
-                        "loop has no static bound",
-                        v.span,
-                        "the start value must be a constant",
-                    ));
+                    self.error(err("E0401", "loop has no static bound", v.span, "the start value must be a constant"));
                     return;
                 }
-                if !matches!(
-                    Type::from_name(&ty.name),
-                    Some(Type::Scalar(Scalar::Int | Scalar::Uint))
-                ) {
+                if !matches!(Type::from_name(&ty.name), Some(Type::Scalar(Scalar::Int | Scalar::Uint))) {
                     self.error(err(
                         "E0401",
                         "loop has no static bound",
@@ -1224,29 +1093,24 @@ impl<'a> Checker<'a> {
             }
             _ => {
                 self.error(
-                    err(
-                        "E0401",
-                        "loop has no static bound",
-                        s.span,
-                        "expected `for (int i = START; i < END; i++)`",
-                    )
-                    .with_note("the loop must declare its counter with a constant start value"),
+                    err("E0401", "loop has no static bound", s.span, "expected `for (int i = START; i < END; i++)`")
+                        .with_note("the loop must declare its counter with a constant start value"),
                 );
                 return;
             }
         };
         let is_var = |e: &Expr| matches!(&e.kind, ExprKind::Name(n) if *n == var);
         let bound = match cond.map(|c| &c.kind) {
-            Some(ExprKind::Binary(
-                BinaryOp::Lt | BinaryOp::Le | BinaryOp::Gt | BinaryOp::Ge | BinaryOp::Ne,
-                a,
-                b,
-            )) if is_var(a) => Some(b.as_ref()),
-            Some(ExprKind::Binary(
-                BinaryOp::Lt | BinaryOp::Le | BinaryOp::Gt | BinaryOp::Ge | BinaryOp::Ne,
-                a,
-                b,
-            )) if is_var(b) => Some(a.as_ref()),
+            Some(ExprKind::Binary(BinaryOp::Lt | BinaryOp::Le | BinaryOp::Gt | BinaryOp::Ge | BinaryOp::Ne, a, b))
+                if is_var(a) =>
+            {
+                Some(b.as_ref())
+            }
+            Some(ExprKind::Binary(BinaryOp::Lt | BinaryOp::Le | BinaryOp::Gt | BinaryOp::Ge | BinaryOp::Ne, a, b))
+                if is_var(b) =>
+            {
+                Some(a.as_ref())
+            }
             _ => None,
         };
         match bound {
@@ -1271,11 +1135,9 @@ impl<'a> Checker<'a> {
         }
         let step_ok = match step.map(|st| &st.kind) {
             Some(StmtKind::Step { target, .. }) => is_var(target),
-            Some(StmtKind::Assign {
-                target,
-                op: AssignOp::Add | AssignOp::Sub,
-                value,
-            }) => is_var(target) && self.const_eval(value).is_some(),
+            Some(StmtKind::Assign { target, op: AssignOp::Add | AssignOp::Sub, value }) => {
+                is_var(target) && self.const_eval(value).is_some()
+            }
             _ => false,
         };
         if !step_ok {
@@ -1288,6 +1150,52 @@ impl<'a> Checker<'a> {
             ));
             return;
         }
+        // The shape is right; now the trip count must be finite and modest.
+        let start = match init.map(|i| &i.kind) {
+            Some(StmtKind::Local { init: Some(v), .. }) => self.const_eval(v).map(|c| c.values[0]),
+            _ => None,
+        };
+        let (op, var_left, limit) = match cond.map(|c| &c.kind) {
+            Some(ExprKind::Binary(op, a, b)) => {
+                (*op, is_var(a), self.const_eval(if is_var(a) { b } else { a }).map(|c| c.values[0]))
+            }
+            _ => (BinaryOp::Lt, true, None),
+        };
+        let delta = match step.map(|st| &st.kind) {
+            Some(StmtKind::Step { increment, .. }) => Some(if *increment { 1.0 } else { -1.0 }),
+            Some(StmtKind::Assign { op: AssignOp::Add, value, .. }) => self.const_eval(value).map(|c| c.values[0]),
+            Some(StmtKind::Assign { op: AssignOp::Sub, value, .. }) => self.const_eval(value).map(|c| -c.values[0]),
+            _ => None,
+        };
+        if let (Some(mut i), Some(limit), Some(delta)) = (start, limit, delta) {
+            let holds = |i: f64| {
+                let (x, y) = if var_left { (i, limit) } else { (limit, i) };
+                match op {
+                    BinaryOp::Lt => x < y,
+                    BinaryOp::Le => x <= y,
+                    BinaryOp::Gt => x > y,
+                    BinaryOp::Ge => x >= y,
+                    _ => x != y,
+                }
+            };
+            let mut trips = 0u64;
+            while holds(i) && trips <= MAX_LOOP_TRIPS {
+                i += delta;
+                trips += 1;
+            }
+            if trips > MAX_LOOP_TRIPS {
+                self.error(
+                    err(
+                        "E0402",
+                        "loop does not terminate within the iteration limit",
+                        s.span,
+                        format!("runs more than {MAX_LOOP_TRIPS} times"),
+                    )
+                    .with_note("check the direction of the step against the condition"),
+                );
+                return;
+            }
+        }
         if let Some(span) = stmt_assigns_name(body, &var) {
             self.error(
                 err(
@@ -1296,10 +1204,7 @@ impl<'a> Checker<'a> {
                     span,
                     format!("the loop variable `{var}` is assigned in the body"),
                 )
-                .with_label(Label::secondary(
-                    init.map(|i| i.span).unwrap_or(s.span),
-                    "declared here",
-                )),
+                .with_label(Label::secondary(init.map(|i| i.span).unwrap_or(s.span), "declared here")),
             );
         }
     }
@@ -1359,12 +1264,7 @@ impl<'a> Checker<'a> {
             }
             _ => {
                 self.expr(target);
-                self.error(err(
-                    "E0203",
-                    "cannot assign to this expression",
-                    target.span,
-                    "not a variable",
-                ));
+                self.error(err("E0203", "cannot assign to this expression", target.span, "not a variable"));
                 Type::Error
             }
         }
@@ -1379,15 +1279,9 @@ impl<'a> Checker<'a> {
                 span,
                 format!("this is `{found}`"),
             );
-            if found.is_numeric_value()
-                && expected.is_numeric_value()
-                && found.components() == expected.components()
-            {
+            if found.is_numeric_value() && expected.is_numeric_value() && found.components() == expected.components() {
                 d = d.with_note(format!("convert explicitly: `{}(...)`", expected.name()));
-            } else if found.scalar().is_some()
-                && found.components() == 1
-                && expected.vector_len().is_some()
-            {
+            } else if found.scalar().is_some() && found.components() == 1 && expected.vector_len().is_some() {
                 d = d.with_note(format!("widen explicitly: `{}(...)`", expected.name()));
             }
             self.error(d);
@@ -1408,15 +1302,17 @@ impl<'a> Checker<'a> {
 
     fn expr_inner(&mut self, e: &Expr) -> Type {
         match &e.kind {
+            ExprKind::Int(v, IntSuffix::None) if *v > i32::MAX as u64 => {
+                self.error(
+                    err("E0205", "integer literal out of range for `int`", e.span, "larger than 2147483647")
+                        .with_note("write it as a `uint` (`4294967295u`) or a float (`3e9`)"),
+                );
+                Type::Error
+            }
             ExprKind::Int(_, IntSuffix::None) => Type::AbstractInt,
             ExprKind::Int(v, IntSuffix::I) => {
-                if *v > i32::MAX as u64 + 1 {
-                    self.error(err(
-                        "E0205",
-                        "integer literal out of range for `int`",
-                        e.span,
-                        "too large",
-                    ));
+                if *v > i32::MAX as u64 {
+                    self.error(err("E0205", "integer literal out of range for `int`", e.span, "too large"));
                 }
                 types::INT
             }
@@ -1430,11 +1326,15 @@ impl<'a> Checker<'a> {
                     return Type::Error;
                 }
                 let ok = match op {
-                    UnaryOp::Neg => t.is_numeric_value() || t.is_abstract(),
-                    UnaryOp::Not => t == types::BOOL,
-                    UnaryOp::BitNot => {
-                        matches!(t.scalar(), Some(Scalar::Int | Scalar::Uint))
+                    // WGSL negates signed scalars and vectors only.
+                    UnaryOp::Neg | UnaryOp::Pos => {
+                        (t.is_numeric_value() || t.is_abstract())
+                            && t.scalar() != Some(Scalar::Uint)
                             && !matches!(t, Type::Matrix(_))
+                    }
+                    UnaryOp::Not => matches!(t, Type::Scalar(Scalar::Bool) | Type::Vector(Scalar::Bool, _)),
+                    UnaryOp::BitNot => {
+                        matches!(t.scalar(), Some(Scalar::Int | Scalar::Uint)) && !matches!(t, Type::Matrix(_))
                     }
                 };
                 if ok {
@@ -1442,15 +1342,11 @@ impl<'a> Checker<'a> {
                 } else {
                     let sym = match op {
                         UnaryOp::Neg => "-",
+                        UnaryOp::Pos => "+",
                         UnaryOp::Not => "!",
                         UnaryOp::BitNot => "~",
                     };
-                    self.error(err(
-                        "E0201",
-                        format!("cannot apply `{sym}` to `{t}`"),
-                        e.span,
-                        "invalid operand",
-                    ));
+                    self.error(err("E0201", format!("cannot apply `{sym}` to `{t}`"), e.span, "invalid operand"));
                     Type::Error
                 }
             }
@@ -1461,6 +1357,32 @@ impl<'a> Checker<'a> {
                     return Type::Error;
                 }
                 match binary_type(*op, &ta, &tb) {
+                    // WGSL folds literal-only arithmetic at shader creation;
+                    // what it would reject must be reported here.
+                    Ok(t) if t.is_abstract() => {
+                        if matches!(op, BinaryOp::Div | BinaryOp::Rem)
+                            && self.const_eval(b).is_some_and(|v| v.values.iter().all(|x| *x == 0.0))
+                        {
+                            self.error(err(
+                                "E0205",
+                                "division by zero in a constant expression",
+                                e.span,
+                                "divides by zero",
+                            ));
+                            return Type::Error;
+                        }
+                        if let Some(v) = self.const_eval(e) {
+                            let bad = v.values.iter().any(|x| {
+                                !x.is_finite()
+                                    || (t == Type::AbstractInt && (*x > i32::MAX as f64 || *x < i32::MIN as f64))
+                            });
+                            if bad {
+                                self.error(err("E0205", "constant expression out of range", e.span, "overflows"));
+                                return Type::Error;
+                            }
+                        }
+                        t
+                    }
                     Ok(t) => t,
                     Err(message) => {
                         self.error(
@@ -1477,7 +1399,8 @@ impl<'a> Checker<'a> {
                 let ta = self.expr(a);
                 let tb = self.expr(b);
                 match unify(&ta, &tb) {
-                    Some(t) => t,
+                    // `select` is a function in WGSL: literal branches become concrete.
+                    Some(t) => t.concretize(),
                     None => {
                         self.error(
                             err(
@@ -1511,18 +1434,9 @@ impl<'a> Checker<'a> {
             return self.out.locals[local.index()].ty.clone();
         }
         let Some(&(global, _)) = self.globals.get(name) else {
-            let mut d = err(
-                "E0100",
-                format!("unknown name `{name}`"),
-                e.span,
-                "not found in this scope",
-            );
-            let candidates: Vec<String> = self
-                .globals
-                .keys()
-                .cloned()
-                .chain(self.scopes.iter().flat_map(|s| s.keys().cloned()))
-                .collect();
+            let mut d = err("E0100", format!("unknown name `{name}`"), e.span, "not found in this scope");
+            let candidates: Vec<String> =
+                self.globals.keys().cloned().chain(self.scopes.iter().flat_map(|s| s.keys().cloned())).collect();
             if let Some(s) = suggest(name, candidates.iter().map(|s| s.as_str())) {
                 d = d.with_note(format!("did you mean `{s}`?"));
             }
@@ -1542,12 +1456,7 @@ impl<'a> Checker<'a> {
             }
             Global::Uniform(id) => {
                 if in_const {
-                    self.error(err(
-                        "E0115",
-                        format!("uniform `{name}` is not a constant"),
-                        e.span,
-                        "not constant",
-                    ));
+                    self.error(err("E0115", format!("uniform `{name}` is not a constant"), e.span, "not constant"));
                     return Type::Error;
                 }
                 self.out.symbols.insert(e.id, Symbol::Uniform(id));
@@ -1585,8 +1494,11 @@ impl<'a> Checker<'a> {
 
     fn context_error(&self, span: Span, name: &str, what: &str) -> Diagnostic {
         match self.ctx {
-            Ctx::Function(_) => err("E0207", format!("functions cannot read `{name}`"), span, format!("`{name}` is {what}"))
-                .with_note("functions see only their parameters, uniforms and constants: pass the value as an argument"),
+            Ctx::Function(_) => {
+                err("E0207", format!("functions cannot read `{name}`"), span, format!("`{name}` is {what}")).with_note(
+                    "functions see only their parameters, uniforms and constants: pass the value as an argument",
+                )
+            }
             _ => err("E0115", format!("`{name}` is not a constant"), span, format!("`{name}` is {what}")),
         }
     }
@@ -1624,15 +1536,8 @@ impl<'a> Checker<'a> {
                 }
                 _ => {
                     self.error(
-                        err(
-                            "E0208",
-                            format!("invalid swizzle `.{}`", field.name),
-                            field.span,
-                            "not a swizzle",
-                        )
-                        .with_note(
-                            "swizzles use `xyzw` or `rgba` (not mixed), one to four letters",
-                        ),
+                        err("E0208", format!("invalid swizzle `.{}`", field.name), field.span, "not a swizzle")
+                            .with_note("swizzles use `xyzw` or `rgba` (not mixed), one to four letters"),
                     );
                     return Type::Error;
                 }
@@ -1656,10 +1561,7 @@ impl<'a> Checker<'a> {
 
     fn index_type(&mut self, base: &Type, index: &Expr, span: Span) -> Type {
         let it = self.expr(index);
-        if !matches!(
-            it,
-            Type::Scalar(Scalar::Int | Scalar::Uint) | Type::AbstractInt | Type::Error
-        ) {
+        if !matches!(it, Type::Scalar(Scalar::Int | Scalar::Uint) | Type::AbstractInt | Type::Error) {
             self.error(err(
                 "E0201",
                 format!("an index must be `int` or `uint`, found `{it}`"),
@@ -1673,12 +1575,7 @@ impl<'a> Checker<'a> {
             Type::Array(t, _) => (**t).clone(),
             Type::Error => Type::Error,
             other => {
-                self.error(err(
-                    "E0209",
-                    format!("cannot index into `{other}`"),
-                    span,
-                    "not a vector, matrix or array",
-                ));
+                self.error(err("E0209", format!("cannot index into `{other}`"), span, "not a vector, matrix or array"));
                 Type::Error
             }
         }
@@ -1716,16 +1613,8 @@ impl<'a> Checker<'a> {
         self.in_derivative = was_in_derivative;
         if arg_types.iter().any(|t| t.is_error()) {
             // Still resolve the callee so unknown functions are reported.
-            if Type::from_name(name).is_none()
-                && !BUILTINS.contains(&name)
-                && !self.globals.contains_key(name)
-            {
-                self.error(err(
-                    "E0100",
-                    format!("unknown function `{name}`"),
-                    callee.span,
-                    "not found",
-                ));
+            if Type::from_name(name).is_none() && !BUILTINS.contains(&name) && !self.globals.contains_key(name) {
+                self.error(err("E0100", format!("unknown function `{name}`"), callee.span, "not found"));
             }
             return Type::Error;
         }
@@ -1734,12 +1623,7 @@ impl<'a> Checker<'a> {
             return match construct_check(&ty, &arg_types) {
                 Ok(()) => ty,
                 Err(message) => {
-                    self.error(err(
-                        "E0210",
-                        message,
-                        e.span,
-                        format!("in this `{name}` constructor"),
-                    ));
+                    self.error(err("E0210", message, e.span, format!("in this `{name}` constructor")));
                     Type::Error
                 }
             };
@@ -1749,19 +1633,12 @@ impl<'a> Checker<'a> {
             if let Ctx::Function(current) = self.ctx {
                 self.out.functions[current.index()].calls.push(fid);
             }
-            let params: Vec<Type> = self.out.functions[fid.index()]
-                .params
-                .iter()
-                .map(|p| self.out.locals[p.index()].ty.clone())
-                .collect();
+            let params: Vec<Type> =
+                self.out.functions[fid.index()].params.iter().map(|p| self.out.locals[p.index()].ty.clone()).collect();
             let ret = self.out.functions[fid.index()].ret.clone();
             let decl_span = self.out.function_decl(fid).name.span;
-            if params.len() != args.len()
-                && !self.out.function_decl(fid).params.is_empty() | params.is_empty()
-            {
-                // Parameters are registered when the function body is checked; a
-                // function declared later has its parameter types from its declaration.
-            }
+            // Parameters are registered when a body is checked; for a function
+            // declared later, take the types from its declaration.
             let declared: Vec<Type> = self
                 .out
                 .function_decl(fid)
@@ -1769,11 +1646,7 @@ impl<'a> Checker<'a> {
                 .iter()
                 .map(|p| Type::from_name(&p.ty.name).unwrap_or(Type::Error))
                 .collect();
-            let params = if params.len() == declared.len() {
-                params
-            } else {
-                declared
-            };
+            let params = if params.len() == declared.len() { params } else { declared };
             if params.len() != args.len() {
                 self.error(
                     err(
@@ -1823,27 +1696,13 @@ impl<'a> Checker<'a> {
                     Type::Error
                 }
                 Err(BuiltinError::Types(message)) => {
-                    let shown = arg_types
-                        .iter()
-                        .map(|t| format!("`{t}`"))
-                        .collect::<Vec<_>>()
-                        .join(", ");
-                    self.error(err(
-                        "E0212",
-                        message,
-                        e.span,
-                        format!("called with {shown}"),
-                    ));
+                    let shown = arg_types.iter().map(|t| format!("`{t}`")).collect::<Vec<_>>().join(", ");
+                    self.error(err("E0212", message, e.span, format!("called with {shown}")));
                     Type::Error
                 }
             };
         }
-        let mut d = err(
-            "E0100",
-            format!("unknown function `{name}`"),
-            callee.span,
-            "not found",
-        );
+        let mut d = err("E0100", format!("unknown function `{name}`"), callee.span, "not found");
         let functions: Vec<String> = self
             .globals
             .iter()
@@ -1852,11 +1711,7 @@ impl<'a> Checker<'a> {
             .collect();
         if let Some(s) = suggest(
             name,
-            BUILTINS
-                .iter()
-                .copied()
-                .chain(functions.iter().map(|s| s.as_str()))
-                .chain(TYPE_NAMES.iter().copied()),
+            BUILTINS.iter().copied().chain(functions.iter().map(|s| s.as_str())).chain(TYPE_NAMES.iter().copied()),
         ) {
             d = d.with_note(format!("did you mean `{s}`?"));
         }
@@ -1899,36 +1754,37 @@ impl<'a> Checker<'a> {
     fn check_outputs_and_usage(&mut self) {
         let effects = &self.out.effects;
         if !effects.iter().any(|e| e.rate == Rate::Out) {
-            let span = self
-                .out
-                .program
-                .items
-                .last()
-                .map(|i| i.name().span)
-                .unwrap_or_default();
+            let span = self.out.program.items.last().map(|i| i.name().span).unwrap_or_default();
             self.diagnostics.push(
-                err(
-                    "E0601",
-                    "the program has no output",
-                    span,
-                    "no `fine out` declared",
-                )
-                .with_note("declare at least one target, e.g. `fine out float4 color = ...;`"),
+                err("E0601", "the program has no output", span, "no `fine out` declared")
+                    .with_note("declare at least one target, e.g. `fine out float4 color = ...;`"),
             );
         }
-        let mut used = vec![false; effects.len()];
-        for e in effects {
-            for (d, _) in &e.deps {
-                used[d.index()] = true;
+        // Unused-effect warnings only on programs without errors: after an
+        // error (a duplicate, a bad name) they are mostly noise.
+        if self.diagnostics.iter().any(|d| d.is_error()) {
+            return;
+        }
+        // An effect is used when an output needs it, directly or through other effects.
+        let mut live = vec![false; effects.len()];
+        let mut stack: Vec<usize> = (0..effects.len()).filter(|&i| effects[i].rate == Rate::Out).collect();
+        while let Some(i) = stack.pop() {
+            if !std::mem::replace(&mut live[i], true) {
+                stack.extend(effects[i].deps.iter().map(|(d, _)| d.index()));
             }
         }
         for (i, e) in effects.iter().enumerate() {
-            if !used[i] && e.rate != Rate::Out {
+            if !live[i] {
+                let read = effects.iter().any(|u| u.deps.iter().any(|(d, _)| d.index() == i));
                 self.diagnostics.push(
                     Diagnostic::warning("W0001", format!("effect `{}` is never used", e.name))
                         .with_label(Label::primary(
                             e.name_span,
-                            "not read by any effect or output",
+                            if read {
+                                "read only by effects that no output needs"
+                            } else {
+                                "not read by any effect or output"
+                            },
                         ))
                         .with_note("it will not be computed"),
                 );
@@ -1970,7 +1826,8 @@ fn suggest<'s>(name: &str, candidates: impl Iterator<Item = &'s str>) -> Option<
     let mut best: Option<(usize, &str)> = None;
     for c in candidates {
         let d = edit_distance(name, c);
-        if d <= (name.len() / 3).max(1) && best.is_none_or(|(bd, _)| d < bd) {
+        // Ties go to the alphabetically first name, so output is deterministic.
+        if d <= (name.len() / 3).max(1) && best.is_none_or(|(bd, bc)| (d, c) < (bd, bc)) {
             best = Some((d, c));
         }
     }
@@ -1993,6 +1850,9 @@ fn edit_distance(a: &str, b: &str) -> usize {
     prev[b.len()]
 }
 
+/// Loops may run at most this many times (a GPU watchdog would stop longer ones).
+pub const MAX_LOOP_TRIPS: u64 = 1 << 16;
+
 /// Whether every path through `block` that reaches its end assigns `name`.
 fn block_assigns(block: &Block, name: &str) -> bool {
     block.stmts.iter().any(|s| stmt_definitely_assigns(s, name))
@@ -2000,17 +1860,11 @@ fn block_assigns(block: &Block, name: &str) -> bool {
 
 fn stmt_definitely_assigns(s: &Stmt, name: &str) -> bool {
     match &s.kind {
-        StmtKind::Assign {
-            target,
-            op: AssignOp::Set,
-            ..
-        } => matches!(&target.kind, ExprKind::Name(n) if n == name),
+        StmtKind::Assign { target, op: AssignOp::Set, .. } => matches!(&target.kind, ExprKind::Name(n) if n == name),
         StmtKind::Block(b) => block_assigns(b, name),
-        StmtKind::If {
-            then,
-            otherwise: Some(o),
-            ..
-        } => stmt_definitely_assigns(then, name) && stmt_definitely_assigns(o, name),
+        StmtKind::If { then, otherwise: Some(o), .. } => {
+            stmt_definitely_assigns(then, name) && stmt_definitely_assigns(o, name)
+        }
         _ => false,
     }
 }
@@ -2023,11 +1877,7 @@ fn stmt_returns(s: &Stmt) -> bool {
     match &s.kind {
         StmtKind::Return(_) => true,
         StmtKind::Block(b) => block_returns(b),
-        StmtKind::If {
-            then,
-            otherwise: Some(o),
-            ..
-        } => stmt_returns(then) && stmt_returns(o),
+        StmtKind::If { then, otherwise: Some(o), .. } => stmt_returns(then) && stmt_returns(o),
         _ => false,
     }
 }
@@ -2042,20 +1892,24 @@ fn stmt_assigns_name(s: &Stmt, name: &str) -> Option<Span> {
         }
     }
     match &s.kind {
-        StmtKind::Assign { target, .. } | StmtKind::Step { target, .. }
-            if root(target) == Some(name) =>
-        {
-            Some(s.span)
-        }
+        StmtKind::Assign { target, .. } | StmtKind::Step { target, .. } if root(target) == Some(name) => Some(s.span),
         StmtKind::Local { name: n, .. } if n.name == name => None,
-        StmtKind::Block(b) => b.stmts.iter().find_map(|s| stmt_assigns_name(s, name)),
-        StmtKind::If {
-            then, otherwise, ..
-        } => stmt_assigns_name(then, name)
-            .or_else(|| otherwise.as_ref().and_then(|o| stmt_assigns_name(o, name))),
-        StmtKind::For {
-            init, step, body, ..
-        } => init
+        StmtKind::Block(b) => {
+            for s in &b.stmts {
+                // A declaration of the same name shadows the loop variable from here on.
+                if matches!(&s.kind, StmtKind::Local { name: n, .. } if n.name == name) {
+                    return None;
+                }
+                if let Some(span) = stmt_assigns_name(s, name) {
+                    return Some(span);
+                }
+            }
+            None
+        }
+        StmtKind::If { then, otherwise, .. } => {
+            stmt_assigns_name(then, name).or_else(|| otherwise.as_ref().and_then(|o| stmt_assigns_name(o, name)))
+        }
+        StmtKind::For { init, step, body, .. } => init
             .as_ref()
             .and_then(|i| stmt_assigns_name(i, name))
             .or_else(|| step.as_ref().and_then(|i| stmt_assigns_name(i, name)))
@@ -2148,7 +2002,10 @@ fn binary_type(op: BinaryOp, a: &Type, b: &Type) -> Result<Type, String> {
     let (ea, sa) = parts(a).ok_or_else(mismatch)?;
     let (eb, sb) = parts(b).ok_or_else(mismatch)?;
     let elem = unify_elem(ea, eb).ok_or_else(|| {
-        format!("cannot apply `{}` to `{a}` and `{b}`: the element types differ (convert one side explicitly)", op.symbol())
+        format!(
+            "cannot apply `{}` to `{a}` and `{b}`: the element types differ (convert one side explicitly)",
+            op.symbol()
+        )
     })?;
     let is_num = |e: Elem| e != Elem::Bool;
     let is_int = |e: Elem| matches!(e, Elem::Int | Elem::Uint | Elem::AbsInt);
@@ -2167,14 +2024,8 @@ fn binary_type(op: BinaryOp, a: &Type, b: &Type) -> Result<Type, String> {
                     x
                 }
                 (Shape::Scalar, Shape::Vec(n)) | (Shape::Vec(n), Shape::Scalar) => Shape::Vec(n),
-                (Shape::Scalar, Shape::Mat(n)) | (Shape::Mat(n), Shape::Scalar) if op == Mul => {
-                    Shape::Mat(n)
-                }
-                (Shape::Mat(n), Shape::Vec(m)) | (Shape::Vec(m), Shape::Mat(n))
-                    if op == Mul && n == m =>
-                {
-                    Shape::Vec(n)
-                }
+                (Shape::Scalar, Shape::Mat(n)) | (Shape::Mat(n), Shape::Scalar) if op == Mul => Shape::Mat(n),
+                (Shape::Mat(n), Shape::Vec(m)) | (Shape::Vec(m), Shape::Mat(n)) if op == Mul && n == m => Shape::Vec(n),
                 _ => return Err(mismatch()),
             };
             if let Shape::Mat(_) = shape {
@@ -2185,10 +2036,7 @@ fn binary_type(op: BinaryOp, a: &Type, b: &Type) -> Result<Type, String> {
             Ok(build(elem, shape))
         }
         Lt | Gt | Le | Ge | Eq | Ne => {
-            if sa != sb
-                || matches!(sa, Shape::Mat(_))
-                || (!is_num(elem) && matches!(op, Lt | Gt | Le | Ge))
-            {
+            if sa != sb || matches!(sa, Shape::Mat(_)) || (!is_num(elem) && matches!(op, Lt | Gt | Le | Ge)) {
                 return Err(mismatch());
             }
             Ok(build(Elem::Bool, sa))
@@ -2197,10 +2045,7 @@ fn binary_type(op: BinaryOp, a: &Type, b: &Type) -> Result<Type, String> {
             if elem == Elem::Bool && sa == Shape::Scalar && sb == Shape::Scalar {
                 Ok(types::BOOL)
             } else {
-                Err(format!(
-                    "`{}` needs two `bool`s, found `{a}` and `{b}`",
-                    op.symbol()
-                ))
+                Err(format!("`{}` needs two `bool`s, found `{a}` and `{b}`", op.symbol()))
             }
         }
         BitAnd | BitOr | BitXor => {
@@ -2213,10 +2058,13 @@ fn binary_type(op: BinaryOp, a: &Type, b: &Type) -> Result<Type, String> {
         Shl | Shr => {
             // The shift amount may be int or uint; WGSL wants u32, codegen converts.
             if is_int(ea) && is_int(eb) && sa == sb && !matches!(sa, Shape::Mat(_)) {
-                Ok(build(
-                    if ea == Elem::AbsInt { Elem::AbsInt } else { ea },
-                    sa,
-                ))
+                // A literal shifted by a concrete amount concretizes to `int`, as in WGSL.
+                let elem = match (ea, eb) {
+                    (Elem::AbsInt, Elem::AbsInt) => Elem::AbsInt,
+                    (Elem::AbsInt, _) => Elem::Int,
+                    _ => ea,
+                };
+                Ok(build(elem, sa))
             } else {
                 Err(mismatch())
             }
@@ -2227,25 +2075,17 @@ fn binary_type(op: BinaryOp, a: &Type, b: &Type) -> Result<Type, String> {
 fn construct_check(ty: &Type, args: &[Type]) -> Result<(), String> {
     let name = ty.name();
     match ty {
-        Type::Texture2d
-        | Type::Sampler
-        | Type::Array(..)
-        | Type::AbstractFloat
-        | Type::AbstractInt
-        | Type::Error => Err(format!("`{name}` cannot be constructed")),
+        Type::Texture2d | Type::Sampler | Type::Array(..) | Type::AbstractFloat | Type::AbstractInt | Type::Error => {
+            Err(format!("`{name}` cannot be constructed"))
+        }
         Type::Scalar(_) => match args {
-            [a] if a.is_value() && a.components() == 1 => Ok(()),
+            [a] if (a.is_value() || a.is_abstract()) && a.components() == 1 => Ok(()),
             [a] => Err(format!("cannot convert `{a}` to `{name}`")),
-            _ => Err(format!(
-                "`{name}(...)` takes exactly one argument, {} given",
-                args.len()
-            )),
+            _ => Err(format!("`{name}(...)` takes exactly one argument, {} given", args.len())),
         },
         Type::Vector(_, n) | Type::Matrix(n) => {
             if args.iter().any(|a| !a.is_value() && !a.is_abstract()) {
-                return Err(format!(
-                    "`{name}` is built from numbers, vectors or matrices"
-                ));
+                return Err(format!("`{name}` is built from numbers, vectors or matrices"));
             }
             let is_matrix = matches!(ty, Type::Matrix(_));
             let target = ty.scalar().unwrap_or(Scalar::Float);
@@ -2268,7 +2108,10 @@ fn construct_check(ty: &Type, args: &[Type]) -> Result<(), String> {
                     return if component_fits(single) {
                         Ok(())
                     } else {
-                        Err(format!("cannot splat `{single}` into `{name}`: convert it first, e.g. `{}(x)`", target.name()))
+                        Err(format!(
+                            "cannot splat `{single}` into `{name}`: convert it first, e.g. `{}(x)`",
+                            target.name()
+                        ))
                     };
                 }
             }
@@ -2278,11 +2121,7 @@ fn construct_check(ty: &Type, args: &[Type]) -> Result<(), String> {
                     target.name()
                 ));
             }
-            if is_matrix
-                && args
-                    .iter()
-                    .any(|a| a.scalar() != Some(Scalar::Float) && !a.is_abstract())
-            {
+            if is_matrix && args.iter().any(|a| a.scalar() != Some(Scalar::Float) && !a.is_abstract()) {
                 return Err(format!("`{name}` is built from floats"));
             }
             let total: u32 = args.iter().map(|a| a.components()).sum();
@@ -2293,13 +2132,9 @@ fn construct_check(ty: &Type, args: &[Type]) -> Result<(), String> {
             if total == want && columns_ok {
                 Ok(())
             } else if is_matrix && !columns_ok {
-                Err(format!(
-                    "`{name}` is built from {n} columns (`float{n}`) or {want} floats"
-                ))
+                Err(format!("`{name}` is built from {n} columns (`float{n}`) or {want} floats"))
             } else {
-                Err(format!(
-                    "`{name}` needs {want} components, but the arguments have {total}"
-                ))
+                Err(format!("`{name}` needs {want} components, but the arguments have {total}"))
             }
         }
     }
@@ -2317,10 +2152,7 @@ fn builtin_type(name: &str, args: &[Type]) -> Result<(Type, Option<Type>), Built
     let float_gen = |t: &Type| {
         matches!(
             t,
-            Type::Scalar(Scalar::Float)
-                | Type::Vector(Scalar::Float, _)
-                | Type::AbstractFloat
-                | Type::AbstractInt
+            Type::Scalar(Scalar::Float) | Type::Vector(Scalar::Float, _) | Type::AbstractFloat | Type::AbstractInt
         )
     };
     let num_gen = |t: &Type| {
@@ -2334,11 +2166,7 @@ fn builtin_type(name: &str, args: &[Type]) -> Result<(Type, Option<Type>), Built
     };
     let fvec = |t: &Type| matches!(t, Type::Vector(Scalar::Float, _));
     let need = |n: usize, text: &'static str| {
-        if args.len() == n {
-            Ok(())
-        } else {
-            Err(Arity(text))
-        }
+        if args.len() == n { Ok(()) } else { Err(Arity(text)) }
     };
     // The generic type T of arguments that must agree, widening scalars.
     let generic = |positions: &[usize],
@@ -2354,14 +2182,13 @@ fn builtin_type(name: &str, args: &[Type]) -> Result<(Type, Option<Type>), Built
             if allow_scalar.contains(&p) && a.components() == 1 {
                 continue;
             }
-            t = match t {
-                None => Some(a.clone()),
-                Some(prev) => Some(unify(&prev, a).filter(|u| !u.is_error()).ok_or_else(|| {
-                    Types(format!(
-                        "`{name}` needs arguments of one type, found `{prev}` and `{a}`"
-                    ))
-                })?),
-            };
+            t =
+                match t {
+                    None => Some(a.clone()),
+                    Some(prev) => Some(unify(&prev, a).filter(|u| !u.is_error()).ok_or_else(|| {
+                        Types(format!("`{name}` needs arguments of one type, found `{prev}` and `{a}`"))
+                    })?),
+                };
         }
         let t = match t {
             Some(t) => t,
@@ -2369,8 +2196,7 @@ fn builtin_type(name: &str, args: &[Type]) -> Result<(Type, Option<Type>), Built
                 // All arguments were scalars in widenable positions.
                 let mut t = args[positions[0]].clone();
                 for &p in positions {
-                    t = unify(&t, &args[p])
-                        .ok_or_else(|| Types(format!("`{name}` needs arguments of one type")))?;
+                    t = unify(&t, &args[p]).ok_or_else(|| Types(format!("`{name}` needs arguments of one type")))?;
                 }
                 t
             }
@@ -2379,78 +2205,43 @@ fn builtin_type(name: &str, args: &[Type]) -> Result<(Type, Option<Type>), Built
             let a = &args[p];
             if a.components() == 1
                 && t.vector_len().is_some()
-                && unify_elem(
-                    parts(a).map(|x| x.0).unwrap_or(Elem::Bool),
-                    parts(&t).map(|x| x.0).unwrap_or(Elem::Bool),
-                )
-                .is_none()
+                && unify_elem(parts(a).map(|x| x.0).unwrap_or(Elem::Bool), parts(&t).map(|x| x.0).unwrap_or(Elem::Bool))
+                    .is_none()
             {
                 return Err(Types(format!("`{name}`: `{a}` does not match `{t}`")));
             }
         }
-        let splat = if t.vector_len().is_some() {
-            Some(t.clone())
-        } else {
-            None
-        };
-        let t = if t.is_abstract() {
-            Type::Scalar(Scalar::Float)
-        } else {
-            t
-        };
+        let splat = if t.vector_len().is_some() { Some(t.clone()) } else { None };
+        let t = if t.is_abstract() { Type::Scalar(Scalar::Float) } else { t };
         Ok((t, splat))
     };
-    let float_result = |r: Result<(Type, Option<Type>), BuiltinError>| {
-        r.map(|(t, s)| (if t == types::INT && false { t } else { t }, s))
-    };
+
     match name {
-        "sin" | "cos" | "tan" | "asin" | "acos" | "atan" | "sinh" | "cosh" | "tanh" | "exp"
-        | "exp2" | "log" | "log2" | "sqrt" | "inversesqrt" | "floor" | "ceil" | "fract"
-        | "round" | "trunc" | "saturate" | "radians" | "degrees" | "ddx" | "ddy" | "fwidth" => {
+        "sin" | "cos" | "tan" | "asin" | "acos" | "atan" | "sinh" | "cosh" | "tanh" | "exp" | "exp2" | "log"
+        | "log2" | "sqrt" | "inversesqrt" | "floor" | "ceil" | "fract" | "round" | "trunc" | "saturate" | "radians"
+        | "degrees" | "ddx" | "ddy" | "fwidth" => {
             need(1, "1 argument")?;
             if !float_gen(&args[0]) {
-                return Err(Types(format!(
-                    "`{name}` needs a float or float vector, found `{}`",
-                    args[0]
-                )));
+                return Err(Types(format!("`{name}` needs a float or float vector, found `{}`", args[0])));
             }
-            Ok((
-                if args[0].is_abstract() {
-                    types::FLOAT
-                } else {
-                    args[0].clone()
-                },
-                None,
-            ))
+            Ok((if args[0].is_abstract() { types::FLOAT } else { args[0].clone() }, None))
         }
         "abs" | "sign" => {
             need(1, "1 argument")?;
             if !num_gen(&args[0]) || (name == "sign" && args[0].scalar() == Some(Scalar::Uint)) {
-                return Err(Types(format!(
-                    "`{name}` needs a number or vector, found `{}`",
-                    args[0]
-                )));
+                return Err(Types(format!("`{name}` needs a number or vector, found `{}`", args[0])));
             }
             Ok((args[0].concretize(), None))
         }
         "pow" | "atan2" | "step" => {
             need(2, "2 arguments")?;
             let allow: &[usize] = if name == "step" { &[0] } else { &[] };
-            float_result(generic(&[0, 1], allow, &float_gen))
+            generic(&[0, 1], allow, &float_gen)
         }
         "min" | "max" => {
             need(2, "2 arguments")?;
             generic(&[0, 1], &[0, 1], &num_gen)
-                .map(|(t, s)| {
-                    (
-                        if args.iter().all(|a| a.is_abstract()) {
-                            args[0].concretize()
-                        } else {
-                            t
-                        },
-                        s,
-                    )
-                })
+                .map(|(t, s)| (if args.iter().all(|a| a.is_abstract()) { args[0].concretize() } else { t }, s))
                 .map(|(t, s)| (concrete_num(&t, args), s))
         }
         "clamp" => {
@@ -2467,19 +2258,11 @@ fn builtin_type(name: &str, args: &[Type]) -> Result<(Type, Option<Type>), Built
         }
         "dot" => {
             need(2, "2 arguments")?;
-            let ok = |t: &Type| {
-                matches!(
-                    t,
-                    Type::Vector(Scalar::Float | Scalar::Int | Scalar::Uint, _)
-                )
-            };
+            let ok = |t: &Type| matches!(t, Type::Vector(Scalar::Float | Scalar::Int | Scalar::Uint, _));
             if !ok(&args[0]) || args[0] != args[1] {
                 return Err(Types("`dot` needs two vectors of the same type".into()));
             }
-            Ok((
-                Type::Scalar(args[0].scalar().unwrap_or(Scalar::Float)),
-                None,
-            ))
+            Ok((Type::Scalar(args[0].scalar().unwrap_or(Scalar::Float)), None))
         }
         "cross" => {
             need(2, "2 arguments")?;
@@ -2491,20 +2274,14 @@ fn builtin_type(name: &str, args: &[Type]) -> Result<(Type, Option<Type>), Built
         "normalize" => {
             need(1, "1 argument")?;
             if !fvec(&args[0]) {
-                return Err(Types(format!(
-                    "`normalize` needs a float vector, found `{}`",
-                    args[0]
-                )));
+                return Err(Types(format!("`normalize` needs a float vector, found `{}`", args[0])));
             }
             Ok((args[0].clone(), None))
         }
         "length" => {
             need(1, "1 argument")?;
             if !float_gen(&args[0]) {
-                return Err(Types(format!(
-                    "`length` needs a float or float vector, found `{}`",
-                    args[0]
-                )));
+                return Err(Types(format!("`length` needs a float or float vector, found `{}`", args[0])));
             }
             Ok((types::FLOAT, None))
         }
@@ -2515,57 +2292,36 @@ fn builtin_type(name: &str, args: &[Type]) -> Result<(Type, Option<Type>), Built
         "reflect" => {
             need(2, "2 arguments")?;
             if !fvec(&args[0]) || args[0] != args[1] {
-                return Err(Types(
-                    "`reflect` needs two float vectors of the same size".into(),
-                ));
+                return Err(Types("`reflect` needs two float vectors of the same size".into()));
             }
             Ok((args[0].clone(), None))
         }
         "refract" => {
             need(3, "3 arguments")?;
             if !fvec(&args[0]) || args[0] != args[1] || !args[2].converts_to(&types::FLOAT) {
-                return Err(Types(
-                    "`refract` needs (floatN incident, floatN normal, float eta)".into(),
-                ));
+                return Err(Types("`refract` needs (floatN incident, floatN normal, float eta)".into()));
             }
             Ok((args[0].clone(), None))
         }
         "faceforward" => {
             need(3, "3 arguments")?;
             if !fvec(&args[0]) || args[0] != args[1] || args[0] != args[2] {
-                return Err(Types(
-                    "`faceforward` needs three float vectors of the same size".into(),
-                ));
+                return Err(Types("`faceforward` needs three float vectors of the same size".into()));
             }
             Ok((args[0].clone(), None))
         }
         "determinant" | "transpose" => {
             need(1, "1 argument")?;
             match args[0] {
-                Type::Matrix(_) => Ok((
-                    if name == "determinant" {
-                        types::FLOAT
-                    } else {
-                        args[0].clone()
-                    },
-                    None,
-                )),
-                _ => Err(Types(format!(
-                    "`{name}` needs a matrix, found `{}`",
-                    args[0]
-                ))),
+                Type::Matrix(_) => Ok((if name == "determinant" { types::FLOAT } else { args[0].clone() }, None)),
+                _ => Err(Types(format!("`{name}` needs a matrix, found `{}`", args[0]))),
             }
         }
         "any" | "all" => {
             need(1, "1 argument")?;
             match args[0] {
-                Type::Scalar(Scalar::Bool) | Type::Vector(Scalar::Bool, _) => {
-                    Ok((types::BOOL, None))
-                }
-                _ => Err(Types(format!(
-                    "`{name}` needs a bool vector, found `{}`",
-                    args[0]
-                ))),
+                Type::Scalar(Scalar::Bool) | Type::Vector(Scalar::Bool, _) => Ok((types::BOOL, None)),
+                _ => Err(Types(format!("`{name}` needs a bool vector, found `{}`", args[0]))),
             }
         }
         "sample" => {
@@ -2579,47 +2335,30 @@ fn builtin_type(name: &str, args: &[Type]) -> Result<(Type, Option<Type>), Built
             Ok((Type::Vector(Scalar::Float, 4), None))
         }
         "sample_grad" => {
-            need(
-                5,
-                "5 arguments (texture, sampler, float2 uv, float2 ddx, float2 ddy)",
-            )?;
+            need(5, "5 arguments (texture, sampler, float2 uv, float2 ddx, float2 ddy)")?;
             let f2 = Type::Vector(Scalar::Float, 2);
             texture_args(name, args, &[f2.clone(), f2.clone(), f2])?;
             Ok((Type::Vector(Scalar::Float, 4), None))
         }
         "load" => {
             if args.len() != 2 && args.len() != 3 {
-                return Err(Arity(
-                    "2 or 3 arguments (texture, int2 coord [, int level])",
-                ));
+                return Err(Arity("2 or 3 arguments (texture, int2 coord [, int level])"));
             }
             if args[0] != Type::Texture2d {
-                return Err(Types(format!(
-                    "`load` needs a `texture2d` first, found `{}`",
-                    args[0]
-                )));
+                return Err(Types(format!("`load` needs a `texture2d` first, found `{}`", args[0])));
             }
             if args[1] != Type::Vector(Scalar::Int, 2) {
-                return Err(Types(format!(
-                    "`load` needs `int2` texel coordinates, found `{}`",
-                    args[1]
-                )));
+                return Err(Types(format!("`load` needs `int2` texel coordinates, found `{}`", args[1])));
             }
             if args.len() == 3 && !args[2].converts_to(&types::INT) {
-                return Err(Types(format!(
-                    "`load` needs an `int` level, found `{}`",
-                    args[2]
-                )));
+                return Err(Types(format!("`load` needs an `int` level, found `{}`", args[2])));
             }
             Ok((Type::Vector(Scalar::Float, 4), None))
         }
         "texture_size" => {
             need(1, "1 argument")?;
             if args[0] != Type::Texture2d {
-                return Err(Types(format!(
-                    "`texture_size` needs a `texture2d`, found `{}`",
-                    args[0]
-                )));
+                return Err(Types(format!("`texture_size` needs a `texture2d`, found `{}`", args[0])));
             }
             Ok((Type::Vector(Scalar::Int, 2), None))
         }
@@ -2629,9 +2368,7 @@ fn builtin_type(name: &str, args: &[Type]) -> Result<(Type, Option<Type>), Built
 
 fn concrete_num(t: &Type, args: &[Type]) -> Type {
     if args.iter().all(|a| a.is_abstract()) {
-        args.iter()
-            .fold(Type::AbstractInt, |acc, a| unify(&acc, a).unwrap_or(acc))
-            .concretize()
+        args.iter().fold(Type::AbstractInt, |acc, a| unify(&acc, a).unwrap_or(acc)).concretize()
     } else {
         t.clone()
     }
@@ -2639,22 +2376,14 @@ fn concrete_num(t: &Type, args: &[Type]) -> Type {
 
 fn texture_args(name: &str, args: &[Type], rest: &[Type]) -> Result<(), BuiltinError> {
     if args[0] != Type::Texture2d {
-        return Err(BuiltinError::Types(format!(
-            "`{name}` needs a `texture2d` first, found `{}`",
-            args[0]
-        )));
+        return Err(BuiltinError::Types(format!("`{name}` needs a `texture2d` first, found `{}`", args[0])));
     }
     if args[1] != Type::Sampler {
-        return Err(BuiltinError::Types(format!(
-            "`{name}` needs a `sampler` second, found `{}`",
-            args[1]
-        )));
+        return Err(BuiltinError::Types(format!("`{name}` needs a `sampler` second, found `{}`", args[1])));
     }
     for (a, want) in args[2..].iter().zip(rest) {
         if !a.converts_to(want) {
-            return Err(BuiltinError::Types(format!(
-                "`{name}` expected `{want}`, found `{a}`"
-            )));
+            return Err(BuiltinError::Types(format!("`{name}` expected `{want}`, found `{a}`")));
         }
     }
     Ok(())
@@ -2662,6 +2391,20 @@ fn texture_args(name: &str, args: &[Type], rest: &[Type]) -> Result<(), BuiltinE
 
 /// Storage-texture formats an output of type `ty` may be written to.
 pub fn formats_for(ty: &Type) -> Vec<&'static str> {
+    // A format must hold every component: single-channel formats only for
+    // scalars, two-channel ones for at most two components.
+    let n = ty.components();
+    formats_any(ty)
+        .into_iter()
+        .filter(|f| match *f {
+            "r32float" | "r32uint" | "r32sint" => n == 1,
+            "rg32float" => n <= 2,
+            _ => true,
+        })
+        .collect()
+}
+
+fn formats_any(ty: &Type) -> Vec<&'static str> {
     match ty {
         Type::Scalar(Scalar::Float) => vec!["r32float", "rgba16float", "rgba32float", "rgba8unorm"],
         Type::Vector(Scalar::Float, _) => {
@@ -2674,9 +2417,7 @@ pub fn formats_for(ty: &Type) -> Vec<&'static str> {
 }
 
 fn output_format_fits(format: &str, ty: &Type) -> bool {
-    let fits = formats_for(ty).contains(&format);
-    // Two-channel formats only for types with at most two components.
-    fits && !(format == "rg32float" && ty.components() > 2)
+    formats_for(ty).contains(&format)
 }
 
 /// The default storage format of an output: exact 32-bit storage, so that

@@ -6,16 +6,25 @@
 //! away at coarse rate, one pixel at fine rate). The operand is rebuilt from
 //! what can be evaluated anywhere: G-buffer inputs (loaded at the neighbour),
 //! uniforms, constants, other effects (their value at the neighbour), pure
-//! functions, and locals. A local is either *invariant* (its value does not
-//! depend on the sample position, like a loop counter: passed as it is) or
-//! *single-definition* (assigned exactly once, outside any branch or loop:
-//! its defining expression is inlined). Any other local is an error, with
-//! the same spirit as hardware's "derivatives need uniform control flow".
+//! functions, and locals. A local is either
+//!
+//! - *invariant*: its value does not depend on the sample position (a loop
+//!   counter, a sum of uniforms). It is passed to the neighbour as it is.
+//!   Through an inlined definition it must still hold the value it had when
+//!   that definition ran: it is assigned only where declared, or it is a loop
+//!   counter (which the body cannot assign);
+//! - *single-definition*: declared with an initialiser and never assigned
+//!   again, or declared without one and assigned exactly once at the top
+//!   level of the body before the derivative. Its defining expression is
+//!   inlined.
+//!
+//! Any other local is an error (E0503), in the spirit of hardware's rule that
+//! derivatives need uniform control flow.
 
 use crate::check::{Callee, Checked, EffectId, LocalId, Symbol};
 use crate::diagnostic::{Diagnostic, Label};
 use crate::syntax::ast::*;
-use std::collections::{BTreeSet, HashMap};
+use std::collections::{BTreeSet, HashMap, HashSet};
 
 /// How one derivative site is recomputed at a neighbour.
 #[derive(Debug, Clone)]
@@ -38,7 +47,7 @@ pub struct DerivInfo<'a> {
     pub site_of: HashMap<NodeId, usize>,
     /// Defining expression of each single-definition local (inlined at neighbours).
     pub definitions: HashMap<LocalId, &'a Expr>,
-    /// Effects whose value is needed at a neighbour (by some operand), in any order.
+    /// Effects whose value is needed at a neighbour (by some operand).
     pub effects_at_neighbours: BTreeSet<EffectId>,
 }
 
@@ -59,39 +68,36 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
             EffectBody::Expr(_) => vec![],
         };
         let facts = LocalFacts::compute(checked, &body);
-        for (k, v) in &facts.definitions {
+        for (k, (v, _)) in &facts.definitions {
             info.definitions.insert(*k, v);
         }
-        let mut calls = vec![];
+        // Derivative calls with the index of the top-level statement holding them.
+        let mut calls: Vec<(usize, &Expr)> = vec![];
         match &effect.body {
-            EffectBody::Expr(e) => collect_derivative_calls(e, checked, &mut calls),
-            EffectBody::Block(b) => b
-                .stmts
-                .iter()
-                .for_each(|s| stmt_calls(s, checked, &mut calls)),
+            EffectBody::Expr(e) => collect_derivative_calls(e, checked, &mut |c| calls.push((0, c))),
+            EffectBody::Block(b) => {
+                for (index, s) in b.stmts.iter().enumerate() {
+                    visit_stmt_exprs(s, &mut |e| collect_derivative_calls(e, checked, &mut |c| calls.push((index, c))));
+                }
+            }
         }
-        for call in calls {
-            let ExprKind::Call { callee, args } = &call.kind else {
-                continue;
-            };
-            let operand = if callee.name == "sample" {
-                &args[2]
-            } else {
-                &args[0]
-            };
-            let mut params = BTreeSet::new();
-            let mut visiting = vec![];
-            let mut effects = BTreeSet::new();
-            check_operand(
+        for (statement, call) in calls {
+            let ExprKind::Call { callee, args } = &call.kind else { continue };
+            // A call with the wrong arity was already reported by the checker.
+            let Some(operand) = args.get(if callee.name == "sample" { 2 } else { 0 }) else { continue };
+            let mut walk = OperandWalk {
                 checked,
-                &facts,
-                operand,
+                facts: &facts,
                 callee,
-                &mut params,
-                &mut visiting,
-                &mut effects,
-                &mut diagnostics,
-            );
+                statement,
+                params: BTreeSet::new(),
+                effects: BTreeSet::new(),
+                visiting: vec![],
+                reported: HashSet::new(),
+                diagnostics: &mut diagnostics,
+            };
+            walk.expr(operand, None);
+            let (params, effects) = (walk.params, walk.effects);
             info.effects_at_neighbours.extend(effects.iter().copied());
             info.site_of.insert(call.id, info.sites.len());
             info.sites.push(DerivSite {
@@ -106,20 +112,12 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
     (info, diagnostics)
 }
 
-fn collect_derivative_calls<'a>(e: &'a Expr, checked: &Checked, out: &mut Vec<&'a Expr>) {
+fn collect_derivative_calls<'a>(e: &'a Expr, checked: &Checked, out: &mut dyn FnMut(&'a Expr)) {
     visit_expr(e, &mut |x| {
-        if let ExprKind::Call { callee, .. } = &x.kind {
-            if matches!(checked.callees.get(&x.id), Some(Callee::Builtin(b)) if crate::check::is_derivative(b))
-            {
-                let _ = callee;
-                out.push(x);
-            }
+        if matches!(checked.callees.get(&x.id), Some(Callee::Builtin(b)) if crate::check::is_derivative(b)) {
+            out(x);
         }
     });
-}
-
-fn stmt_calls<'a>(s: &'a Stmt, checked: &Checked, out: &mut Vec<&'a Expr>) {
-    visit_stmt_exprs(s, &mut |e| collect_derivative_calls(e, checked, out));
 }
 
 /// Calls `f` on every top-level expression of a statement (recursively through sub-statements).
@@ -131,23 +129,14 @@ pub fn visit_stmt_exprs<'a>(s: &'a Stmt, f: &mut dyn FnMut(&'a Expr)) {
             f(value);
         }
         StmtKind::Step { target, .. } => f(target),
-        StmtKind::If {
-            cond,
-            then,
-            otherwise,
-        } => {
+        StmtKind::If { cond, then, otherwise } => {
             f(cond);
             visit_stmt_exprs(then, f);
             if let Some(o) = otherwise {
                 visit_stmt_exprs(o, f);
             }
         }
-        StmtKind::For {
-            init,
-            cond,
-            step,
-            body,
-        } => {
+        StmtKind::For { init, cond, step, body } => {
             if let Some(i) = init {
                 visit_stmt_exprs(i, f);
             }
@@ -189,11 +178,29 @@ pub fn visit_expr<'a>(e: &'a Expr, f: &mut dyn FnMut(&'a Expr)) {
     }
 }
 
+/// One assignment to a local, as collected from an effect body.
+struct Assignment<'a> {
+    local: LocalId,
+    /// The value, for whole-variable `=` and declarations with an initialiser.
+    value: Option<&'a Expr>,
+    /// Inside a branch or loop.
+    nested: bool,
+    declaration: bool,
+    for_init: bool,
+    /// Index of the top-level statement it is in.
+    statement: usize,
+}
+
+/// Where a single-definition local is defined: its top-level statement
+/// (`None` when defined by its declaration, which scoping already orders).
+type Definition<'a> = (&'a Expr, Option<usize>);
+
 /// What is known about the locals of one effect body.
 struct LocalFacts<'a> {
     invariant: HashMap<LocalId, bool>,
-    definitions: HashMap<LocalId, &'a Expr>,
+    definitions: HashMap<LocalId, Definition<'a>>,
     assignment_count: HashMap<LocalId, u32>,
+    loop_counters: HashSet<LocalId>,
 }
 
 impl<'a> LocalFacts<'a> {
@@ -202,26 +209,35 @@ impl<'a> LocalFacts<'a> {
             invariant: HashMap::new(),
             definitions: HashMap::new(),
             assignment_count: HashMap::new(),
+            loop_counters: HashSet::new(),
         };
-        // Single definitions: declared with an initialiser and never assigned,
-        // or declared without one and assigned once at the top level.
         let mut all = vec![];
-        for s in body {
-            collect_assignments(s, checked, &mut all, false);
+        for (index, s) in body.iter().enumerate() {
+            collect_assignments(s, checked, &mut all, false, index);
         }
-        for (local, _, _) in &all {
-            *facts.assignment_count.entry(*local).or_default() += 1;
+        for a in &all {
+            *facts.assignment_count.entry(a.local).or_default() += 1;
+            if a.for_init {
+                facts.loop_counters.insert(a.local);
+            }
         }
-        for (local, value, nested) in &all {
-            if facts.assignment_count[local] == 1 && !nested {
-                if let Some(v) = value {
-                    facts.definitions.insert(*local, *v);
+        for a in &all {
+            if facts.assignment_count[&a.local] != 1 {
+                continue;
+            }
+            match (a.value, a.declaration, a.nested) {
+                (Some(v), true, _) => {
+                    facts.definitions.insert(a.local, (v, None));
                 }
+                (Some(v), false, false) => {
+                    facts.definitions.insert(a.local, (v, Some(a.statement)));
+                }
+                _ => {}
             }
         }
         // Invariance: a fixed point, starting from "everything is invariant".
-        for (local, _, _) in &all {
-            facts.invariant.insert(*local, true);
+        for a in &all {
+            facts.invariant.insert(a.local, true);
         }
         loop {
             let mut changed = false;
@@ -237,6 +253,11 @@ impl<'a> LocalFacts<'a> {
 
     fn is_invariant(&self, local: LocalId) -> bool {
         self.invariant.get(&local).copied().unwrap_or(false)
+    }
+
+    /// An invariant local keeps its value from its declaration on.
+    fn is_stable(&self, local: LocalId) -> bool {
+        self.loop_counters.contains(&local) || self.assignment_count.get(&local).copied().unwrap_or(0) <= 1
     }
 
     fn expr_invariant(&self, e: &Expr, checked: &Checked) -> bool {
@@ -255,6 +276,21 @@ impl<'a> LocalFacts<'a> {
         invariant
     }
 
+    /// Whether a loop body may leave an iteration early depending on the position
+    /// (a `break` or `continue` under a varying condition, outside nested loops).
+    fn exits_on_varying(&self, s: &Stmt, checked: &Checked, varying: bool) -> bool {
+        match &s.kind {
+            StmtKind::Break | StmtKind::Continue => varying,
+            StmtKind::If { cond, then, otherwise } => {
+                let v = varying || !self.expr_invariant(cond, checked);
+                self.exits_on_varying(then, checked, v)
+                    || otherwise.as_ref().is_some_and(|o| self.exits_on_varying(o, checked, v))
+            }
+            StmtKind::Block(b) => b.stmts.iter().any(|s| self.exits_on_varying(s, checked, varying)),
+            _ => false,
+        }
+    }
+
     /// Marks locals assigned from varying values or under varying control flow.
     fn mark_varying(&mut self, s: &Stmt, checked: &Checked, varying_flow: bool) -> bool {
         let mut changed = false;
@@ -266,21 +302,14 @@ impl<'a> LocalFacts<'a> {
         match &s.kind {
             StmtKind::Local { init, .. } => {
                 if let Some(local) = checked.local_decls.get(&s.id) {
-                    let v = varying_flow
-                        || init
-                            .as_ref()
-                            .is_some_and(|e| !self.expr_invariant(e, checked));
-                    if v {
+                    if varying_flow || init.as_ref().is_some_and(|e| !self.expr_invariant(e, checked)) {
                         mark(self, *local);
                     }
                 }
             }
             StmtKind::Assign { target, value, .. } => {
                 if let Some(local) = root_local(target, checked) {
-                    if varying_flow
-                        || !self.expr_invariant(value, checked)
-                        || !self.expr_invariant(target, checked)
-                    {
+                    if varying_flow || !self.expr_invariant(value, checked) || !self.expr_invariant(target, checked) {
                         mark(self, local);
                     }
                 }
@@ -292,27 +321,17 @@ impl<'a> LocalFacts<'a> {
                     }
                 }
             }
-            StmtKind::If {
-                cond,
-                then,
-                otherwise,
-            } => {
+            StmtKind::If { cond, then, otherwise } => {
                 let v = varying_flow || !self.expr_invariant(cond, checked);
                 changed |= self.mark_varying(then, checked, v);
                 if let Some(o) = otherwise {
                     changed |= self.mark_varying(o, checked, v);
                 }
             }
-            StmtKind::For {
-                init,
-                cond,
-                step,
-                body,
-            } => {
+            StmtKind::For { init, cond, step, body } => {
                 let v = varying_flow
-                    || cond
-                        .as_ref()
-                        .is_some_and(|c| !self.expr_invariant(c, checked));
+                    || cond.as_ref().is_some_and(|c| !self.expr_invariant(c, checked))
+                    || self.exits_on_varying(body, checked, false);
                 if let Some(i) = init {
                     changed |= self.mark_varying(i, checked, varying_flow);
                 }
@@ -343,108 +362,143 @@ fn root_local(e: &Expr, checked: &Checked) -> Option<LocalId> {
     }
 }
 
-/// Every assignment in `s`: (local, its value if a whole-variable `=`, nested in a branch/loop).
 fn collect_assignments<'a>(
     s: &'a Stmt,
     checked: &Checked,
-    out: &mut Vec<(LocalId, Option<&'a Expr>, bool)>,
+    out: &mut Vec<Assignment<'a>>,
     nested: bool,
+    statement: usize,
 ) {
+    let mut push = |local, value, declaration, for_init| {
+        out.push(Assignment { local, value, nested, declaration, for_init, statement })
+    };
     match &s.kind {
         StmtKind::Local { init, .. } => {
             if let (Some(local), Some(init)) = (checked.local_decls.get(&s.id), init) {
-                out.push((*local, Some(init), nested));
+                push(*local, Some(init), true, false);
             }
         }
         StmtKind::Assign { target, op, value } => {
             if let Some(local) = root_local(target, checked) {
                 let whole = matches!(target.kind, ExprKind::Name(_)) && *op == AssignOp::Set;
-                out.push((local, if whole { Some(value) } else { None }, nested));
+                push(local, if whole { Some(value) } else { None }, false, false);
             }
         }
         StmtKind::Step { target, .. } => {
             if let Some(local) = root_local(target, checked) {
-                out.push((local, None, nested));
+                push(local, None, false, false);
             }
         }
-        StmtKind::If {
-            then, otherwise, ..
-        } => {
-            collect_assignments(then, checked, out, true);
+        StmtKind::If { then, otherwise, .. } => {
+            collect_assignments(then, checked, out, true, statement);
             if let Some(o) = otherwise {
-                collect_assignments(o, checked, out, true);
+                collect_assignments(o, checked, out, true, statement);
             }
         }
-        StmtKind::For {
-            init, step, body, ..
-        } => {
+        StmtKind::For { init, step, body, .. } => {
             if let Some(i) = init {
-                collect_assignments(i, checked, out, true);
+                if let (StmtKind::Local { init: Some(v), .. }, Some(local)) = (&i.kind, checked.local_decls.get(&i.id))
+                {
+                    out.push(Assignment {
+                        local: *local,
+                        value: Some(v),
+                        nested: true,
+                        declaration: true,
+                        for_init: true,
+                        statement,
+                    });
+                }
             }
             if let Some(st) = step {
-                collect_assignments(st, checked, out, true);
+                collect_assignments(st, checked, out, true, statement);
             }
-            collect_assignments(body, checked, out, true);
+            collect_assignments(body, checked, out, true, statement);
         }
-        StmtKind::Block(b) => b
-            .stmts
-            .iter()
-            .for_each(|s| collect_assignments(s, checked, out, nested)),
+        StmtKind::Block(b) => b.stmts.iter().for_each(|s| collect_assignments(s, checked, out, nested, statement)),
         _ => {}
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn check_operand(
-    checked: &Checked,
-    facts: &LocalFacts,
-    e: &Expr,
-    callee: &Ident,
-    params: &mut BTreeSet<LocalId>,
-    visiting: &mut Vec<LocalId>,
-    effects: &mut BTreeSet<EffectId>,
-    diagnostics: &mut Vec<Diagnostic>,
-) {
-    visit_expr(e, &mut |x| {
-        if let ExprKind::Name(name) = &x.kind {
-            match checked.symbols.get(&x.id) {
+/// Walks a derivative operand, inlining single definitions and collecting
+/// the invariant locals and effects it needs.
+struct OperandWalk<'w, 'a> {
+    checked: &'w Checked<'a>,
+    facts: &'w LocalFacts<'a>,
+    callee: &'w Ident,
+    /// Top-level statement holding the derivative.
+    statement: usize,
+    params: BTreeSet<LocalId>,
+    effects: BTreeSet<EffectId>,
+    visiting: Vec<LocalId>,
+    reported: HashSet<LocalId>,
+    diagnostics: &'w mut Vec<Diagnostic>,
+}
+
+impl OperandWalk<'_, '_> {
+    /// `through`: the single-definition local whose definition is being walked.
+    fn expr(&mut self, e: &Expr, through: Option<LocalId>) {
+        let mut names = vec![];
+        visit_expr(e, &mut |x| {
+            if let ExprKind::Name(name) = &x.kind {
+                names.push((x.span, name.clone(), self.checked.symbols.get(&x.id).copied()));
+            }
+        });
+        for (span, name, symbol) in names {
+            match symbol {
                 Some(Symbol::Effect(id)) => {
-                    effects.insert(*id);
+                    self.effects.insert(id);
                 }
-                Some(Symbol::Local(local)) => {
-                    if facts.is_invariant(*local) {
-                        params.insert(*local);
-                    } else if let Some(def) = facts.definitions.get(local) {
-                        if visiting.contains(local) {
-                            return;
-                        }
-                        visiting.push(*local);
-                        check_operand(
-                            checked,
-                            facts,
-                            def,
-                            callee,
-                            params,
-                            visiting,
-                            effects,
-                            diagnostics,
-                        );
-                        visiting.pop();
-                    } else {
-                        let decl = checked.locals[local.index()].span;
-                        diagnostics.push(
-                            Diagnostic::error("E0503", format!("`{}` cannot differentiate `{name}`", callee.name))
-                                .with_label(Label::primary(x.span, format!("`{name}` cannot be recomputed at the neighbouring sample")))
-                                .with_label(Label::secondary(decl, "declared here"))
-                                .with_note(format!(
-                                    "a derivative re-evaluates its operand at the neighbouring sample; `{name}` is assigned more than once or inside a branch or loop. \
-                                     Assign it exactly once, where it is declared, or differentiate the expression it is built from"
-                                )),
-                        );
-                    }
-                }
+                Some(Symbol::Local(local)) => self.local(local, span, &name, through),
                 _ => {}
             }
         }
-    });
+    }
+
+    fn local(&mut self, local: LocalId, span: Span, name: &str, through: Option<LocalId>) {
+        let facts = self.facts;
+        if facts.is_invariant(local) {
+            if through.is_some() && !facts.is_stable(local) {
+                let via = through.map(|l| self.checked.locals[l.index()].name.clone()).unwrap_or_default();
+                self.error(local, span, name, format!("`{name}` is assigned again after `{via}` is computed from it, so its value at the neighbour is not known"));
+                return;
+            }
+            self.params.insert(local);
+            return;
+        }
+        match facts.definitions.get(&local) {
+            Some((_, Some(defined_at))) if *defined_at >= self.statement => {
+                self.error(local, span, name, format!("`{name}` is differentiated before it is assigned"));
+            }
+            Some((definition, _)) => {
+                if self.visiting.contains(&local) {
+                    return;
+                }
+                self.visiting.push(local);
+                self.expr(definition, Some(local));
+                self.visiting.pop();
+            }
+            None => self.error(
+                local,
+                span,
+                name,
+                format!("`{name}` is assigned more than once or inside a branch or loop, so it cannot be recomputed at the neighbouring sample"),
+            ),
+        }
+    }
+
+    fn error(&mut self, local: LocalId, span: Span, name: &str, why: String) {
+        if !self.reported.insert(local) {
+            return;
+        }
+        let decl = self.checked.locals[local.index()].span;
+        self.diagnostics.push(
+            Diagnostic::error("E0503", format!("`{}` cannot differentiate `{name}`", self.callee.name))
+                .with_label(Label::primary(span, why))
+                .with_label(Label::secondary(decl, "declared here"))
+                .with_note(
+                    "a derivative re-evaluates its operand at the neighbouring sample: differentiate locals that are \
+                     assigned exactly once, where they are declared, or the expression they are built from",
+                ),
+        );
+    }
 }

@@ -24,18 +24,10 @@ pub struct Label {
 
 impl Label {
     pub fn primary(span: Span, message: impl Into<String>) -> Label {
-        Label {
-            span,
-            message: message.into(),
-            primary: true,
-        }
+        Label { span, message: message.into(), primary: true }
     }
     pub fn secondary(span: Span, message: impl Into<String>) -> Label {
-        Label {
-            span,
-            message: message.into(),
-            primary: false,
-        }
+        Label { span, message: message.into(), primary: false }
     }
 }
 
@@ -52,25 +44,13 @@ pub struct Diagnostic {
 
 impl Diagnostic {
     pub fn error(code: &'static str, message: impl Into<String>) -> Diagnostic {
-        Diagnostic {
-            severity: Severity::Error,
-            code,
-            message: message.into(),
-            labels: vec![],
-            notes: vec![],
-        }
+        Diagnostic { severity: Severity::Error, code, message: message.into(), labels: vec![], notes: vec![] }
     }
     pub fn warning(code: &'static str, message: impl Into<String>) -> Diagnostic {
-        Diagnostic {
-            severity: Severity::Warning,
-            ..Diagnostic::error(code, message)
-        }
+        Diagnostic { severity: Severity::Warning, ..Diagnostic::error(code, message) }
     }
     pub fn bug(message: impl Into<String>) -> Diagnostic {
-        Diagnostic {
-            severity: Severity::Bug,
-            ..Diagnostic::error("E9000", message)
-        }
+        Diagnostic { severity: Severity::Bug, ..Diagnostic::error("E9000", message) }
     }
     pub fn with_label(mut self, label: Label) -> Diagnostic {
         self.labels.push(label);
@@ -98,11 +78,7 @@ impl Diagnostic {
             .labels
             .iter()
             .map(|l| {
-                let style = if l.primary {
-                    cs::LabelStyle::Primary
-                } else {
-                    cs::LabelStyle::Secondary
-                };
+                let style = if l.primary { cs::LabelStyle::Primary } else { cs::LabelStyle::Secondary };
                 cs::Label::new(style, (), l.span.range()).with_message(&l.message)
             })
             .collect();
@@ -125,10 +101,9 @@ pub fn render_all(diagnostics: &[Diagnostic], file_name: &str, source: &str) -> 
     let config = term::Config::default();
     let mut out = String::new();
     for diagnostic in diagnostics {
-        let d = clamp_spans(diagnostic, source.len());
-        let one = term::emit_into_string(&config, &file, &d.to_codespan()).unwrap_or_else(|_| {
-            format!("{}[{}]: {}\n", severity_word(d.severity), d.code, d.message)
-        });
+        let d = clamp_spans(diagnostic, source);
+        let one = term::emit_into_string(&config, &file, &d.to_codespan())
+            .unwrap_or_else(|_| format!("{}[{}]: {}\n", severity_word(d.severity), d.code, d.message));
         out.push_str(&one);
     }
     out
@@ -144,9 +119,8 @@ pub fn emit_colored(
     let file = SimpleFile::new(file_name, clamp_source(source));
     let config = term::Config::default();
     for diagnostic in diagnostics {
-        let d = clamp_spans(diagnostic, source.len());
-        term::emit_to_write_style(writer, &config, &file, &d.to_codespan())
-            .map_err(std::io::Error::other)?;
+        let d = clamp_spans(diagnostic, source);
+        term::emit_to_write_style(writer, &config, &file, &d.to_codespan()).map_err(std::io::Error::other)?;
     }
     Ok(())
 }
@@ -164,11 +138,18 @@ fn clamp_source(source: &str) -> &str {
 }
 
 /// Keeps every span inside the source and on char boundaries, so rendering never fails.
-fn clamp_spans(diagnostic: &Diagnostic, len: usize) -> Diagnostic {
+fn clamp_spans(diagnostic: &Diagnostic, source: &str) -> Diagnostic {
+    let floor = |mut i: usize| {
+        i = i.min(source.len());
+        while !source.is_char_boundary(i) {
+            i -= 1;
+        }
+        i
+    };
     let mut d = diagnostic.clone();
     for label in &mut d.labels {
-        let end = (label.span.end as usize).min(len);
-        let start = (label.span.start as usize).min(end);
+        let end = floor(label.span.end as usize);
+        let start = floor(label.span.start as usize).min(end);
         label.span = Span::new(start, end);
     }
     d

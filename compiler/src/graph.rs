@@ -31,11 +31,7 @@ impl EffectGraph {
                 stack.extend(checked.effects[e.index()].deps.iter().map(|(d, _)| *d));
             }
         }
-        self.order
-            .iter()
-            .copied()
-            .filter(|e| needed[e.index()])
-            .collect()
+        self.order.iter().copied().filter(|e| needed[e.index()]).collect()
     }
 }
 
@@ -79,47 +75,25 @@ pub fn build(checked: &Checked) -> (EffectGraph, Vec<Diagnostic>) {
         // it reads in the source ("a -> b": `a` reads `b`).
         let mut path = cycle_path(&graph, &scc);
         path[1..].reverse();
-        let names: Vec<&str> = path
-            .iter()
-            .map(|n| effects[graph[*n].index()].name.as_str())
-            .collect();
+        let names: Vec<&str> = path.iter().map(|n| effects[graph[*n].index()].name.as_str()).collect();
         let mut shown = names.clone();
         shown.push(names[0]);
-        let mut d = Diagnostic::error(
-            "E0311",
-            format!(
-                "effects depend on each other in a cycle: {}",
-                shown.join(" -> ")
-            ),
-        );
+        let mut d =
+            Diagnostic::error("E0311", format!("effects depend on each other in a cycle: {}", shown.join(" -> ")));
         for (k, &n) in path.iter().enumerate() {
             let next = path[(k + 1) % path.len()];
             let user = &effects[graph[n].index()];
-            let span = user
-                .deps
-                .iter()
-                .find(|(dep, _)| *dep == graph[next])
-                .map(|(_, s)| *s)
-                .unwrap_or(user.name_span);
+            let span = user.deps.iter().find(|(dep, _)| *dep == graph[next]).map(|(_, s)| *s).unwrap_or(user.name_span);
             let message = format!("`{}` reads `{}`", user.name, effects[graph[next].index()].name);
-            d = d.with_label(if k == 0 {
-                Label::primary(span, message)
-            } else {
-                Label::secondary(span, message)
-            });
+            d = d.with_label(if k == 0 { Label::primary(span, message) } else { Label::secondary(span, message) });
         }
-        diagnostics.push(d.with_note(
-            "effects form a DAG: break the cycle by computing one value from the inputs directly",
-        ));
+        diagnostics
+            .push(d.with_note("effects form a DAG: break the cycle by computing one value from the inputs directly"));
     }
     // Phase 4: liveness and topological order (skipped for cyclic graphs).
     let mut live = vec![false; effects.len()];
-    let mut stack: Vec<EffectId> = effects
-        .iter()
-        .enumerate()
-        .filter(|(_, e)| e.rate == Rate::Out)
-        .map(|(i, _)| EffectId(i as u32))
-        .collect();
+    let mut stack: Vec<EffectId> =
+        effects.iter().enumerate().filter(|(_, e)| e.rate == Rate::Out).map(|(i, _)| EffectId(i as u32)).collect();
     while let Some(e) = stack.pop() {
         if !std::mem::replace(&mut live[e.index()], true) {
             stack.extend(effects[e.index()].deps.iter().map(|(d, _)| *d));
@@ -129,24 +103,10 @@ pub fn build(checked: &Checked) -> (EffectGraph, Vec<Diagnostic>) {
         vec![]
     } else {
         petgraph::algo::toposort(&graph, None)
-            .map(|nodes| {
-                nodes
-                    .into_iter()
-                    .map(|n| graph[n])
-                    .filter(|e| live[e.index()])
-                    .collect()
-            })
+            .map(|nodes| nodes.into_iter().map(|n| graph[n]).filter(|e| live[e.index()]).collect())
             .unwrap_or_default()
     };
-    (
-        EffectGraph {
-            graph,
-            order,
-            users,
-            live,
-        },
-        diagnostics,
-    )
+    (EffectGraph { graph, order, users, live }, diagnostics)
 }
 
 /// A simple cycle through the nodes of one strongly connected component,

@@ -49,8 +49,7 @@ impl PassCondition {
     }
     /// Evaluates the condition for given refine flags.
     pub fn holds(&self, me: EffectId, refined: &dyn Fn(EffectId) -> bool) -> bool {
-        !(self.self_refines && refined(me))
-            && (self.fine_user || self.refining_users.iter().any(|u| refined(*u)))
+        !(self.self_refines && refined(me)) && (self.fine_user || self.refining_users.iter().any(|u| refined(*u)))
     }
 }
 
@@ -97,9 +96,8 @@ impl Interface {
 /// Computes pass conditions, the interference graph and the slot allocation.
 pub fn allocate(checked: &Checked, graph: &EffectGraph) -> Interface {
     let n = checked.effects.len();
-    let refines = |e: EffectId| {
-        checked.effects[e.index()].rate == Rate::Coarse && checked.effects[e.index()].has_refine
-    };
+    let refines =
+        |e: EffectId| checked.effects[e.index()].rate == Rate::Coarse && checked.effects[e.index()].has_refine;
     let mut conditions = vec![None; n];
     for (i, effect) in checked.effects.iter().enumerate() {
         if effect.rate != Rate::Coarse || !graph.live[i] {
@@ -120,34 +118,20 @@ pub fn allocate(checked: &Checked, graph: &EffectGraph) -> Interface {
         }
         refining_users.sort();
         refining_users.dedup();
-        conditions[i] = Some(PassCondition {
-            fine_user,
-            refining_users,
-            self_refines: refines(me),
-        });
+        conditions[i] = Some(PassCondition { fine_user, refining_users, self_refines: refines(me) });
     }
-    let passed: Vec<EffectId> = (0..n)
-        .filter(|&i| conditions[i].as_ref().is_some_and(|c| c.possible()))
-        .map(|i| EffectId(i as u32))
-        .collect();
+    let passed: Vec<EffectId> =
+        (0..n).filter(|&i| conditions[i].as_ref().is_some_and(|c| c.possible())).map(|i| EffectId(i as u32)).collect();
 
     let mut interference = vec![];
     for (k, &a) in passed.iter().enumerate() {
         for &b in &passed[k + 1..] {
-            if interfere(
-                conditions[a.index()].as_ref(),
-                conditions[b.index()].as_ref(),
-                a,
-                b,
-            ) {
+            if interfere(conditions[a.index()].as_ref(), conditions[b.index()].as_ref(), a, b) {
                 interference.push((a, b));
             }
         }
     }
-    let sizes: Vec<u32> = passed
-        .iter()
-        .map(|e| checked.effects[e.index()].ty.components())
-        .collect();
+    let sizes: Vec<u32> = passed.iter().map(|e| checked.effects[e.index()].ty.components()).collect();
     let (classes, exact) = colour(&passed, &sizes, &interference);
 
     let mut refine_bit = vec![None; n];
@@ -169,89 +153,52 @@ pub fn allocate(checked: &Checked, graph: &EffectGraph) -> Interface {
         for e in &effects {
             slot_of[e.index()] = Some(slots.len());
         }
-        slots.push(Slot {
-            offset,
-            size,
-            effects,
-        });
+        slots.push(Slot { offset, size, effects });
         offset += size;
     }
-    Interface {
-        conditions,
-        interference,
-        slots,
-        slot_of,
-        refine_bit,
-        flag_words,
-        stride: offset,
-        exact,
-    }
+    Interface { conditions, interference, slots, slot_of, refine_bit, flag_words, stride: offset, exact }
 }
 
-fn interfere(
-    a: Option<&PassCondition>,
-    b: Option<&PassCondition>,
-    ea: EffectId,
-    eb: EffectId,
-) -> bool {
+fn interfere(a: Option<&PassCondition>, b: Option<&PassCondition>, ea: EffectId, eb: EffectId) -> bool {
     let (Some(a), Some(b)) = (a, b) else {
         return false;
     };
     // With r_a = r_b = false (required by both conditions), each disjunction
     // must still be satisfiable by its own, independent literals.
-    let alive =
-        |c: &PassCondition| c.fine_user || c.refining_users.iter().any(|u| *u != ea && *u != eb);
+    let alive = |c: &PassCondition| c.fine_user || c.refining_users.iter().any(|u| *u != ea && *u != eb);
     alive(a) && alive(b)
 }
 
 /// Colours the interference graph into slots minimising the sum of slot widths.
 /// Returns the classes (indices into `nodes`) and whether the result is proven minimal.
-pub fn colour(
-    nodes: &[EffectId],
-    sizes: &[u32],
-    edges: &[(EffectId, EffectId)],
-) -> (Vec<Vec<usize>>, bool) {
-    let index_of = |e: EffectId| {
-        nodes
-            .iter()
-            .position(|n| *n == e)
-            .expect("edges join passed effects")
-    };
+pub fn colour(nodes: &[EffectId], sizes: &[u32], edges: &[(EffectId, EffectId)]) -> (Vec<Vec<usize>>, bool) {
+    let index: std::collections::HashMap<EffectId, usize> = nodes.iter().enumerate().map(|(i, n)| (*n, i)).collect();
     let mut graph: UnGraph<(), ()> = UnGraph::with_capacity(nodes.len(), edges.len());
     for _ in nodes {
         graph.add_node(());
     }
+    // The petgraph graph gives degrees; a dense matrix answers adjacency in
+    // O(1), which keeps first fit quadratic on near-complete graphs.
+    let n = nodes.len();
+    let mut matrix = vec![false; n * n];
     for &(a, b) in edges {
-        graph.add_edge(
-            petgraph::graph::NodeIndex::new(index_of(a)),
-            petgraph::graph::NodeIndex::new(index_of(b)),
-            (),
-        );
+        let (a, b) = (index[&a], index[&b]);
+        graph.add_edge(petgraph::graph::NodeIndex::new(a), petgraph::graph::NodeIndex::new(b), ());
+        matrix[a * n + b] = true;
+        matrix[b * n + a] = true;
     }
-    let adjacent = |a: usize, b: usize| {
-        graph.contains_edge(
-            petgraph::graph::NodeIndex::new(a),
-            petgraph::graph::NodeIndex::new(b),
-        )
-    };
+    let adjacent = |a: usize, b: usize| matrix[a * n + b];
     // Widest first (a class's width is then fixed by its first member), then
     // most constrained first.
     let mut order: Vec<usize> = (0..nodes.len()).collect();
     order.sort_by_key(|&k| {
-        (
-            std::cmp::Reverse(sizes[k]),
-            std::cmp::Reverse(graph.neighbors(petgraph::graph::NodeIndex::new(k)).count()),
-            k,
-        )
+        (std::cmp::Reverse(sizes[k]), std::cmp::Reverse(graph.neighbors(petgraph::graph::NodeIndex::new(k)).count()), k)
     });
 
     // First fit: never raises a class's width, since members come widest first.
     let mut greedy: Vec<Vec<usize>> = vec![];
     for &k in &order {
-        match greedy
-            .iter_mut()
-            .find(|class| class.iter().all(|&m| !adjacent(m, k)))
-        {
+        match greedy.iter_mut().find(|class| class.iter().all(|&m| !adjacent(m, k))) {
             Some(class) => class.push(k),
             None => greedy.push(vec![k]),
         }
@@ -259,12 +206,8 @@ pub fn colour(
     if nodes.len() > EXACT_LIMIT {
         return (greedy, false);
     }
-    let cost = |classes: &[Vec<usize>]| {
-        classes
-            .iter()
-            .map(|c| c.iter().map(|&k| sizes[k]).max().unwrap_or(0))
-            .sum::<u32>()
-    };
+    let cost =
+        |classes: &[Vec<usize>]| classes.iter().map(|c| c.iter().map(|&k| sizes[k]).max().unwrap_or(0)).sum::<u32>();
     struct Search<'s> {
         order: &'s [usize],
         sizes: &'s [u32],
@@ -298,14 +241,8 @@ pub fn colour(
         }
     }
     let greedy_cost = cost(&greedy);
-    let mut search = Search {
-        order: &order,
-        sizes,
-        adjacent: &adjacent,
-        best: greedy.clone(),
-        best_cost: greedy_cost,
-        steps: 0,
-    };
+    let mut search =
+        Search { order: &order, sizes, adjacent: &adjacent, best: greedy.clone(), best_cost: greedy_cost, steps: 0 };
     search.go(0, &mut vec![], 0);
     let exact = search.steps <= EXACT_STEP_BUDGET;
     let mut best = search.best;

@@ -35,7 +35,17 @@ pub struct Layout {
     pub channels: Vec<Channel>,
     pub interface: InterfaceLayout,
     pub outputs: Vec<Output>,
+    pub stats: StatsLayout,
     pub effects: Vec<EffectLayout>,
+}
+
+/// Counters the fine kernel accumulates (when the program has live coarse effects).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct StatsLayout {
+    pub group: u32,
+    pub binding: u32,
+    /// Counter `k` counts the pixels that re-evaluated this coarse effect.
+    pub counters: Vec<String>,
 }
 
 /// The runtime-owned uniform block every kernel reads.
@@ -211,12 +221,7 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface) -> L
                 offset += size;
             }
             UniformKind::Texture => {
-                textures.push(ResourceBinding {
-                    name: u.name.clone(),
-                    group: GROUP_RESOURCES,
-                    binding,
-                    kind: "float",
-                });
+                textures.push(ResourceBinding { name: u.name.clone(), group: GROUP_RESOURCES, binding, kind: "float" });
                 binding += 1;
             }
             UniformKind::Sampler => {
@@ -257,11 +262,7 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface) -> L
     let slots = interface
         .slots
         .iter()
-        .map(|s| SlotLayout {
-            offset: s.offset,
-            size: s.size,
-            effects: s.effects.iter().map(name).collect(),
-        })
+        .map(|s| SlotLayout { offset: s.offset, size: s.size, effects: s.effects.iter().map(name).collect() })
         .collect();
     let outputs = checked
         .effects
@@ -282,26 +283,15 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface) -> L
         .enumerate()
         .map(|(i, e)| {
             let id = crate::check::EffectId(i as u32);
-            let condition = interface.conditions[i]
-                .as_ref()
-                .filter(|c| c.possible())
-                .map(|c| {
-                    let mut terms = vec![];
-                    if c.fine_user {
-                        terms.push("fine".to_string());
-                    }
-                    terms.extend(c.refining_users.iter().map(|u| format!("r_{}", name(u))));
-                    let any = if terms.len() == 1 {
-                        terms[0].clone()
-                    } else {
-                        format!("({})", terms.join(" || "))
-                    };
-                    if c.self_refines {
-                        format!("!r_{} && {any}", e.name)
-                    } else {
-                        any
-                    }
-                });
+            let condition = interface.conditions[i].as_ref().filter(|c| c.possible()).map(|c| {
+                let mut terms = vec![];
+                if c.fine_user {
+                    terms.push("fine".to_string());
+                }
+                terms.extend(c.refining_users.iter().map(|u| format!("r_{}", name(u))));
+                let any = if terms.len() == 1 { terms[0].clone() } else { format!("({})", terms.join(" || ")) };
+                if c.self_refines { format!("!r_{} && {any}", e.name) } else { any }
+            });
             EffectLayout {
                 name: e.name.clone(),
                 rate: e.rate,
@@ -309,13 +299,8 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface) -> L
                 live: graph.live[i],
                 refine_bit: interface.refine_bit[i],
                 slot: interface.slot_of[i],
-                resample: (e.rate == Rate::Coarse).then(|| {
-                    if uses_nearest(checked, id) {
-                        "nearest"
-                    } else {
-                        "bilinear"
-                    }
-                }),
+                resample: (e.rate == Rate::Coarse)
+                    .then(|| if uses_nearest(checked, id) { "nearest" } else { "bilinear" }),
                 depends_on: e.deps.iter().map(|(d, _)| name(d)).collect(),
                 pass_condition: condition,
             }
@@ -336,6 +321,16 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface) -> L
             slots,
             minimal: interface.exact,
             samples: "nx * ny, nx = (W + B - 2) / B + 1, ny = (H + B - 2) / B + 1 (integer division); sample (i, j) shades pixel (min(i*B, W-1), min(j*B, H-1))",
+        },
+        stats: StatsLayout {
+            group: GROUP_STAGE,
+            binding: 1 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
+            counters: graph
+                .order
+                .iter()
+                .filter(|e| checked.effects[e.index()].rate == Rate::Coarse)
+                .map(|e| checked.effects[e.index()].name.clone())
+                .collect(),
         },
         outputs,
         effects,

@@ -45,19 +45,13 @@ pub struct Options {
     pub coarse: bool,
     pub fine: bool,
     pub reference: bool,
-    /// Name shown in diagnostics and generated-code headers.
+    /// Name written in the header comment of every generated kernel.
     pub file_name: String,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Options {
-            block_sizes: vec![2, 4],
-            coarse: true,
-            fine: true,
-            reference: true,
-            file_name: "program.mrsl".into(),
-        }
+        Options { block_sizes: vec![2, 4], coarse: true, fine: true, reference: true, file_name: "program.mrsl".into() }
     }
 }
 
@@ -87,9 +81,7 @@ pub struct Program {
 impl Program {
     /// The kernel of `kind` for block size `block` (ignored for the reference kernel).
     pub fn kernel(&self, kind: KernelKind, block: u32) -> Option<&Kernel> {
-        self.kernels.iter().find(|k| {
-            k.kind == kind && (kind == KernelKind::Reference || k.block_size == Some(block))
-        })
+        self.kernels.iter().find(|k| k.kind == kind && (kind == KernelKind::Reference || k.block_size == Some(block)))
     }
 }
 
@@ -105,11 +97,7 @@ pub fn check(source: &str) -> Vec<Diagnostic> {
 /// Compiles a program to kernels and a layout, or returns its diagnostics
 /// (errors, and warnings found alongside them).
 pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnostic>> {
-    if let Some(bad) = options
-        .block_sizes
-        .iter()
-        .find(|b| !BLOCK_SIZES.contains(b))
-    {
+    if let Some(bad) = options.block_sizes.iter().find(|b| !BLOCK_SIZES.contains(b)) {
         return Err(vec![
             Diagnostic::error("E0900", format!("unsupported block size {bad}"))
                 .with_note("supported block sizes: 2, 4"),
@@ -149,16 +137,27 @@ pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnosti
     if options.reference {
         wanted.push((KernelKind::Reference, None));
     }
-    for (kind, block) in wanted {
-        let wgsl = wgsl::write_string(&inputs, kind, block.unwrap_or(1));
-        if let Err(message) = validate_wgsl(&wgsl) {
+    let texts: Vec<(KernelKind, Option<u32>, String)> = wanted
+        .into_iter()
+        .map(|(kind, block)| (kind, block, wgsl::write_string(&inputs, kind, block.unwrap_or(1))))
+        .collect();
+    // naga validation dominates compile time; the kernels are independent, so
+    // they are validated on as many threads as there are kernels.
+    let verdicts: Vec<Result<(), String>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = texts.iter().map(|(_, _, wgsl)| scope.spawn(move || validate_wgsl(wgsl))).collect();
+        handles.into_iter().map(|h| h.join().unwrap_or_else(|_| Err("naga panicked while validating".into()))).collect()
+    });
+    for ((kind, block, wgsl), verdict) in texts.into_iter().zip(verdicts) {
+        if let Err(message) = verdict {
             let what = match block {
                 Some(b) => format!("{} kernel ({b}x{b})", kind.name()),
                 None => format!("{} kernel", kind.name()),
             };
             return Err(vec![
                 Diagnostic::bug(format!("internal compiler error: the generated {what} failed naga validation"))
-                    .with_note("the program passed every check, so this is a bug in mrsl; please report it with the program")
+                    .with_note(
+                        "the program passed every check, so this is a bug in mrsl; please report it with the program",
+                    )
                     .with_note(message),
             ]);
         }
@@ -170,11 +169,7 @@ pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnosti
             wgsl,
         });
     }
-    Ok(Program {
-        kernels,
-        layout,
-        warnings: diagnostics,
-    })
+    Ok(Program { kernels, layout, warnings: diagnostics })
 }
 
 /// Runs the front end and all checks; returns warnings on success.
@@ -186,11 +181,7 @@ fn analyse(source: &str, _file_name: &str) -> Result<((), Vec<Diagnostic>), Vec<
     let (_, deriv_diagnostics) = deriv::analyse(&checked);
     diagnostics.extend(deriv_diagnostics);
     sort(&mut diagnostics);
-    if diagnostics.iter().any(|d| d.is_error()) {
-        Err(diagnostics)
-    } else {
-        Ok(((), diagnostics))
-    }
+    if diagnostics.iter().any(|d| d.is_error()) { Err(diagnostics) } else { Ok(((), diagnostics)) }
 }
 
 fn sort(diagnostics: &mut [Diagnostic]) {
@@ -199,13 +190,9 @@ fn sort(diagnostics: &mut [Diagnostic]) {
 
 /// Parses and validates WGSL with naga, as WebGPU requires (no optional capabilities).
 pub fn validate_wgsl(wgsl: &str) -> Result<(), String> {
-    let module = naga::front::wgsl::parse_str(wgsl)
+    let module = naga::front::wgsl::parse_str(wgsl).map_err(|e| e.emit_to_string_with_path(wgsl, "generated.wgsl"))?;
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
+        .validate(&module)
         .map_err(|e| e.emit_to_string_with_path(wgsl, "generated.wgsl"))?;
-    naga::valid::Validator::new(
-        naga::valid::ValidationFlags::all(),
-        naga::valid::Capabilities::empty(),
-    )
-    .validate(&module)
-    .map_err(|e| e.emit_to_string_with_path(wgsl, "generated.wgsl"))?;
     Ok(())
 }

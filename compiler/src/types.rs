@@ -118,19 +118,13 @@ impl Type {
         matches!(self, Type::AbstractInt | Type::AbstractFloat)
     }
     pub fn is_numeric_value(&self) -> bool {
-        matches!(
-            self.scalar(),
-            Some(Scalar::Int | Scalar::Uint | Scalar::Float)
-        ) && !matches!(self, Type::Array(..))
+        matches!(self.scalar(), Some(Scalar::Int | Scalar::Uint | Scalar::Float)) && !matches!(self, Type::Array(..))
     }
     /// float, floatN, or an abstract literal that can become one.
     pub fn is_float_like(&self) -> bool {
         matches!(
             self,
-            Type::Scalar(Scalar::Float)
-                | Type::Vector(Scalar::Float, _)
-                | Type::AbstractFloat
-                | Type::AbstractInt
+            Type::Scalar(Scalar::Float) | Type::Vector(Scalar::Float, _) | Type::AbstractFloat | Type::AbstractInt
         )
     }
     /// A plain value that can live in a variable, the interface or an output.

@@ -41,21 +41,16 @@ fn parse_int<'a>(lex: &mut logos::Lexer<'a, Token<'a>>) -> Result<u64, LexError>
     } else {
         text.parse::<u64>()
     };
-    value.map_err(|_| LexError::BadNumber).and_then(|v| {
-        if v > u32::MAX as u64 {
-            Err(LexError::BadNumber)
-        } else {
-            Ok(v)
-        }
-    })
+    value.map_err(|_| LexError::BadNumber).and_then(
+        |v| {
+            if v > u32::MAX as u64 { Err(LexError::BadNumber) } else { Ok(v) }
+        },
+    )
 }
 
 fn parse_float<'a>(lex: &mut logos::Lexer<'a, Token<'a>>) -> Result<f64, LexError> {
     let text = lex.slice().trim_end_matches(['f', 'F']);
-    text.parse::<f64>()
-        .ok()
-        .filter(|v| v.is_finite() && *v <= f32::MAX as f64)
-        .ok_or(LexError::BadNumber)
+    text.parse::<f64>().ok().filter(|v| v.is_finite() && *v <= f32::MAX as f64).ok_or(LexError::BadNumber)
 }
 
 /// Every token of the language.
@@ -277,9 +272,7 @@ pub struct Lexer<'input> {
 
 impl<'input> Lexer<'input> {
     pub fn new(source: &'input str) -> Self {
-        Lexer {
-            inner: Token::lexer(source).spanned(),
-        }
+        Lexer { inner: Token::lexer(source).spanned() }
     }
 }
 
@@ -290,11 +283,7 @@ impl<'input> Iterator for Lexer<'input> {
         let (token, span) = self.inner.next()?;
         Some(match token {
             Ok(token) => Ok((span.start, token, span.end)),
-            Err(error) => Err(LexErrorAt {
-                error,
-                start: span.start,
-                end: span.end,
-            }),
+            Err(error) => Err(LexErrorAt { error, start: span.start, end: span.end }),
         })
     }
 }

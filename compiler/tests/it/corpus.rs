@@ -36,7 +36,8 @@ fn ok_programs() {
         let mut snapshot = String::new();
         writeln!(snapshot, "----- SOURCE\n{}", source.trim_end()).unwrap();
         if !program.warnings.is_empty() {
-            writeln!(snapshot, "----- WARNINGS\n{}", mrsl::render_all(&program.warnings, &name, &source).trim_end()).unwrap();
+            writeln!(snapshot, "----- WARNINGS\n{}", mrsl::render_all(&program.warnings, &name, &source).trim_end())
+                .unwrap();
         }
         writeln!(snapshot, "----- LAYOUT\n{}", serde_json::to_string_pretty(&program.layout).unwrap()).unwrap();
         for (kind, block) in [(KernelKind::Coarse, 4), (KernelKind::Fine, 4), (KernelKind::Reference, 1)] {
@@ -65,6 +66,10 @@ fn err_programs() {
             assert!(d.span().is_some(), "{name}: diagnostic without a source span: {d:?}");
         }
         let rendered = mrsl::render_all(&diagnostics, &name, &source);
-        insta::assert_snapshot!(format!("----- SOURCE\n{}\n----- DIAGNOSTICS\n{}", source.trim_end(), rendered.trim_end()));
+        insta::assert_snapshot!(format!(
+            "----- SOURCE\n{}\n----- DIAGNOSTICS\n{}",
+            source.trim_end(),
+            rendered.trim_end()
+        ));
     });
 }

@@ -204,10 +204,13 @@ fn exact_colouring_matches_brute_force() {
                 }
             }
         }
-        let adjacent = |a: usize, b: usize| edges.iter().any(|&(x, y)| (x.0 as usize, y.0 as usize) == (a.min(b), a.max(b)));
+        let adjacent =
+            |a: usize, b: usize| edges.iter().any(|&(x, y)| (x.0 as usize, y.0 as usize) == (a.min(b), a.max(b)));
         let (classes, exact) = mrsl::interface::colour(&nodes, &sizes, &edges);
         assert!(exact);
-        let cost = |classes: &[Vec<usize>]| classes.iter().map(|c| c.iter().map(|&k| sizes[k]).max().unwrap_or(0)).sum::<u32>();
+        let cost = |classes: &[Vec<usize>]| {
+            classes.iter().map(|c| c.iter().map(|&k| sizes[k]).max().unwrap_or(0)).sum::<u32>()
+        };
         for c in &classes {
             for (i, &a) in c.iter().enumerate() {
                 for &b in &c[i + 1..] {

@@ -1,0 +1,44 @@
+//! The runtime's typed errors: every mismatch between a program's layout and what the engine binds.
+
+/// What went wrong, naming the binding at fault.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum Error {
+    #[error("no adapter: {0}")]
+    NoAdapter(String),
+    #[error("device request failed: {0}")]
+    Device(String),
+    #[error("G-buffer channel `{0}` is not bound")]
+    MissingChannel(String),
+    #[error(
+        "G-buffer channel `{channel}` has format {found:?}, but the program reads it as `{ty}` (expected {expected}, or a format with the same sample type and at least {components} components)"
+    )]
+    ChannelFormat { channel: String, ty: String, expected: String, components: u32, found: wgpu::TextureFormat },
+    #[error("{what} `{name}` is {found_width}x{found_height}, but the target is {width}x{height}")]
+    SizeMismatch { what: &'static str, name: String, width: u32, height: u32, found_width: u32, found_height: u32 },
+    #[error("uniform `{0}` has no default and was not set")]
+    MissingUniform(String),
+    #[error("the program has no uniform `{0}`")]
+    UnknownUniform(String),
+    #[error("uniform `{name}` is `{ty}` ({expected} components), but {found} values were given")]
+    UniformComponents { name: String, ty: String, expected: usize, found: usize },
+    #[error("texture `{0}` is not bound")]
+    MissingTexture(String),
+    #[error("sampler `{0}` is not bound")]
+    MissingSampler(String),
+    #[error("output `{0}` is not bound")]
+    MissingOutput(String),
+    #[error("output `{name}` must be a {expected:?} storage texture, found {found:?}")]
+    OutputFormat { name: String, expected: wgpu::TextureFormat, found: wgpu::TextureFormat },
+    #[error("output `{0}` was not created with TextureUsages::STORAGE_BINDING")]
+    OutputUsage(String),
+    #[error("target size {width}x{height} is not supported: {reason}")]
+    BadSize { width: u32, height: u32, reason: String },
+    #[error("mode `{0}` is not supported by this program: {1}")]
+    UnsupportedMode(String, String),
+    #[error("unknown mode `{0}` (expected reference, coarse2x2, coarse4x4)")]
+    UnknownMode(String),
+    #[error("the device rejected a pipeline: {0}")]
+    Pipeline(String),
+    #[error("reading results back failed: {0}")]
+    Readback(String),
+}

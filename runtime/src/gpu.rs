@@ -1,0 +1,130 @@
+//! Device acquisition for tools and tests, and texture upload/readback helpers.
+
+use crate::error::Error;
+
+/// A headless device: the first adapter wgpu finds (lavapipe on a machine
+/// without a GPU), with timestamp queries when the adapter has them.
+pub struct Gpu {
+    pub adapter_info: wgpu::AdapterInfo,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+}
+
+impl Gpu {
+    pub fn new() -> Result<Gpu, Error> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+            apply_limit_buckets: false,
+        }))
+        .map_err(|e| Error::NoAdapter(format!("{e} (on a machine without a GPU, install Mesa's lavapipe: apt-get install mesa-vulkan-drivers libvulkan1)")))?;
+        let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        let features = adapter.features() & wanted;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("mrsl"),
+            required_features: features,
+            required_limits: wgpu::Limits::default().using_resolution(adapter.limits()),
+            ..Default::default()
+        }))
+        .map_err(|e| Error::Device(e.to_string()))?;
+        Ok(Gpu { adapter_info: adapter.get_info(), device, queue })
+    }
+
+    /// Creates a 2D texture and fills it with `data` (tightly packed rows).
+    pub fn texture_with_data(
+        &self,
+        label: &str,
+        size: (u32, u32),
+        format: wgpu::TextureFormat,
+        data: &[u8],
+    ) -> wgpu::Texture {
+        let texture = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let bytes_per_pixel = format.block_copy_size(None).unwrap_or(4);
+        self.queue.write_texture(
+            texture.as_image_copy(),
+            data,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(size.0 * bytes_per_pixel),
+                rows_per_image: Some(size.1),
+            },
+            texture.size(),
+        );
+        texture
+    }
+
+    /// Creates an output texture a kernel can write and a copy can read.
+    pub fn output_texture(&self, label: &str, size: (u32, u32), format: wgpu::TextureFormat) -> wgpu::Texture {
+        self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        })
+    }
+
+    /// Reads a texture back as rows of raw texel bytes, tightly packed.
+    pub fn read_texture(&self, texture: &wgpu::Texture) -> Result<Vec<u8>, Error> {
+        let bytes_per_pixel = texture.format().block_copy_size(None).unwrap_or(4);
+        let (width, height) = (texture.width(), texture.height());
+        let row = width * bytes_per_pixel;
+        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("mrsl readback"),
+            size: padded as u64 * height as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        encoder.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded),
+                    rows_per_image: Some(height),
+                },
+            },
+            texture.size(),
+        );
+        self.queue.submit([encoder.finish()]);
+        let slice = buffer.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Readback(e.to_string()))?;
+        rx.recv().map_err(|e| Error::Readback(e.to_string()))?.map_err(|e| Error::Readback(e.to_string()))?;
+        let view = slice.get_mapped_range().map_err(|e| Error::Readback(e.to_string()))?;
+        let mut out = Vec::with_capacity((row * height) as usize);
+        for y in 0..height as usize {
+            out.extend_from_slice(&view[y * padded as usize..y * padded as usize + row as usize]);
+        }
+        Ok(out)
+    }
+
+    /// Reads an `rgba32float` texture as RGBA pixels.
+    pub fn read_rgba32f(&self, texture: &wgpu::Texture) -> Result<Vec<[f32; 4]>, Error> {
+        let bytes = self.read_texture(texture)?;
+        let floats: Vec<f32> = bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+        Ok(floats.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect())
+    }
+}

@@ -1,0 +1,77 @@
+//! mrsl-runtime: executes compiled mrsl programs with wgpu.
+//!
+//! The engine owns the device, the G-buffer textures and the output
+//! textures; [`Shader`] owns the pipelines, the uniform and control blocks
+//! and the coarse-to-fine interface buffer, and records its passes into the
+//! engine's command encoder:
+//!
+//! ```no_run
+//! # fn demo(device: &wgpu::Device, queue: &wgpu::Queue, program: &mrsl::Program,
+//! #         normal: &wgpu::Texture, color: &wgpu::Texture) -> Result<(), mrsl_runtime::Error> {
+//! use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader};
+//! let mut shader = Shader::new(device, program)?;
+//! let mut bindings = Bindings { size: (color.width(), color.height()), ..Default::default() };
+//! bindings.channels.insert("normal".into(), normal);
+//! bindings.outputs.insert("color".into(), color);
+//! let mut encoder = device.create_command_encoder(&Default::default());
+//! shader.encode(device, queue, &mut encoder, &bindings, DispatchOptions { mode: Mode::Coarse4x4, force_refine: false })?;
+//! queue.submit([encoder.finish()]);
+//! let stats = shader.read_stats(device)?;
+//! println!("shaded {:.1}% of the reference's work", 100.0 * stats.shaded_fraction);
+//! # Ok(()) }
+//! ```
+
+mod error;
+pub mod gpu;
+pub mod scene;
+mod shader;
+mod stats;
+
+pub use error::Error;
+pub use shader::{Bindings, DispatchOptions, Shader};
+pub use stats::{EffectStats, Stats, Timings};
+
+/// How a program is dispatched.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Mode {
+    /// Every effect per pixel.
+    Reference,
+    /// One coarse sample per 2x2 block, refined per block.
+    Coarse2x2,
+    /// One coarse sample per 4x4 block, refined per block.
+    Coarse4x4,
+}
+
+impl Mode {
+    pub const ALL: [Mode; 3] = [Mode::Reference, Mode::Coarse2x2, Mode::Coarse4x4];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Reference => "reference",
+            Mode::Coarse2x2 => "coarse2x2",
+            Mode::Coarse4x4 => "coarse4x4",
+        }
+    }
+
+    /// The coarse block size, or `None` for per-pixel shading.
+    pub fn block_size(self) -> Option<u32> {
+        match self {
+            Mode::Reference => None,
+            Mode::Coarse2x2 => Some(2),
+            Mode::Coarse4x4 => Some(4),
+        }
+    }
+}
+
+impl std::str::FromStr for Mode {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Mode, Error> {
+        Mode::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| Error::UnknownMode(s.to_string()))
+    }
+}
+
+impl std::fmt::Display for Mode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}

@@ -1,0 +1,254 @@
+//! G-buffers made on the CPU: the DACS test patterns (gradient, steps,
+//! sinusoid) for precise tests, and an analytically ray-cast demo scene.
+//!
+//! Every scene provides the same channels, so any program reading a subset
+//! of them runs on any scene: `position` (float3, world space), `normal`
+//! (float3, unit), `uv` (float2), `material` (uint; 255 is the background)
+//! and `depth` (float, distance from the camera).
+
+use crate::gpu::Gpu;
+
+/// Material id of background pixels.
+pub const BACKGROUND: u32 = 255;
+
+/// The data of one channel, row-major, top row first.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ChannelData {
+    /// `components` floats per pixel (1 to 4).
+    Float {
+        components: u32,
+        data: Vec<f32>,
+    },
+    Uint(Vec<u32>),
+}
+
+/// A G-buffer in CPU memory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GBuffer {
+    pub width: u32,
+    pub height: u32,
+    pub channels: Vec<(String, ChannelData)>,
+}
+
+/// Which synthetic scene to make.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Scene {
+    /// Spheres on a checkered ground plane, under the demo program's default camera.
+    Demo,
+    /// A tilted plane whose position and uv vary linearly across the image.
+    Gradient,
+    /// Vertical stripes with constant, different normals and materials (step functions).
+    Steps { count: u32 },
+    /// A surface whose normal oscillates: `frequency` periods across the image along `angle` (degrees).
+    Sinusoid { angle: f32, frequency: f32 },
+}
+
+impl Scene {
+    pub fn parse(name: &str) -> Option<Scene> {
+        Some(match name {
+            "demo" => Scene::Demo,
+            "gradient" => Scene::Gradient,
+            "steps" => Scene::Steps { count: 8 },
+            "sinusoid" => Scene::Sinusoid { angle: 30.0, frequency: 12.0 },
+            _ => return None,
+        })
+    }
+
+    pub fn render(self, width: u32, height: u32) -> GBuffer {
+        match self {
+            Scene::Demo => demo(width, height),
+            Scene::Gradient => {
+                surface(width, height, |u, v| (0, [u * 2.0 - 1.0, 1.0 - v * 2.0, 0.2 * u], [0.0, 0.0, 1.0]))
+            }
+            Scene::Steps { count } => surface(width, height, move |u, v| {
+                let k = ((u * count as f32) as u32).min(count - 1);
+                let a = k as f32 / count as f32 * 2.4 - 1.2;
+                (k, [u * 2.0 - 1.0, 1.0 - v * 2.0, 0.0], [a.sin(), 0.3, a.cos()])
+            }),
+            Scene::Sinusoid { angle, frequency } => {
+                let (s, c) = angle.to_radians().sin_cos();
+                surface(width, height, move |u, v| {
+                    let phase = (u * c + v * s) * frequency * std::f32::consts::TAU;
+                    let slope = 0.6 * phase.cos();
+                    (0, [u * 2.0 - 1.0, 1.0 - v * 2.0, 0.0], [slope * c, slope * s, 1.0])
+                })
+            }
+        }
+    }
+}
+
+impl GBuffer {
+    pub fn channel(&self, name: &str) -> Option<&ChannelData> {
+        self.channels.iter().find(|(n, _)| n == name).map(|(_, d)| d)
+    }
+
+    /// Uploads every channel as a texture in the format mrsl's layout expects.
+    pub fn upload(&self, gpu: &Gpu) -> Vec<(String, wgpu::Texture)> {
+        let size = (self.width, self.height);
+        self.channels
+            .iter()
+            .map(|(name, data)| {
+                let texture = match data {
+                    ChannelData::Uint(values) => {
+                        gpu.texture_with_data(name, size, wgpu::TextureFormat::R32Uint, bytemuck::cast_slice(values))
+                    }
+                    ChannelData::Float { components, data } => {
+                        let (format, stride) = match components {
+                            1 => (wgpu::TextureFormat::R32Float, 1),
+                            2 => (wgpu::TextureFormat::Rg32Float, 2),
+                            _ => (wgpu::TextureFormat::Rgba32Float, 4),
+                        };
+                        let n = *components as usize;
+                        let mut padded = Vec::with_capacity(data.len() / n * stride);
+                        for px in data.chunks_exact(n) {
+                            padded.extend_from_slice(px);
+                            padded.extend(std::iter::repeat_n(0.0f32, stride - n));
+                        }
+                        gpu.texture_with_data(name, size, format, bytemuck::cast_slice(&padded))
+                    }
+                };
+                (name.clone(), texture)
+            })
+            .collect()
+    }
+}
+
+fn normalize(v: [f32; 3]) -> [f32; 3] {
+    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt().max(1e-20);
+    [v[0] / l, v[1] / l, v[2] / l]
+}
+
+/// A surface facing the camera, described per pixel by `f(u, v) -> (material, position, normal)`.
+fn surface(width: u32, height: u32, f: impl Fn(f32, f32) -> (u32, [f32; 3], [f32; 3])) -> GBuffer {
+    let mut b = Builder::new(width, height);
+    for y in 0..height {
+        for x in 0..width {
+            let (u, v) = ((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32);
+            let (material, position, normal) = f(u, v);
+            let depth = 5.0 - position[2];
+            b.push(position, normalize(normal), [u, v], material, depth);
+        }
+    }
+    b.finish()
+}
+
+struct Builder {
+    width: u32,
+    height: u32,
+    position: Vec<f32>,
+    normal: Vec<f32>,
+    uv: Vec<f32>,
+    material: Vec<u32>,
+    depth: Vec<f32>,
+}
+
+impl Builder {
+    fn new(width: u32, height: u32) -> Builder {
+        let n = (width * height) as usize;
+        Builder {
+            width,
+            height,
+            position: Vec::with_capacity(3 * n),
+            normal: Vec::with_capacity(3 * n),
+            uv: Vec::with_capacity(2 * n),
+            material: Vec::with_capacity(n),
+            depth: Vec::with_capacity(n),
+        }
+    }
+    fn push(&mut self, position: [f32; 3], normal: [f32; 3], uv: [f32; 2], material: u32, depth: f32) {
+        self.position.extend(position);
+        self.normal.extend(normal);
+        self.uv.extend(uv);
+        self.material.push(material);
+        self.depth.push(depth);
+    }
+    fn finish(self) -> GBuffer {
+        GBuffer {
+            width: self.width,
+            height: self.height,
+            channels: vec![
+                ("position".into(), ChannelData::Float { components: 3, data: self.position }),
+                ("normal".into(), ChannelData::Float { components: 3, data: self.normal }),
+                ("uv".into(), ChannelData::Float { components: 2, data: self.uv }),
+                ("material".into(), ChannelData::Uint(self.material)),
+                ("depth".into(), ChannelData::Float { components: 1, data: self.depth }),
+            ],
+        }
+    }
+}
+
+/// Ray-casts spheres on a ground plane from the demo program's default camera
+/// (at (0, 1.5, 5), looking at (0, 0.5, 0), 50 degree vertical field of view).
+fn demo(width: u32, height: u32) -> GBuffer {
+    let eye = [0.0f32, 1.5, 5.0];
+    let target = [0.0f32, 0.5, 0.0];
+    let forward = normalize([target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]]);
+    let right = normalize([-forward[2], 0.0, forward[0]]);
+    let up = [
+        right[1] * forward[2] - right[2] * forward[1],
+        right[2] * forward[0] - right[0] * forward[2],
+        right[0] * forward[1] - right[1] * forward[0],
+    ];
+    let tan_half = (50.0f32.to_radians() / 2.0).tan();
+    let aspect = width as f32 / height as f32;
+    // (center, radius, material)
+    let spheres = [
+        ([-1.3f32, 0.7, 0.0], 0.7f32, 1u32),
+        ([0.5, 0.5, 0.9], 0.5, 2),
+        ([1.6, 0.9, -1.2], 0.9, 3),
+        ([-0.2, 0.35, -1.6], 0.35, 4),
+    ];
+    let mut b = Builder::new(width, height);
+    for y in 0..height {
+        for x in 0..width {
+            let sx = (2.0 * (x as f32 + 0.5) / width as f32 - 1.0) * tan_half * aspect;
+            let sy = (1.0 - 2.0 * (y as f32 + 0.5) / height as f32) * tan_half;
+            let dir = normalize([
+                forward[0] + sx * right[0] + sy * up[0],
+                forward[1] + sx * right[1] + sy * up[1],
+                forward[2] + sx * right[2] + sy * up[2],
+            ]);
+            let mut best: Option<(f32, [f32; 3], [f32; 2], u32)> = None;
+            // Ground plane y = 0, within |x|, |z| < 6.
+            if dir[1] < -1e-6 {
+                let t = -eye[1] / dir[1];
+                let p = [eye[0] + t * dir[0], 0.0, eye[2] + t * dir[2]];
+                if p[0].abs() < 6.0 && p[2].abs() < 6.0 {
+                    best = Some((t, [0.0, 1.0, 0.0], [p[0] * 0.25 + 0.5, p[2] * 0.25 + 0.5], 0));
+                }
+            }
+            for (center, radius, material) in spheres {
+                let oc = [eye[0] - center[0], eye[1] - center[1], eye[2] - center[2]];
+                let bq = oc[0] * dir[0] + oc[1] * dir[1] + oc[2] * dir[2];
+                let cq = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2] - radius * radius;
+                let disc = bq * bq - cq;
+                if disc < 0.0 {
+                    continue;
+                }
+                let t = -bq - disc.sqrt();
+                if t > 1e-4 && best.is_none_or(|(bt, ..)| t < bt) {
+                    let p = [eye[0] + t * dir[0], eye[1] + t * dir[1], eye[2] + t * dir[2]];
+                    let n = normalize([p[0] - center[0], p[1] - center[1], p[2] - center[2]]);
+                    let uv = [0.5 + n[2].atan2(n[0]) / std::f32::consts::TAU, 0.5 - n[1].asin() / std::f32::consts::PI];
+                    best = Some((t, n, uv, material));
+                }
+            }
+            match best {
+                Some((t, n, uv, material)) => {
+                    b.push([eye[0] + t * dir[0], eye[1] + t * dir[1], eye[2] + t * dir[2]], n, uv, material, t)
+                }
+                None => {
+                    let t = 50.0;
+                    b.push(
+                        [eye[0] + t * dir[0], eye[1] + t * dir[1], eye[2] + t * dir[2]],
+                        [-dir[0], -dir[1], -dir[2]],
+                        [0.0, 0.0],
+                        BACKGROUND,
+                        t,
+                    )
+                }
+            }
+        }
+    }
+    b.finish()
+}

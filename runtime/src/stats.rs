@@ -1,0 +1,121 @@
+//! What a dispatch shaded: per effect, how many pixels took the coarse value
+//! and how many re-evaluated it, and the work relative to the reference.
+
+use crate::shader::DispatchOptions;
+use mrsl::layout::Layout;
+use mrsl::syntax::ast::Rate;
+
+/// GPU time of the passes, from timestamp queries.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Timings {
+    pub coarse_ms: f64,
+    pub fine_ms: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct EffectStats {
+    pub name: String,
+    pub rate: Rate,
+    /// Evaluations in the coarse kernel (one per coarse sample).
+    pub coarse_evaluations: u64,
+    /// Pixels that evaluated the effect themselves.
+    pub pixel_evaluations: u64,
+    /// Pixels that took a resampled coarse value.
+    pub resampled: u64,
+    /// Evaluations relative to the reference (one per pixel).
+    pub shaded_fraction: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Stats {
+    pub mode: String,
+    pub force_refine: bool,
+    pub width: u32,
+    pub height: u32,
+    pub coarse_samples: u64,
+    pub effects: Vec<EffectStats>,
+    /// Effect evaluations relative to the reference's (pixels x live effects).
+    pub shaded_fraction: f64,
+    pub timings: Option<Timings>,
+}
+
+impl Stats {
+    pub(crate) fn new(
+        layout: &Layout,
+        options: DispatchOptions,
+        size: (u32, u32),
+        counters: &[u32],
+        timings: Option<Timings>,
+    ) -> Stats {
+        let pixels = size.0 as u64 * size.1 as u64;
+        let samples = options.mode.block_size().map(|b| crate::Shader::coarse_samples(size, b)).unwrap_or(0);
+        let mut effects = vec![];
+        for e in layout.effects.iter().filter(|e| e.live) {
+            let (coarse_evaluations, pixel_evaluations) = match (options.mode.block_size(), e.rate) {
+                (Some(_), Rate::Coarse) => {
+                    let k = layout.stats.counters.iter().position(|c| *c == e.name);
+                    (samples, k.map(|k| counters.get(k).copied().unwrap_or(0) as u64).unwrap_or(0))
+                }
+                _ => (0, pixels),
+            };
+            effects.push(EffectStats {
+                name: e.name.clone(),
+                rate: e.rate,
+                coarse_evaluations,
+                pixel_evaluations,
+                resampled: pixels - pixel_evaluations.min(pixels),
+                shaded_fraction: (coarse_evaluations + pixel_evaluations) as f64 / pixels as f64,
+            });
+        }
+        let total: u64 = effects.iter().map(|e| e.coarse_evaluations + e.pixel_evaluations).sum();
+        let shaded_fraction =
+            if effects.is_empty() { 1.0 } else { total as f64 / (pixels * effects.len() as u64) as f64 };
+        Stats {
+            mode: options.mode.name().into(),
+            force_refine: options.force_refine,
+            width: size.0,
+            height: size.1,
+            coarse_samples: samples,
+            effects,
+            shaded_fraction,
+            timings,
+        }
+    }
+
+    /// A human-readable table.
+    pub fn table(&self) -> String {
+        let mut out = format!(
+            "{} {}x{}{}: {} coarse samples, shaded fraction {:.1}% of the reference\n",
+            self.mode,
+            self.width,
+            self.height,
+            if self.force_refine { " (forced refine)" } else { "" },
+            self.coarse_samples,
+            100.0 * self.shaded_fraction
+        );
+        out.push_str(&format!(
+            "  {:<20} {:>6} {:>12} {:>12} {:>12} {:>8}\n",
+            "effect", "rate", "coarse", "per-pixel", "resampled", "shaded"
+        ));
+        for e in &self.effects {
+            let rate = match e.rate {
+                Rate::Coarse => "coarse",
+                Rate::Fine => "fine",
+                Rate::Out => "out",
+            };
+            out.push_str(&format!(
+                "  {:<20} {:>6} {:>12} {:>12} {:>12} {:>7.1}%\n",
+                e.name,
+                rate,
+                e.coarse_evaluations,
+                e.pixel_evaluations,
+                e.resampled,
+                100.0 * e.shaded_fraction
+            ));
+        }
+        if let Some(t) = self.timings {
+            out.push_str(&format!("  GPU time: coarse {:.3} ms, fine {:.3} ms\n", t.coarse_ms, t.fine_ms));
+        }
+        out
+    }
+}
