@@ -7,6 +7,8 @@ use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+mod render;
+
 #[derive(Parser)]
 #[command(name = "mrslc", version, about = "Compiler for mrsl, a multi-rate shading language", long_about = None)]
 struct Cli {
@@ -48,6 +50,42 @@ enum Command {
         #[arg(short, long = "block", value_parser = ["2", "4"], default_values = ["2", "4"])]
         blocks: Vec<String>,
     },
+    /// Render a program over a scene with the wgpu runtime (lavapipe works).
+    ///
+    /// With no arguments: the built-in demo program over the demo scene at
+    /// 960x540 in coarse 4x4 mode, writing demo.coarse4x4.png, a heatmap and
+    /// demo.stats.json into the current directory.
+    Render(Render),
+}
+
+#[derive(clap::Args)]
+struct Render {
+    /// The .mrsl program (default: the built-in demo program).
+    program: Option<PathBuf>,
+    /// Scene: demo, gradient, steps or sinusoid.
+    #[arg(long, default_value = "demo")]
+    scene: String,
+    /// reference, coarse2x2, coarse4x4 or all.
+    #[arg(long, default_value = "coarse4x4")]
+    mode: String,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "960x540", value_parser = render::parse_size)]
+    size: (u32, u32),
+    /// Set a uniform: NAME=VALUE or NAME=X,Y,Z (repeatable).
+    #[arg(long = "set", value_parser = render::parse_set)]
+    sets: Vec<(String, Vec<f64>)>,
+    /// Output PNG (default: PROGRAM.MODE.png in the current directory).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Heatmap PNG of where coarse effects were evaluated per pixel.
+    #[arg(long)]
+    heatmap: Option<PathBuf>,
+    /// Print per-effect statistics.
+    #[arg(long)]
+    stats: bool,
+    /// Force every refine predicate (the output must equal the reference).
+    #[arg(long)]
+    force_refine: bool,
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq)]
@@ -83,6 +121,36 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
             } else {
                 eprintln!("{name}: ok ({warnings} warning{})", plural(warnings));
                 Ok(ExitCode::SUCCESS)
+            }
+        }
+        Command::Render(r) => {
+            let modes: Vec<mrsl_runtime::Mode> = if r.mode == "all" {
+                mrsl_runtime::Mode::ALL.to_vec()
+            } else {
+                vec![r.mode.parse().map_err(|e: mrsl_runtime::Error| e.to_string())?]
+            };
+            let args = render::RenderArgs {
+                program: r.program.clone(),
+                scene: r.scene.clone(),
+                modes,
+                size: r.size,
+                sets: r.sets.clone(),
+                output: r.output.clone(),
+                heatmap: r.heatmap.clone(),
+                stats: r.stats,
+                force_refine: r.force_refine,
+            };
+            match render::render(&args) {
+                Ok(paths) => {
+                    for p in paths {
+                        eprintln!("wrote {}", p.display());
+                    }
+                    Ok(ExitCode::SUCCESS)
+                }
+                Err(message) => {
+                    eprintln!("{message}");
+                    Ok(ExitCode::from(1))
+                }
             }
         }
         Command::Compile { file, out_dir, emit, blocks } => {

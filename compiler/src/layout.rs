@@ -36,6 +36,8 @@ pub struct Layout {
     pub interface: InterfaceLayout,
     pub outputs: Vec<Output>,
     pub stats: StatsLayout,
+    /// The fine kernel's per-pixel refine mask (`r32uint`; bit k = stats counter k).
+    pub rate_image: ResourceBinding,
     pub effects: Vec<EffectLayout>,
 }
 
@@ -331,6 +333,12 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface) -> L
                 .filter(|e| checked.effects[e.index()].rate == Rate::Coarse)
                 .map(|e| checked.effects[e.index()].name.clone())
                 .collect(),
+        },
+        rate_image: ResourceBinding {
+            name: "mrsl_rate".into(),
+            group: GROUP_STAGE,
+            binding: 2 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
+            kind: "r32uint",
         },
         outputs,
         effects,

@@ -273,6 +273,17 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
                 ),
             );
             self.line(0, format!("var<workgroup> mrsl_wg_stats: array<atomic<u32>, {}>;", self.coarse_live().len()));
+            self.line(
+                0,
+                "// Per pixel, bit k set: coarse effect k (bits 0..31) was evaluated per pixel (layout `rate_image`).",
+            );
+            self.line(
+                0,
+                format!(
+                    "@group({}) @binding({}) var mrsl_rate: texture_storage_2d<r32uint, write>;",
+                    l.rate_image.group, l.rate_image.binding
+                ),
+            );
         }
         if self.kind != KernelKind::Coarse {
             for o in &l.outputs {
@@ -1071,6 +1082,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         let nc = self.coarse_live().len();
         self.line(1, "if (all(mrsl_pos < mrsl_grid())) {");
         self.line(2, "let mrsl_b = mrsl_resolve(mrsl_pos);");
+        self.line(2, "textureStore(mrsl_rate, mrsl_pos, vec4<u32>(mrsl_b.refined[0], 0u, 0u, 1u));");
         for k in 0..nc {
             self.line(2, format!("if (mrsl_is_refined(mrsl_b, {k}u)) {{ atomicAdd(&mrsl_wg_stats[{k}], 1u); }}"));
         }

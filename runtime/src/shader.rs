@@ -53,6 +53,8 @@ pub struct Shader {
     uniform_values: HashMap<String, Vec<f64>>,
     /// Interface buffers by block size, with the size they were made for.
     interfaces: HashMap<u32, (wgpu::Buffer, (u32, u32))>,
+    /// The fine kernel's per-pixel refine mask, with the size it was made for.
+    rate: Option<(wgpu::Texture, (u32, u32))>,
     stats: wgpu::Buffer,
     stats_readback: wgpu::Buffer,
     timestamps: Option<Timestamps>,
@@ -159,6 +161,7 @@ impl Shader {
             uniforms,
             uniform_values: HashMap::new(),
             interfaces: HashMap::new(),
+            rate: None,
             stats,
             stats_readback,
             timestamps,
@@ -338,6 +341,7 @@ impl Shader {
             }
             Some(block) => {
                 let interface = self.interface(device, block, bindings.size).clone();
+                self.ensure_rate_image(device, bindings.size);
                 let coarse_stage = self.stage_group(device, KernelKind::Coarse, Some(&interface), &views);
                 let fine_stage = self.stage_group(device, KernelKind::Fine, Some(&interface), &views);
                 let (nx, ny) = sample_grid(bindings.size, block);
@@ -476,14 +480,45 @@ impl Shader {
                 });
             }
         }
+        let rate_view = self.rate.as_ref().map(|(t, _)| t.create_view(&Default::default()));
         if kind == KernelKind::Fine && !l.stats.counters.is_empty() {
             entries.push(wgpu::BindGroupEntry { binding: l.stats.binding, resource: self.stats.as_entire_binding() });
+            if let Some(view) = &rate_view {
+                entries.push(wgpu::BindGroupEntry {
+                    binding: l.rate_image.binding,
+                    resource: wgpu::BindingResource::TextureView(view),
+                });
+            }
         }
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some(kind.name()),
             layout: &self.stage_layouts[&kind],
             entries: &entries,
         })
+    }
+
+    fn ensure_rate_image(&mut self, device: &wgpu::Device, size: (u32, u32)) {
+        if self.rate.as_ref().is_some_and(|(_, s)| *s == size) {
+            return;
+        }
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("mrsl rate image"),
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R32Uint,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        self.rate = Some((texture, size));
+    }
+
+    /// The per-pixel refine mask of the last coarse-mode dispatch: bit k set
+    /// when coarse effect k (`layout().stats.counters[k]`) was evaluated per
+    /// pixel. `None` before any coarse-mode dispatch.
+    pub fn rate_image(&self) -> Option<&wgpu::Texture> {
+        self.rate.as_ref().map(|(t, _)| t)
     }
 
     /// Reads the statistics of the last submitted dispatch (waits for the GPU).
@@ -705,6 +740,16 @@ fn stage_layout(device: &wgpu::Device, l: &Layout, kind: KernelKind) -> wgpu::Bi
     }
     if kind == KernelKind::Fine && !l.stats.counters.is_empty() {
         entries.push(storage(l.stats.binding, false));
+        entries.push(wgpu::BindGroupLayoutEntry {
+            binding: l.rate_image.binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format: wgpu::TextureFormat::R32Uint,
+                view_dimension: wgpu::TextureViewDimension::D2,
+            },
+            count: None,
+        });
     }
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(kind.name()), entries: &entries })
 }

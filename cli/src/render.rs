@@ -1,0 +1,262 @@
+//! `mrslc render`: runs a program over a scene with the wgpu runtime and
+//! writes the image, a refinement heatmap and statistics.
+
+use mrsl::{KernelKind, Options};
+use mrsl_runtime::gpu::Gpu;
+use mrsl_runtime::scene::Scene;
+use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader, Stats};
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The built-in demo program (examples/demo.mrsl).
+pub const DEMO_PROGRAM: &str = include_str!("../../examples/demo.mrsl");
+
+pub struct RenderArgs {
+    pub program: Option<PathBuf>,
+    pub scene: String,
+    pub modes: Vec<Mode>,
+    pub size: (u32, u32),
+    pub sets: Vec<(String, Vec<f64>)>,
+    pub output: Option<PathBuf>,
+    pub heatmap: Option<PathBuf>,
+    pub stats: bool,
+    pub force_refine: bool,
+}
+
+fn progress(what: &str, start: Instant) {
+    eprintln!("{what} ({:.0} ms)", start.elapsed().as_secs_f64() * 1e3);
+}
+
+/// Runs the render; returns the paths written.
+pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
+    let (name, source) = match &args.program {
+        Some(path) => (
+            path.display().to_string(),
+            std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?,
+        ),
+        None => ("demo.mrsl (built in)".to_string(), DEMO_PROGRAM.to_string()),
+    };
+    let stem = args.program.as_ref().and_then(|p| p.file_stem()).and_then(|s| s.to_str()).unwrap_or("demo").to_string();
+    let start = Instant::now();
+    let options = Options { file_name: name.clone(), ..Options::default() };
+    let program = mrsl::compile(&source, &options).map_err(|d| mrsl::render_all(&d, &name, &source))?;
+    progress(&format!("compiled {name}: {} kernels", program.kernels.len()), start);
+
+    let scene = Scene::parse(&args.scene)
+        .ok_or_else(|| format!("unknown scene `{}` (expected demo, gradient, steps or sinusoid)", args.scene))?;
+    let start = Instant::now();
+    let gbuffer = scene.render(args.size.0, args.size.1);
+    progress(&format!("built the {} G-buffer at {}x{}", args.scene, args.size.0, args.size.1), start);
+
+    let start = Instant::now();
+    let gpu = Gpu::new().map_err(|e| e.to_string())?;
+    progress(&format!("device: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend), start);
+    let channels = gbuffer.upload(&gpu);
+    let mut shader = Shader::new(&gpu.device, &program).map_err(|e| e.to_string())?;
+    shader.set_timestamp_period(&gpu.queue);
+    for (name, values) in &args.sets {
+        shader.set_uniform(name, values).map_err(|e| e.to_string())?;
+    }
+    // Programs that sample textures get a procedural checker texture and a
+    // linear, repeating sampler (scenes carry no textures of their own yet).
+    let checker = checker_texture(&gpu);
+    let checker_view = checker.create_view(&Default::default());
+    let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+        address_mode_u: wgpu::AddressMode::Repeat,
+        address_mode_v: wgpu::AddressMode::Repeat,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Linear,
+        ..Default::default()
+    });
+    let outputs: Vec<(String, wgpu::Texture)> = program
+        .layout
+        .outputs
+        .iter()
+        .map(|o| (o.name.clone(), gpu.output_texture(&o.name, args.size, output_format(&o.format))))
+        .collect();
+    let mut bindings = Bindings { size: args.size, ..Default::default() };
+    for (name, texture) in &channels {
+        bindings.channels.insert(name.clone(), texture);
+    }
+    for t in &program.layout.textures {
+        bindings.textures.insert(t.name.clone(), &checker_view);
+    }
+    for s in &program.layout.samplers {
+        bindings.samplers.insert(s.name.clone(), &sampler);
+    }
+    for (name, texture) in &outputs {
+        bindings.outputs.insert(name.clone(), texture);
+    }
+
+    let mut written = vec![];
+    let mut all_stats: Vec<Stats> = vec![];
+    for &mode in &args.modes {
+        let start = Instant::now();
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        shader
+            .encode(
+                &gpu.device,
+                &gpu.queue,
+                &mut encoder,
+                &bindings,
+                DispatchOptions { mode, force_refine: args.force_refine },
+            )
+            .map_err(|e| e.to_string())?;
+        gpu.queue.submit([encoder.finish()]);
+        let stats = shader.read_stats(&gpu.device).map_err(|e| e.to_string())?;
+        progress(&format!("rendered {mode}"), start);
+        let suffix = if args.modes.len() > 1 || args.output.is_none() { format!(".{mode}") } else { String::new() };
+        for (k, (name, texture)) in outputs.iter().enumerate() {
+            let path = match (&args.output, k) {
+                (Some(p), 0) => with_suffix(p, &suffix),
+                (Some(p), _) => with_suffix(p, &format!("{suffix}.{name}")),
+                (None, 0) => PathBuf::from(format!("{stem}{suffix}.png")),
+                (None, _) => PathBuf::from(format!("{stem}{suffix}.{name}.png")),
+            };
+            save_output(&gpu, texture, &path)?;
+            written.push(path);
+        }
+        if mode != Mode::Reference && program.kernel(KernelKind::Fine, 4).is_some() {
+            let path = match &args.heatmap {
+                Some(p) => with_suffix(p, if args.modes.len() > 1 { &suffix } else { "" }),
+                None => PathBuf::from(format!("{stem}.{mode}.heatmap.png")),
+            };
+            if let Some(rate) = shader.rate_image() {
+                save_heatmap(&gpu, rate, shader.layout().stats.counters.len(), &path)?;
+                written.push(path);
+            }
+        }
+        if args.stats || args.output.is_none() {
+            println!("{}", stats.table());
+        }
+        all_stats.push(stats);
+    }
+    let stats_path = match &args.output {
+        Some(p) => p.with_extension("stats.json"),
+        None => PathBuf::from(format!("{stem}.stats.json")),
+    };
+    std::fs::write(&stats_path, serde_json::to_string_pretty(&all_stats).map_err(|e| e.to_string())?)
+        .map_err(|e| format!("cannot write {}: {e}", stats_path.display()))?;
+    written.push(stats_path);
+    Ok(written)
+}
+
+fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
+    if suffix.is_empty() {
+        return path.to_path_buf();
+    }
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("out");
+    let ext = path.extension().and_then(|s| s.to_str()).unwrap_or("png");
+    path.with_file_name(format!("{stem}{suffix}.{ext}"))
+}
+
+fn output_format(name: &str) -> wgpu::TextureFormat {
+    match name {
+        "r32float" => wgpu::TextureFormat::R32Float,
+        "rg32float" => wgpu::TextureFormat::Rg32Float,
+        "rgba16float" => wgpu::TextureFormat::Rgba16Float,
+        "rgba8unorm" => wgpu::TextureFormat::Rgba8Unorm,
+        "r32uint" => wgpu::TextureFormat::R32Uint,
+        "rgba32uint" => wgpu::TextureFormat::Rgba32Uint,
+        "r32sint" => wgpu::TextureFormat::R32Sint,
+        "rgba32sint" => wgpu::TextureFormat::Rgba32Sint,
+        _ => wgpu::TextureFormat::Rgba32Float,
+    }
+}
+
+fn checker_texture(gpu: &Gpu) -> wgpu::Texture {
+    let n = 64u32;
+    let mut data = Vec::with_capacity((n * n * 4) as usize);
+    for y in 0..n {
+        for x in 0..n {
+            let odd = ((x / 8) + (y / 8)) % 2 == 1;
+            let (r, g, b) = if odd { (200, 80, 60) } else { (235, 225, 200) };
+            data.extend_from_slice(&[r, g, b, 255]);
+        }
+    }
+    gpu.texture_with_data("checker", (n, n), wgpu::TextureFormat::Rgba8UnormSrgb, &data)
+}
+
+/// Linear [0, 1] to an 8-bit sRGB value (the outputs are linear radiance).
+fn to_srgb8(v: f32) -> u8 {
+    let v = if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 };
+    let s = if v <= 0.0031308 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
+    (s * 255.0 + 0.5) as u8
+}
+
+fn save_output(gpu: &Gpu, texture: &wgpu::Texture, path: &Path) -> Result<(), String> {
+    let (w, h) = (texture.width(), texture.height());
+    let bytes = gpu.read_texture(texture).map_err(|e| e.to_string())?;
+    let pixels: Vec<[f32; 4]> = match texture.format() {
+        wgpu::TextureFormat::Rgba32Float => gpu.read_rgba32f(texture).map_err(|e| e.to_string())?,
+        wgpu::TextureFormat::R32Float => bytes
+            .chunks_exact(4)
+            .map(|b| {
+                let v = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+                [v, v, v, 1.0]
+            })
+            .collect(),
+        wgpu::TextureFormat::Rgba8Unorm => bytes
+            .chunks_exact(4)
+            .map(|b| [b[0] as f32 / 255.0, b[1] as f32 / 255.0, b[2] as f32 / 255.0, 1.0])
+            .collect(),
+        other => return Err(format!("cannot write an output of format {other:?} as PNG yet")),
+    };
+    let mut img = image::RgbaImage::new(w, h);
+    for (i, p) in pixels.iter().enumerate() {
+        img.put_pixel(i as u32 % w, i as u32 / w, image::Rgba([to_srgb8(p[0]), to_srgb8(p[1]), to_srgb8(p[2]), 255]));
+    }
+    img.save(path).map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+/// Colours each pixel by the fraction of coarse effects it evaluated per
+/// pixel, in the style of He et al.'s heatmaps: blue = every coarse effect
+/// resampled (coarse rate), yellow = half, red = all per pixel.
+fn save_heatmap(gpu: &Gpu, rate: &wgpu::Texture, effects: usize, path: &Path) -> Result<(), String> {
+    let (w, h) = (rate.width(), rate.height());
+    let bytes = gpu.read_texture(rate).map_err(|e| e.to_string())?;
+    let mut img = image::RgbImage::new(w, h);
+    let counted = effects.clamp(1, 32) as f32;
+    for (i, b) in bytes.chunks_exact(4).enumerate() {
+        let mask = u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+        let f = mask.count_ones() as f32 / counted;
+        let (r, g, bl) = if f <= 0.0 {
+            (40, 70, 200)
+        } else if f < 0.5 {
+            let t = f / 0.5;
+            ((40.0 + t * 215.0) as u8, (70.0 + t * 150.0) as u8, (200.0 - t * 160.0) as u8)
+        } else {
+            let t = (f - 0.5) / 0.5;
+            (255, (220.0 - t * 180.0) as u8, 40)
+        };
+        img.put_pixel(i as u32 % w, i as u32 / w, image::Rgb([r, g, bl]));
+    }
+    img.save(path).map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+/// Parses `name=v1,v2,...`.
+pub fn parse_set(text: &str) -> Result<(String, Vec<f64>), String> {
+    let (name, values) = text.split_once('=').ok_or_else(|| format!("expected NAME=VALUE[,VALUE...], got `{text}`"))?;
+    let values = values
+        .split(',')
+        .map(|v| match v.trim() {
+            "true" => Ok(1.0),
+            "false" => Ok(0.0),
+            v => v.parse::<f64>().map_err(|_| format!("`{v}` is not a number (in `{text}`)")),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((name.trim().to_string(), values))
+}
+
+/// Parses `WxH`.
+pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    let (w, h) = text.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got `{text}`"))?;
+    let w: u32 = w.parse().map_err(|_| format!("bad width in `{text}`"))?;
+    let h: u32 = h.parse().map_err(|_| format!("bad height in `{text}`"))?;
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(format!("size `{text}` must be between 1x1 and 16384x16384"));
+    }
+    Ok((w, h))
+}
