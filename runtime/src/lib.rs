@@ -28,7 +28,7 @@ mod shader;
 mod stats;
 
 pub use error::Error;
-pub use shader::{Bindings, DispatchOptions, Shader};
+pub use shader::{Bindings, DispatchOptions, Shader, components};
 pub use stats::{EffectStats, Stats, Timings};
 
 /// How a program is dispatched.

@@ -573,7 +573,8 @@ pub(crate) fn describe(error: &wgpu::Error) -> String {
     }
 }
 
-pub(crate) fn components(ty: &str) -> usize {
+/// Number of scalar components of an mrsl type name (`float3` = 3, `float4[8]` = 32).
+pub fn components(ty: &str) -> usize {
     match ty {
         "float2x2" => 4,
         "float3x3" => 9,

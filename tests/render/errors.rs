@@ -1,0 +1,102 @@
+//! Bad bindings give the typed error that names what is wrong, never a panic.
+
+use crate::{compile, gpu, run};
+use mrsl_runtime::gpu::Gpu;
+use mrsl_runtime::scene::{ChannelData, GBuffer, Scene};
+use mrsl_runtime::{Bindings, DispatchOptions, Error, Mode, Shader};
+
+const PROGRAM: &str = "
+in float3 normal;
+@key in uint material;
+uniform float4 lights[4];
+uniform float gain = 1.0;
+coarse effect float d = saturate(dot(normal, lights[0].xyz)) * gain;
+fine out float4 color = float4(d);
+";
+
+fn dispatch(gpu: &Gpu, shader: &mut Shader, bindings: &Bindings) -> Result<(), Error> {
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    shader.encode(
+        &gpu.device,
+        &gpu.queue,
+        &mut encoder,
+        bindings,
+        DispatchOptions { mode: Mode::Coarse4x4, force_refine: false },
+    )
+}
+
+#[test]
+fn binding_mismatches_are_typed_errors() {
+    let Some(gpu) = gpu() else { return };
+    let program = compile(PROGRAM);
+    let gbuffer = Scene::Demo.render(16, 8);
+    let channels = gbuffer.upload(gpu);
+    let get = |name: &str| &channels.iter().find(|(n, _)| n == name).unwrap().1;
+    let output = gpu.output_texture("color", (16, 8), wgpu::TextureFormat::Rgba32Float);
+    let mut shader = Shader::new(&gpu.device, &program).unwrap();
+    let mut bindings = Bindings { size: (16, 8), ..Default::default() };
+    bindings.outputs.insert("color".into(), &output);
+
+    // Missing channel.
+    assert_eq!(dispatch(gpu, &mut shader, &bindings), Err(Error::MissingChannel("normal".into())));
+    // Wrong format: a uint texture where the program reads float3.
+    bindings.channels.insert("normal".into(), get("material"));
+    bindings.channels.insert("material".into(), get("material"));
+    assert!(
+        matches!(dispatch(gpu, &mut shader, &bindings), Err(Error::ChannelFormat { ref channel, .. }) if channel == "normal")
+    );
+    // A float2 texture cannot hold a float3 channel either.
+    bindings.channels.insert("normal".into(), get("uv"));
+    assert!(
+        matches!(dispatch(gpu, &mut shader, &bindings), Err(Error::ChannelFormat { ref channel, .. }) if channel == "normal")
+    );
+    // Size mismatch.
+    let small = Scene::Demo.render(8, 8).upload(gpu);
+    bindings.channels.insert("normal".into(), &small.iter().find(|(n, _)| n == "normal").unwrap().1);
+    assert!(matches!(
+        dispatch(gpu, &mut shader, &bindings),
+        Err(Error::SizeMismatch { ref name, found_width: 8, width: 16, .. }) if name == "normal"
+    ));
+    bindings.channels.insert("normal".into(), get("normal"));
+    // A uniform with no default that was never set.
+    assert_eq!(dispatch(gpu, &mut shader, &bindings), Err(Error::MissingUniform("lights".into())));
+    // Setting uniforms: unknown names and wrong component counts.
+    assert_eq!(shader.set_uniform("nope", &[1.0]), Err(Error::UnknownUniform("nope".into())));
+    assert!(matches!(
+        shader.set_uniform("lights", &[1.0; 3]),
+        Err(Error::UniformComponents { expected: 16, found: 3, .. })
+    ));
+    shader.set_uniform("lights", &[0.5; 16]).unwrap();
+    // Output of the wrong format.
+    let wrong = gpu.output_texture("color", (16, 8), wgpu::TextureFormat::Rgba8Unorm);
+    bindings.outputs.insert("color".into(), &wrong);
+    assert!(
+        matches!(dispatch(gpu, &mut shader, &bindings), Err(Error::OutputFormat { ref name, .. }) if name == "color")
+    );
+    bindings.outputs.insert("color".into(), &output);
+    // Empty target.
+    bindings.size = (0, 8);
+    assert!(matches!(dispatch(gpu, &mut shader, &bindings), Err(Error::BadSize { .. })));
+    bindings.size = (16, 8);
+    // And with everything right, it runs.
+    dispatch(gpu, &mut shader, &bindings).unwrap();
+}
+
+#[test]
+fn unknown_modes_are_named() {
+    assert_eq!("coarse8x8".parse::<Mode>(), Err(Error::UnknownMode("coarse8x8".into())));
+    assert_eq!("coarse4x4".parse::<Mode>(), Ok(Mode::Coarse4x4));
+}
+
+/// A G-buffer channel the program does not declare is simply unused, and
+/// the run helper reports missing bindings rather than panicking.
+#[test]
+fn extra_channels_are_ignored() {
+    let Some(gpu) = gpu() else { return };
+    let program = compile("in float depth;\nfine out float4 color = float4(depth);");
+    let mut gbuffer = Scene::Gradient.render(8, 8);
+    gbuffer.channels.push(("unused".into(), ChannelData::Uint(vec![0; 64])));
+    run(gpu, &program, &gbuffer, Mode::Coarse2x2, false).unwrap();
+    let empty = GBuffer { width: 8, height: 8, channels: vec![] };
+    assert_eq!(run(gpu, &program, &empty, Mode::Reference, false).err(), Some(Error::MissingChannel("depth".into())));
+}

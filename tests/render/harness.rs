@@ -1,0 +1,115 @@
+//! Shared device and a `run` helper: one program, one G-buffer, one mode.
+
+use mrsl_runtime::gpu::Gpu;
+use mrsl_runtime::scene::GBuffer;
+use mrsl_runtime::{Bindings, DispatchOptions, Error, Mode, Shader, Stats};
+use std::sync::OnceLock;
+
+static GPU: OnceLock<Option<Gpu>> = OnceLock::new();
+
+/// The shared device, or `None` (with a message) when there is no adapter
+/// outside CI. Under `CI=true` a missing adapter panics: a failure, not a skip.
+pub fn gpu() -> Option<&'static Gpu> {
+    let gpu = GPU.get_or_init(|| match Gpu::new() {
+        Ok(gpu) => Some(gpu),
+        Err(e) if std::env::var("CI").is_ok_and(|v| v == "true") => panic!("CI=true but no GPU adapter: {e}"),
+        Err(e) => {
+            eprintln!("SKIPPED render test: no GPU adapter ({e})");
+            None
+        }
+    });
+    gpu.as_ref()
+}
+
+/// What one dispatch produced.
+pub struct Output {
+    /// The first output, as RGBA floats.
+    pub pixels: Vec<[f32; 4]>,
+    pub stats: Stats,
+    pub width: u32,
+}
+
+pub fn compile(source: &str) -> mrsl::Program {
+    mrsl::compile(source, &mrsl::Options::default())
+        .unwrap_or_else(|d| panic!("test program does not compile:\n{}", mrsl::render_all(&d, "test.mrsl", source)))
+}
+
+/// Runs `program` over `gbuffer`; uniforms without defaults get `fill`
+/// values (a deterministic ramp) so that every example can run.
+pub fn run(
+    gpu: &Gpu,
+    program: &mrsl::Program,
+    gbuffer: &GBuffer,
+    mode: Mode,
+    force_refine: bool,
+) -> Result<Output, Error> {
+    let size = (gbuffer.width, gbuffer.height);
+    let channels = gbuffer.upload(gpu);
+    let mut shader = Shader::new(&gpu.device, program)?;
+    if let Some(block) = &program.layout.uniforms {
+        for f in &block.fields {
+            if f.default.is_none() {
+                let n = mrsl_runtime::components(&f.ty);
+                let values: Vec<f64> = (0..n).map(|i| 0.25 + 0.5 * ((i * 7919) % 13) as f64 / 13.0).collect();
+                shader.set_uniform(&f.name, &values)?;
+            }
+        }
+    }
+    let texture = gpu.texture_with_data(
+        "test texture",
+        (4, 4),
+        wgpu::TextureFormat::Rgba8Unorm,
+        &(0..64).map(|i| (i * 37 % 256) as u8).collect::<Vec<u8>>(),
+    );
+    let view = texture.create_view(&Default::default());
+    let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        ..Default::default()
+    });
+    let outputs: Vec<(String, wgpu::Texture)> = program
+        .layout
+        .outputs
+        .iter()
+        .map(|o| {
+            assert_eq!(o.format, "rgba32float", "render tests read rgba32float outputs");
+            (o.name.clone(), gpu.output_texture(&o.name, size, wgpu::TextureFormat::Rgba32Float))
+        })
+        .collect();
+    let mut bindings = Bindings { size, ..Default::default() };
+    for (name, t) in &channels {
+        bindings.channels.insert(name.clone(), t);
+    }
+    for t in &program.layout.textures {
+        bindings.textures.insert(t.name.clone(), &view);
+    }
+    for s in &program.layout.samplers {
+        bindings.samplers.insert(s.name.clone(), &sampler);
+    }
+    for (name, t) in &outputs {
+        bindings.outputs.insert(name.clone(), t);
+    }
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, DispatchOptions { mode, force_refine })?;
+    gpu.queue.submit([encoder.finish()]);
+    let stats = shader.read_stats(&gpu.device)?;
+    let pixels = gpu.read_rgba32f(&outputs[0].1)?;
+    Ok(Output { pixels, stats, width: size.0 })
+}
+
+/// Distance in units in the last place between two floats (0 when bit-equal).
+pub fn ulps(a: f32, b: f32) -> u32 {
+    if a == b {
+        return 0;
+    }
+    let key = |x: f32| {
+        let bits = x.to_bits() as i32;
+        if bits < 0 { i32::MIN - bits } else { bits }
+    };
+    (key(a) as i64 - key(b) as i64).unsigned_abs().min(u32::MAX as u64) as u32
+}
+
+/// Largest absolute difference over every channel of every pixel.
+pub fn max_abs_diff(a: &[[f32; 4]], b: &[[f32; 4]]) -> f32 {
+    a.iter().zip(b).flat_map(|(p, q)| (0..4).map(move |c| (p[c] - q[c]).abs())).fold(0.0, f32::max)
+}

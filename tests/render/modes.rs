@@ -1,0 +1,195 @@
+//! Every mode against the reference of the same program.
+
+use crate::{compile, gpu, max_abs_diff, run, ulps};
+use mrsl_runtime::Mode;
+use mrsl_runtime::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
+
+const COARSE_MODES: [Mode; 2] = [Mode::Coarse2x2, Mode::Coarse4x4];
+
+fn examples() -> Vec<(String, String)> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
+    let mut out: Vec<(String, String)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "mrsl"))
+        .map(|p| (p.file_name().unwrap().to_string_lossy().into_owned(), std::fs::read_to_string(&p).unwrap()))
+        .collect();
+    out.sort();
+    out
+}
+
+/// With every refine predicate forced, each coarse mode evaluates every
+/// effect per pixel with the same code as the reference kernel: the images
+/// must be bit-identical.
+#[test]
+fn forced_refinement_equals_reference_for_every_example() {
+    let Some(gpu) = gpu() else { return };
+    let gbuffer = Scene::Demo.render(75, 43);
+    for (name, source) in examples() {
+        let program = compile(&source);
+        let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
+        for mode in COARSE_MODES {
+            let out = run(gpu, &program, &gbuffer, mode, true).unwrap();
+            let worst = out
+                .pixels
+                .iter()
+                .zip(&reference.pixels)
+                .flat_map(|(a, b)| (0..4).map(move |c| ulps(a[c], b[c])))
+                .max()
+                .unwrap();
+            assert_eq!(worst, 0, "{name} {mode}: forced refinement differs from the reference by up to {worst} ulps");
+            for e in out.stats.effects.iter().filter(|e| e.rate == mrsl::syntax::ast::Rate::Coarse) {
+                assert_eq!(
+                    e.pixel_evaluations,
+                    75 * 43,
+                    "{name} {mode}: `{}` was not evaluated at every pixel",
+                    e.name
+                );
+            }
+        }
+    }
+}
+
+const GRADIENT: &str = "
+in float2 uv;
+uniform float2 slope = float2(0.7, 0.25);
+coarse effect float ramp = dot(uv, slope) + 0.05;
+fine out float4 color = float4(ramp, ramp * 0.5, 1.0 - ramp, 1.0);
+";
+
+/// A linear function is reproduced exactly by bilinear resampling, up to
+/// float rounding: values are below 1, where an ulp is 6e-8, and the
+/// resampling adds four products, so 5e-7 (8 ulps) bounds the error. The
+/// effect is shaded once per 4x4 block plus the border row and column.
+#[test]
+fn gradient_is_reconstructed_at_one_sixteenth_of_the_cost() {
+    let Some(gpu) = gpu() else { return };
+    let program = compile(GRADIENT);
+    let gbuffer = Scene::Gradient.render(256, 256);
+    let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
+    let out = run(gpu, &program, &gbuffer, Mode::Coarse4x4, false).unwrap();
+    let err = max_abs_diff(&out.pixels, &reference.pixels);
+    assert!(err <= 5e-7, "bilinear resampling of a linear ramp is off by {err}");
+    let ramp = out.stats.effects.iter().find(|e| e.name == "ramp").unwrap();
+    assert_eq!(ramp.pixel_evaluations, 0, "a linear ramp never needs refinement");
+    assert!(ramp.shaded_fraction <= 0.07, "ramp shaded at {:.4} of the pixels", ramp.shaded_fraction);
+    assert_eq!(ramp.coarse_evaluations, 65 * 65);
+}
+
+const STEPS: &str = "
+in float3 normal;
+@key in uint material;
+coarse effect float shade = saturate(dot(normal, normalize(float3(0.4, 0.5, 0.8))));
+fine out float4 color = float4(shade, shade, shade, 1.0);
+";
+
+/// Step functions with the step on the discontinuity key: blocks that
+/// straddle a step are shaded per pixel, the others are constant, so no
+/// pixel may blend two steps. A blended pixel would be off by at least a
+/// step height (> 0.05); interpolating equal corners is exact up to the
+/// rounding of weights that sum to one (2e-7).
+#[test]
+fn steps_keep_their_edges() {
+    let Some(gpu) = gpu() else { return };
+    let program = compile(STEPS);
+    for (w, h) in [(256, 64), (131, 37)] {
+        let gbuffer = Scene::Steps { count: 9 }.render(w, h);
+        let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
+        for mode in COARSE_MODES {
+            let out = run(gpu, &program, &gbuffer, mode, false).unwrap();
+            let err = max_abs_diff(&out.pixels, &reference.pixels);
+            assert!(err <= 2e-7, "{w}x{h} {mode}: a step was blended (error {err})");
+            let shade = &out.stats.effects[0];
+            assert!(shade.pixel_evaluations > 0 && shade.pixel_evaluations < (w * h) as u64 / 2, "{mode}: {shade:?}");
+        }
+    }
+}
+
+const PER_OBJECT: &str = "
+in float3 normal;
+@key in uint material;
+coarse effect float3 tint = float3(float(material % 5u) * 0.2, float(material % 3u) * 0.3, 0.1 + float(material) * 0.003);
+fine out float4 color = float4(tint, 1.0);
+";
+
+/// Silhouettes: on the demo scene, a coarse effect that is constant per
+/// object must never be blended across an object's outline, so every pixel
+/// equals the reference (to the 2e-7 of weights summing to one) although
+/// most of the image is resampled.
+#[test]
+fn silhouettes_are_never_blended() {
+    let Some(gpu) = gpu() else { return };
+    let program = compile(PER_OBJECT);
+    let gbuffer = Scene::Demo.render(203, 117);
+    let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
+    for mode in COARSE_MODES {
+        let out = run(gpu, &program, &gbuffer, mode, false).unwrap();
+        let err = max_abs_diff(&out.pixels, &reference.pixels);
+        assert!(err <= 2e-7, "{mode}: colours blended across a silhouette (error {err})");
+        let tint = &out.stats.effects[0];
+        assert!(tint.resampled > tint.pixel_evaluations, "{mode}: most pixels should be resampled: {tint:?}");
+    }
+    // The scene really has silhouettes next to the background.
+    let Some(ChannelData::Uint(material)) = gbuffer.channel("material") else { panic!() };
+    assert!(material.contains(&BACKGROUND) && material.iter().any(|m| *m != BACKGROUND && *m != 0));
+}
+
+/// Sizes that are not multiples of the block or the tile: every pixel is
+/// written (alpha is 1) and matches the reference.
+#[test]
+fn odd_sizes_cover_every_pixel() {
+    let Some(gpu) = gpu() else { return };
+    let program = compile(GRADIENT);
+    for (w, h) in [(1, 1), (5, 3), (2, 7), (1023, 769)] {
+        let gbuffer = Scene::Gradient.render(w, h);
+        let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
+        for mode in COARSE_MODES {
+            let out = run(gpu, &program, &gbuffer, mode, false).unwrap();
+            assert_eq!(out.pixels.len(), (w * h) as usize);
+            let missing = out.pixels.iter().filter(|p| p[3] != 1.0).count();
+            assert_eq!(missing, 0, "{w}x{h} {mode}: {missing} pixels not written");
+            let err = max_abs_diff(&out.pixels, &reference.pixels);
+            assert!(err <= 5e-7, "{w}x{h} {mode}: error {err}");
+        }
+    }
+}
+
+/// The statistics add up: the reference shades everything once; coarse
+/// modes shade less, and 4x4 less than 2x2, on the demo program and scene.
+#[test]
+fn shaded_fraction_falls_from_reference_to_coarse4x4() {
+    let Some(gpu) = gpu() else { return };
+    let program = compile(include_str!("../../examples/demo.mrsl"));
+    let gbuffer = Scene::Demo.render(160, 96);
+    let fractions: Vec<f64> = [Mode::Reference, Mode::Coarse2x2, Mode::Coarse4x4]
+        .into_iter()
+        .map(|mode| {
+            let out = run(gpu, &program, &gbuffer, mode, false).unwrap();
+            for e in &out.stats.effects {
+                assert_eq!(e.pixel_evaluations + e.resampled, 160 * 96, "{mode} {}", e.name);
+            }
+            out.stats.shaded_fraction
+        })
+        .collect();
+    assert_eq!(fractions[0], 1.0);
+    assert!(fractions[1] < 1.0 && fractions[2] < fractions[1], "{fractions:?}");
+}
+
+/// A G-buffer made by hand, to check the runtime reads the engine's data
+/// without assumptions about the scene module.
+#[test]
+fn hand_made_gbuffer_reads_back() {
+    let Some(gpu) = gpu() else { return };
+    let program = compile("in float depth;\nfine out float4 color = float4(depth, depth * 2.0, 0.0, 1.0);");
+    let data: Vec<f32> = (0..12).map(|i| i as f32 * 0.125).collect();
+    let gbuffer = GBuffer {
+        width: 4,
+        height: 3,
+        channels: vec![("depth".into(), ChannelData::Float { components: 1, data: data.clone() })],
+    };
+    let out = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
+    for (p, d) in out.pixels.iter().zip(&data) {
+        assert_eq!(*p, [*d, d * 2.0, 0.0, 1.0]);
+    }
+    let _ = out.width;
+}
