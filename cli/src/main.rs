@@ -62,15 +62,15 @@ enum Command {
 struct Render {
     /// The .mrsl program (default: the built-in demo program).
     program: Option<PathBuf>,
-    /// Scene: demo, gradient, steps or sinusoid.
+    /// Scene: demo, gradient, steps, sinusoid, sponza, or a .toml scene file (docs/scenes.md).
     #[arg(long, default_value = "demo")]
     scene: String,
-    /// reference, coarse2x2, coarse4x4 or all.
+    /// reference, coarse2x2, coarse4x4, dynamic or all.
     #[arg(long, default_value = "coarse4x4")]
     mode: String,
-    /// Image size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "960x540", value_parser = render::parse_size)]
-    size: (u32, u32),
+    /// Image size, WIDTHxHEIGHT (default: the scene file's, else 960x540).
+    #[arg(long, value_parser = render::parse_size)]
+    size: Option<(u32, u32)>,
     /// Set a uniform: NAME=VALUE or NAME=X,Y,Z (repeatable).
     #[arg(long = "set", value_parser = render::parse_set)]
     sets: Vec<(String, Vec<f64>)>,

@@ -4,10 +4,14 @@
 use mrsl::{KernelKind, Options};
 use mrsl_runtime::gpu::Gpu;
 use mrsl_runtime::scene::Scene;
+use mrsl_runtime::scene_file::SceneFile;
 use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader, Stats};
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+/// Image size when neither `--size` nor a scene file gives one.
+pub const DEFAULT_SIZE: (u32, u32) = (960, 540);
 
 /// The built-in demo program (examples/demo.mrsl).
 pub const DEMO_PROGRAM: &str = include_str!("../../examples/demo.mrsl");
@@ -16,7 +20,8 @@ pub struct RenderArgs {
     pub program: Option<PathBuf>,
     pub scene: String,
     pub modes: Vec<Mode>,
-    pub size: (u32, u32),
+    /// `--size`, if given; else the scene file's size, else 960x540.
+    pub size: Option<(u32, u32)>,
     pub sets: Vec<(String, Vec<f64>)>,
     pub output: Option<PathBuf>,
     pub heatmap: Option<PathBuf>,
@@ -43,18 +48,33 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
     let program = mrsl::compile(&source, &options).map_err(|d| mrsl::render_all(&d, &name, &source))?;
     progress(&format!("compiled {name}: {} kernels", program.kernels.len()), start);
 
-    let scene = Scene::parse(&args.scene)
-        .ok_or_else(|| format!("unknown scene `{}` (expected demo, gradient, steps or sinusoid)", args.scene))?;
-    let start = Instant::now();
-    let gbuffer = scene.render(args.size.0, args.size.1);
-    progress(&format!("built the {} G-buffer at {}x{}", args.scene, args.size.0, args.size.1), start);
-
     let start = Instant::now();
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
     progress(&format!("device: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend), start);
-    let channels = gbuffer.upload(&gpu);
+    let start = Instant::now();
+    let scene = bind_scene(&gpu, &args.scene, args.size)?;
+    let size = scene.size;
+    progress(&format!("built the {} G-buffer at {}x{}", args.scene, size.0, size.1), start);
+    let channels = scene.channels;
     let mut shader = Shader::new(&gpu.device, &program).map_err(|e| e.to_string())?;
     shader.set_timestamp_period(&gpu.queue);
+    // A scene with a free camera tells programs where it is (the demo
+    // program's specular term reads `camera_pos`).
+    if let Some(camera) = scene.camera {
+        let has_camera_pos = program
+            .layout
+            .uniforms
+            .as_ref()
+            .is_some_and(|u| u.fields.iter().any(|f| f.name == "camera_pos" && f.ty == "float3"));
+        if has_camera_pos {
+            let eye: Vec<f64> = camera.eye.iter().map(|&v| v as f64).collect();
+            shader.set_uniform("camera_pos", &eye).map_err(|e| e.to_string())?;
+        }
+    }
+    // The scene file's uniforms, then the command line's.
+    for (name, values) in &scene.uniforms {
+        shader.set_uniform(name, values).map_err(|e| format!("{}: `uniforms.{name}`: {e}", args.scene))?;
+    }
     for (name, values) in &args.sets {
         shader.set_uniform(name, values).map_err(|e| e.to_string())?;
     }
@@ -74,9 +94,9 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
         .layout
         .outputs
         .iter()
-        .map(|o| (o.name.clone(), gpu.output_texture(&o.name, args.size, output_format(&o.format))))
+        .map(|o| (o.name.clone(), gpu.output_texture(&o.name, size, output_format(&o.format))))
         .collect();
-    let mut bindings = Bindings { size: args.size, ..Default::default() };
+    let mut bindings = Bindings { size, ..Default::default() };
     for (name, texture) in &channels {
         bindings.channels.insert(name.clone(), texture);
     }
@@ -141,6 +161,34 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
         .map_err(|e| format!("cannot write {}: {e}", stats_path.display()))?;
     written.push(stats_path);
     Ok(written)
+}
+
+/// A scene ready to bind: its G-buffer textures, the image size, the
+/// camera (for scenes that have a free one) and a scene file's uniforms.
+struct BoundScene {
+    channels: Vec<(String, wgpu::Texture)>,
+    size: (u32, u32),
+    camera: Option<mrsl_runtime::raster::Camera>,
+    uniforms: Vec<(String, Vec<f64>)>,
+}
+
+/// `--scene`: a built-in scene's name, or a `.toml` scene file (see
+/// docs/scenes.md). A scene file's `size` applies unless `--size` was given.
+fn bind_scene(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> Result<BoundScene, String> {
+    if let Some(builtin) = Scene::parse(scene) {
+        let size = size.unwrap_or(DEFAULT_SIZE);
+        let channels = builtin.textures_on(gpu, size.0, size.1).map_err(|e| e.to_string())?;
+        return Ok(BoundScene { channels, size, camera: builtin.camera(), uniforms: vec![] });
+    }
+    let path = Path::new(scene);
+    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
+        let file = SceneFile::load(path).map_err(|e| e.to_string())?;
+        // The command line's --size wins over the file's.
+        let size = size.or(file.size).unwrap_or(DEFAULT_SIZE);
+        let (channels, camera) = file.textures_on(gpu, size).map_err(|e| e.to_string())?;
+        return Ok(BoundScene { channels, size, camera: Some(camera), uniforms: file.uniforms.clone() });
+    }
+    Err(format!("unknown scene `{scene}` (expected {}, or a .toml scene file)", Scene::NAMES.join(", ")))
 }
 
 fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
@@ -211,18 +259,22 @@ fn save_output(gpu: &Gpu, texture: &wgpu::Texture, path: &Path) -> Result<(), St
     img.save(path).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
-/// Colours each pixel by the fraction of coarse effects it evaluated per
-/// pixel, in the style of He et al.'s heatmaps: blue = every coarse effect
-/// resampled (coarse rate), yellow = half, red = all per pixel.
+/// Colours each pixel by the rate its coarse effects were shaded at, in the
+/// style of He et al.'s heatmaps: blue = every coarse effect resampled from
+/// the first (2x2 or 4x4) level, green = some taken from the dynamic mode's
+/// 2x2 level, then yellow to red as the fraction evaluated per pixel grows.
 fn save_heatmap(gpu: &Gpu, rate: &wgpu::Texture, effects: usize, path: &Path) -> Result<(), String> {
     let (w, h) = (rate.width(), rate.height());
     let bytes = gpu.read_texture(rate).map_err(|e| e.to_string())?;
     let mut img = image::RgbImage::new(w, h);
     let counted = effects.clamp(1, 32) as f32;
-    for (i, b) in bytes.chunks_exact(4).enumerate() {
+    for (i, b) in bytes.chunks_exact(8).enumerate() {
         let mask = u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+        let level2 = u32::from_le_bytes([b[4], b[5], b[6], b[7]]);
         let f = mask.count_ones() as f32 / counted;
-        let (r, g, bl) = if f <= 0.0 {
+        let (r, g, bl) = if f <= 0.0 && level2 != 0 {
+            (60, 190, 80)
+        } else if f <= 0.0 {
             (40, 70, 200)
         } else if f < 0.5 {
             let t = f / 0.5;

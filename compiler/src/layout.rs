@@ -36,8 +36,12 @@ pub struct Layout {
     pub interface: InterfaceLayout,
     pub outputs: Vec<Output>,
     pub stats: StatsLayout,
-    /// The fine kernel's per-pixel refine mask (`r32uint`; bit k = stats counter k).
+    /// The fine kernels' per-pixel refine mask (`rg32uint`: x bit k = coarse effect k
+    /// (stats counter k) evaluated per pixel; y bit k = taken from the dynamic mode's 2x2 level).
     pub rate_image: ResourceBinding,
+    /// The dynamic mode's second (2x2) level of coarse samples: records of
+    /// `interface.stride_words + 1` words, the last being a validity tag.
+    pub interface2: ResourceBinding,
     pub effects: Vec<EffectLayout>,
 }
 
@@ -46,7 +50,8 @@ pub struct Layout {
 pub struct StatsLayout {
     pub group: u32,
     pub binding: u32,
-    /// Counter `k` counts the pixels that re-evaluated this coarse effect.
+    /// Counter `k` counts the pixels that re-evaluated this coarse effect;
+    /// one more counter after them counts the 2x2 samples the dynamic mode shaded.
     pub counters: Vec<String>,
 }
 
@@ -338,7 +343,13 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface) -> L
             name: "mrsl_rate".into(),
             group: GROUP_STAGE,
             binding: 2 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
-            kind: "r32uint",
+            kind: "rg32uint",
+        },
+        interface2: ResourceBinding {
+            name: "mrsl_interface2".into(),
+            group: GROUP_STAGE,
+            binding: 3 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
+            kind: "storage",
         },
         outputs,
         effects,

@@ -45,13 +45,22 @@ pub struct Options {
     pub coarse: bool,
     pub fine: bool,
     pub reference: bool,
+    /// The dynamic mode's kernels (4x4, refined to 2x2, then per pixel).
+    pub dynamic: bool,
     /// Name written in the header comment of every generated kernel.
     pub file_name: String,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Options { block_sizes: vec![2, 4], coarse: true, fine: true, reference: true, file_name: "program.mrsl".into() }
+        Options {
+            block_sizes: vec![2, 4],
+            coarse: true,
+            fine: true,
+            reference: true,
+            dynamic: true,
+            file_name: "program.mrsl".into(),
+        }
     }
 }
 
@@ -81,7 +90,8 @@ pub struct Program {
 impl Program {
     /// The kernel of `kind` for block size `block` (ignored for the reference kernel).
     pub fn kernel(&self, kind: KernelKind, block: u32) -> Option<&Kernel> {
-        self.kernels.iter().find(|k| k.kind == kind && (kind == KernelKind::Reference || k.block_size == Some(block)))
+        let any_block = matches!(kind, KernelKind::Reference | KernelKind::DynamicCoarse | KernelKind::DynamicFine);
+        self.kernels.iter().find(|k| k.kind == kind && (any_block || k.block_size == Some(block)))
     }
 }
 
@@ -136,6 +146,14 @@ pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnosti
     }
     if options.reference {
         wanted.push((KernelKind::Reference, None));
+    }
+    if options.dynamic {
+        // The 4x4 level is the ordinary 4x4 coarse kernel.
+        if !wanted.contains(&(KernelKind::Coarse, Some(4))) {
+            wanted.push((KernelKind::Coarse, Some(4)));
+        }
+        wanted.push((KernelKind::DynamicCoarse, Some(2)));
+        wanted.push((KernelKind::DynamicFine, Some(4)));
     }
     let texts: Vec<(KernelKind, Option<u32>, String)> = wanted
         .into_iter()

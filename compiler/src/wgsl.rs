@@ -25,6 +25,26 @@ pub enum KernelKind {
     Fine,
     /// One invocation per pixel: every effect evaluated per pixel.
     Reference,
+    /// Dynamic mode, second level: one invocation per 2x2 coarse sample, shading
+    /// only samples that a 4x4 block refined by the (4x4) coarse kernel needs.
+    DynamicCoarse,
+    /// Dynamic mode, per pixel: 4x4 value, else 2x2 value, else evaluated.
+    DynamicFine,
+}
+
+/// One level of coarse samples as the fine stage reads it.
+struct Level {
+    /// Suffix of the generated functions (`mrsl_resolve{suffix}`).
+    suffix: &'static str,
+    block: u32,
+    buffer: &'static str,
+    /// Refines only within the parent level's refined effects (dynamic mode).
+    parent: bool,
+}
+
+impl Level {
+    const DYNAMIC_OUTER: Level = Level { suffix: "", block: 4, buffer: "mrsl_interface", parent: false };
+    const DYNAMIC_INNER: Level = Level { suffix: "2", block: 2, buffer: "mrsl_interface2", parent: true };
 }
 
 impl KernelKind {
@@ -33,6 +53,8 @@ impl KernelKind {
             KernelKind::Coarse => "coarse",
             KernelKind::Fine => "fine",
             KernelKind::Reference => "reference",
+            KernelKind::DynamicCoarse => "dynamic_coarse",
+            KernelKind::DynamicFine => "dynamic_fine",
         }
     }
     pub fn entry_point(self) -> &'static str {
@@ -40,11 +62,21 @@ impl KernelKind {
             KernelKind::Coarse => "coarse_main",
             KernelKind::Fine => "fine_main",
             KernelKind::Reference => "reference_main",
+            KernelKind::DynamicCoarse => "dynamic_coarse_main",
+            KernelKind::DynamicFine => "dynamic_fine_main",
         }
+    }
+    /// Whether the kernel runs per coarse sample (else per pixel).
+    pub fn is_coarse(self) -> bool {
+        matches!(self, KernelKind::Coarse | KernelKind::DynamicCoarse)
+    }
+    /// Whether the kernel resolves coarse values per pixel.
+    pub fn is_fine(self) -> bool {
+        matches!(self, KernelKind::Fine | KernelKind::DynamicFine)
     }
     pub fn workgroup_size(self) -> [u32; 3] {
         match self {
-            KernelKind::Coarse => [8, 8, 1],
+            KernelKind::Coarse | KernelKind::DynamicCoarse => [8, 8, 1],
             _ => [layout::TILE * layout::TILE, 1, 1],
         }
     }
@@ -149,6 +181,10 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             }
             KernelKind::Fine => format!("fine kernel, {b}x{b} blocks: one invocation per pixel", b = self.block),
             KernelKind::Reference => "reference kernel: every effect per pixel".to_string(),
+            KernelKind::DynamicCoarse => {
+                "dynamic mode, second level: one invocation per 2x2 coarse sample inside refined 4x4 blocks".to_string()
+            }
+            KernelKind::DynamicFine => "dynamic mode, fine kernel: 4x4, then 2x2, then per pixel".to_string(),
         };
         self.line(
             0,
@@ -158,7 +194,9 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         self.line(0, "");
         self.line(0, format!("const MRSL_BLOCK: i32 = {};", self.block));
         if self.kind != KernelKind::Reference {
-            self.line(0, format!("const MRSL_STRIDE: u32 = {}u;", self.i.interface.stride));
+            // The dynamic mode's second level carries a validity tag after each record.
+            let extra = u32::from(self.kind == KernelKind::DynamicCoarse);
+            self.line(0, format!("const MRSL_STRIDE: u32 = {}u;", self.i.interface.stride + extra));
         }
         self.line(0, "");
         self.bindings();
@@ -182,8 +220,8 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         self.derivative_helpers();
         self.neighbour_functions();
         match self.kind {
-            KernelKind::Coarse => self.coarse_entry(),
-            KernelKind::Fine => {
+            KernelKind::Coarse | KernelKind::DynamicCoarse => self.coarse_entry(),
+            KernelKind::Fine | KernelKind::DynamicFine => {
                 self.fine_support();
                 self.pixel_entry();
             }
@@ -248,7 +286,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
                     ),
                 );
             }
-            KernelKind::Fine => {
+            KernelKind::Fine | KernelKind::DynamicFine => {
                 self.line(0, "// Interface: per coarse sample, refine flag words then value slots (see layout).");
                 self.line(
                     0,
@@ -257,10 +295,47 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
                         l.interface.group, l.interface.binding
                     ),
                 );
+                if self.kind == KernelKind::DynamicFine {
+                    self.line(0, "// Second level (2x2) interface, each record followed by its validity tag.");
+                    self.line(
+                        0,
+                        format!(
+                            "@group({}) @binding({}) var<storage, read> mrsl_interface2: array<u32>;",
+                            l.interface2.group, l.interface2.binding
+                        ),
+                    );
+                }
+            }
+            KernelKind::DynamicCoarse => {
+                self.line(
+                    0,
+                    "// The 4x4 level, read to find refined blocks; the 2x2 level, written with validity tags.",
+                );
+                self.line(
+                    0,
+                    format!(
+                        "@group({}) @binding({}) var<storage, read> mrsl_parent: array<u32>;",
+                        l.interface.group, l.interface.binding
+                    ),
+                );
+                self.line(
+                    0,
+                    format!(
+                        "@group({}) @binding({}) var<storage, read_write> mrsl_interface: array<u32>;",
+                        l.interface2.group, l.interface2.binding
+                    ),
+                );
+                self.line(
+                    0,
+                    format!(
+                        "@group({}) @binding({}) var<storage, read_write> mrsl_stats: array<atomic<u32>>;",
+                        l.stats.group, l.stats.binding
+                    ),
+                );
             }
             KernelKind::Reference => {}
         }
-        if self.kind == KernelKind::Fine && !self.coarse_live().is_empty() {
+        if self.kind.is_fine() && !self.coarse_live().is_empty() {
             self.line(
                 0,
                 "// Statistics: element k counts the pixels that re-evaluated coarse effect k (layout `stats`).",
@@ -275,17 +350,17 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             self.line(0, format!("var<workgroup> mrsl_wg_stats: array<atomic<u32>, {}>;", self.coarse_live().len()));
             self.line(
                 0,
-                "// Per pixel, bit k set: coarse effect k (bits 0..31) was evaluated per pixel (layout `rate_image`).",
+                "// Per pixel: .x bit k = coarse effect k evaluated per pixel, .y bit k = taken from the 2x2 level.",
             );
             self.line(
                 0,
                 format!(
-                    "@group({}) @binding({}) var mrsl_rate: texture_storage_2d<r32uint, write>;",
+                    "@group({}) @binding({}) var mrsl_rate: texture_storage_2d<rg32uint, write>;",
                     l.rate_image.group, l.rate_image.binding
                 ),
             );
         }
-        if self.kind != KernelKind::Coarse {
+        if !self.kind.is_coarse() {
             for o in &l.outputs {
                 self.line(
                     0,
@@ -303,7 +378,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         self.line(0, "// A position is a coarse-sample index in the coarse kernel and a pixel elsewhere.");
         self.line(0, "fn mrsl_grid() -> vec2<i32> {");
         self.line(1, "let size = vec2<i32>(mrsl_ctl.size);");
-        if self.kind == KernelKind::Coarse {
+        if self.kind.is_coarse() {
             self.line(1, "return (size + vec2<i32>(MRSL_BLOCK - 2)) / MRSL_BLOCK + vec2<i32>(1);");
         } else {
             self.line(1, "return size;");
@@ -311,7 +386,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         self.line(0, "}");
         self.line(0, "");
         self.line(0, "fn mrsl_pixel(pos: vec2<i32>) -> vec2<i32> {");
-        if self.kind == KernelKind::Coarse {
+        if self.kind.is_coarse() {
             self.line(1, "return min(pos * MRSL_BLOCK, vec2<i32>(mrsl_ctl.size) - vec2<i32>(1));");
         } else {
             self.line(1, "return pos;");
@@ -694,7 +769,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             .order
             .iter()
             .copied()
-            .filter(|e| self.kind != KernelKind::Coarse || c.effects[e.index()].rate == Rate::Coarse)
+            .filter(|e| !self.kind.is_coarse() || c.effects[e.index()].rate == Rate::Coarse)
             .collect()
     }
 
@@ -754,8 +829,8 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             );
             self.line(0, format!("fn mrsl_at_{}(mrsl_pos: vec2<i32>) -> {} {{", info.name, info.ty.wgsl()));
             let chain = self.i.graph.closure(e, c);
-            if self.kind == KernelKind::Fine && chain.iter().any(|x| c.effects[x.index()].rate == Rate::Coarse) {
-                self.line(1, "let mrsl_b = mrsl_resolve(mrsl_pos);");
+            if chain.iter().any(|x| c.effects[x.index()].rate == Rate::Coarse) {
+                self.resolve_preamble(1);
             }
             self.effect_chain(&chain, 1);
             self.line(1, format!("return {};", self.effect_name(e)));
@@ -782,6 +857,22 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
                 }
             };
             match (self.kind, info.rate) {
+                (KernelKind::DynamicFine, Rate::Coarse) => {
+                    let index = self.coarse_index[&e];
+                    self.line(indent, format!("var {name}: {};", info.ty.wgsl()));
+                    if self.i.interface.is_passed(e) {
+                        self.line(indent, format!("if (!mrsl_is_refined(mrsl_b, {index}u)) {{"));
+                        self.line(indent + 1, format!("{name} = mrsl_resample_{}(mrsl_b);", info.name));
+                        self.line(indent, format!("}} else if (!mrsl_is_refined(mrsl_b2, {index}u)) {{"));
+                        self.line(indent + 1, format!("{name} = mrsl_resample2_{}(mrsl_b2);", info.name));
+                        self.line(indent, "} else {");
+                    } else {
+                        self.line(indent, format!("if (mrsl_is_refined(mrsl_b2, {index}u)) {{"));
+                    }
+                    declare_flag(self);
+                    self.line(indent + 1, format!("{name} = {call};"));
+                    self.line(indent, "}");
+                }
                 (KernelKind::Fine, Rate::Coarse) => {
                     let index = self.coarse_index[&e];
                     self.line(indent, format!("var {name}: {};", info.ty.wgsl()));
@@ -804,18 +895,96 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         }
     }
 
+    /// Declares `mrsl_b` (and in the dynamic mode `mrsl_b2`) for the pixel at `mrsl_pos`.
+    fn resolve_preamble(&mut self, indent: usize) {
+        match self.kind {
+            KernelKind::Fine => self.line(indent, "let mrsl_b = mrsl_resolve(mrsl_pos);"),
+            KernelKind::DynamicFine => {
+                self.line(indent, "let mrsl_b = mrsl_resolve(mrsl_pos);");
+                self.line(indent, "var mrsl_b2 = mrsl_b;");
+                self.line(indent, "if (mrsl_any_refined(mrsl_b)) { mrsl_b2 = mrsl_resolve2(mrsl_pos, mrsl_b); }");
+            }
+            _ => {}
+        }
+    }
+
     // ---- Coarse kernel ----------------------------------------------------------
 
+    /// Dynamic mode: whether any 4x4 block holding a pixel of the 2x2 blocks
+    /// around the sample at pixel `p` was refined (flags, key disagreement, force).
+    fn parent_refined(&mut self) {
+        let c = self.checked();
+        let iface = self.i.interface;
+        self.line(0, "fn mrsl_parent_refined(p: vec2<i32>) -> bool {");
+        self.line(1, "let size = vec2<i32>(mrsl_ctl.size);");
+        self.line(1, "let n = (size + vec2<i32>(2)) / 4 + vec2<i32>(1);");
+        self.line(1, "var refined = mrsl_ctl.force_refine != 0u;");
+        self.line(1, "for (var k = 0; k < 4; k++) {");
+        self.line(2, "let q = clamp(p + vec2<i32>(select(-2, 1, (k & 1) != 0), select(-2, 1, (k & 2) != 0)), vec2<i32>(0), size - vec2<i32>(1));");
+        self.line(2, "let i0 = q / 4;");
+        self.line(2, "let i1 = min(i0 + vec2<i32>(1), n - vec2<i32>(1));");
+        self.line(2, "let corners = array<vec2<i32>, 4>(i0, vec2<i32>(i1.x, i0.y), vec2<i32>(i0.x, i1.y), i1);");
+        self.line(2, "for (var j = 0; j < 4; j++) {");
+        self.line(3, "let s = u32(corners[j].y * n.x + corners[j].x);");
+        for w in 0..iface.flag_words {
+            self.line(3, format!("refined = refined || mrsl_parent[s * {}u + {w}u] != 0u;", iface.stride));
+        }
+        self.line(2, "}");
+        for (i, input) in c.inputs.iter().enumerate() {
+            let Some(key) = input.key else { continue };
+            let _ = i;
+            let name = &input.name;
+            let differs = |a: &str, b: &str| match key {
+                KeyCompare::Exact if input.ty.components() == 1 => format!("({a} != {b})"),
+                KeyCompare::Exact => format!("any({a} != {b})"),
+                KeyCompare::Threshold { threshold } => format!("(distance({a}, {b}) > {})", float_literal(threshold)),
+            };
+            self.line(2, format!("let k00_{name} = mrsl_load_{name}(min(i0 * 4, size - vec2<i32>(1)));"));
+            self.line(
+                2,
+                format!("let k10_{name} = mrsl_load_{name}(min(vec2<i32>(i1.x, i0.y) * 4, size - vec2<i32>(1)));"),
+            );
+            self.line(
+                2,
+                format!("let k01_{name} = mrsl_load_{name}(min(vec2<i32>(i0.x, i1.y) * 4, size - vec2<i32>(1)));"),
+            );
+            self.line(2, format!("let k11_{name} = mrsl_load_{name}(min(i1 * 4, size - vec2<i32>(1)));"));
+            self.line(
+                2,
+                format!(
+                    "refined = refined || {} || {} || {};",
+                    differs(&format!("k00_{name}"), &format!("k10_{name}")),
+                    differs(&format!("k00_{name}"), &format!("k01_{name}")),
+                    differs(&format!("k00_{name}"), &format!("k11_{name}"))
+                ),
+            );
+        }
+        self.line(1, "}");
+        self.line(1, "return refined;");
+        self.line(0, "}");
+        self.line(0, "");
+    }
+
     fn coarse_entry(&mut self) {
+        if self.kind == KernelKind::DynamicCoarse {
+            self.parent_refined();
+        }
         let c = self.checked();
         let iface = self.i.interface;
         let [wx, wy, wz] = self.kind.workgroup_size();
         self.line(0, format!("@compute @workgroup_size({wx}, {wy}, {wz})"));
-        self.line(0, "fn coarse_main(@builtin(global_invocation_id) mrsl_gid: vec3<u32>) {");
+        self.line(0, format!("fn {}(@builtin(global_invocation_id) mrsl_gid: vec3<u32>) {{", self.kind.entry_point()));
         self.line(1, "let mrsl_n = mrsl_grid();");
         self.line(1, "if (mrsl_gid.x >= u32(mrsl_n.x) || mrsl_gid.y >= u32(mrsl_n.y)) { return; }");
         self.line(1, "let mrsl_pos = vec2<i32>(mrsl_gid.xy);");
         self.line(1, "let mrsl_rec = (mrsl_gid.y * u32(mrsl_n.x) + mrsl_gid.x) * MRSL_STRIDE;");
+        if self.kind == KernelKind::DynamicCoarse {
+            self.line(1, "// Shade this 2x2 sample only where a 4x4 block around it was refined; the fine");
+            self.line(1, "// kernel treats an untagged (skipped) corner as a reason to shade per pixel.");
+            self.line(1, "if (!mrsl_parent_refined(mrsl_pixel(mrsl_pos))) { return; }");
+            self.line(1, format!("atomicAdd(&mrsl_stats[{}], 1u);", self.coarse_live().len()));
+            self.line(1, "mrsl_interface[mrsl_rec + MRSL_STRIDE - 1u] = mrsl_ctl.frame + 1u;");
+        }
         let coarse: Vec<EffectId> =
             self.i.graph.order.iter().copied().filter(|e| c.effects[e.index()].rate == Rate::Coarse).collect();
         for &e in &coarse {
@@ -903,12 +1072,10 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
     }
 
     fn fine_support(&mut self) {
-        let c = self.checked();
         let coarse = self.coarse_live();
         if coarse.is_empty() {
             return;
         }
-        let iface = self.i.interface;
         let mask_words = (coarse.len() as u32).div_ceil(32);
         self.line(0, "// Where a pixel takes its coarse values from, and which coarse effects it re-evaluates.");
         self.line(0, "struct MrslBlock {");
@@ -922,34 +1089,75 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         self.line(1, "return ((b.refined[k / 32u] >> (k % 32u)) & 1u) != 0u;");
         self.line(0, "}");
         self.line(0, "");
-        // Key comparisons.
+        if self.kind == KernelKind::DynamicFine {
+            self.line(0, "fn mrsl_any_refined(b: MrslBlock) -> bool {");
+            let words: Vec<String> = (0..mask_words).map(|w| format!("b.refined[{w}]")).collect();
+            self.line(1, format!("return ({}) != 0u;", words.join(" | ")));
+            self.line(0, "}");
+            self.line(0, "");
+            self.fine_level(&Level::DYNAMIC_OUTER);
+            self.fine_level(&Level::DYNAMIC_INNER);
+        } else {
+            self.fine_level(&Level { suffix: "", block: self.block, buffer: "mrsl_interface", parent: false });
+        }
+    }
+
+    /// `mrsl_resolve{suffix}` and the getters and resamplers of one level of coarse samples.
+    fn fine_level(&mut self, level: &Level) {
+        let c = self.checked();
+        let coarse = self.coarse_live();
+        let iface = self.i.interface;
+        let (sfx, bk, buf) = (level.suffix, level.block, level.buffer);
+        // A level read by the dynamic mode's inner pass carries a validity tag
+        // after the values: samples the inner coarse pass skipped are stale.
+        let stride = if level.parent { iface.stride + 1 } else { iface.stride };
         let keys: Vec<(usize, KeyCompare)> =
             c.inputs.iter().enumerate().filter_map(|(i, x)| x.key.map(|k| (i, k))).collect();
-        self.line(0, "fn mrsl_resolve(pos: vec2<i32>) -> MrslBlock {");
+        if level.parent {
+            self.line(
+                0,
+                format!("// Second level ({bk}x{bk}) of the dynamic mode: only effects refined at the first level"),
+            );
+            self.line(0, "// look here; a corner the inner coarse pass did not shade (stale tag) means per-pixel.");
+            self.line(0, format!("fn mrsl_resolve{sfx}(pos: vec2<i32>, parent: MrslBlock) -> MrslBlock {{"));
+        } else {
+            self.line(0, format!("fn mrsl_resolve{sfx}(pos: vec2<i32>) -> MrslBlock {{"));
+        }
         self.line(1, "let size = vec2<i32>(mrsl_ctl.size);");
-        self.line(1, "let n = (size + vec2<i32>(MRSL_BLOCK - 2)) / MRSL_BLOCK + vec2<i32>(1);");
-        self.line(1, "let i0 = pos / MRSL_BLOCK;");
+        self.line(1, format!("let n = (size + vec2<i32>({})) / {bk} + vec2<i32>(1);", bk as i32 - 2));
+        self.line(1, format!("let i0 = pos / {bk};"));
         self.line(1, "let i1 = min(i0 + vec2<i32>(1), n - vec2<i32>(1));");
-        self.line(1, "let p0 = min(i0 * MRSL_BLOCK, size - vec2<i32>(1));");
-        self.line(1, "let p1 = min(i1 * MRSL_BLOCK, size - vec2<i32>(1));");
+        self.line(1, format!("let p0 = min(i0 * {bk}, size - vec2<i32>(1));"));
+        self.line(1, format!("let p1 = min(i1 * {bk}, size - vec2<i32>(1));"));
         self.line(1, "let extent = p1 - p0;");
-        self.line(1, "let t = select(vec2<f32>(0.0), vec2<f32>(pos - p0) / vec2<f32>(max(extent, vec2<i32>(1))), extent > vec2<i32>(0));");
+        self.line(
+            1,
+            "let t = select(vec2<f32>(0.0), vec2<f32>(pos - p0) / vec2<f32>(max(extent, vec2<i32>(1))), extent > vec2<i32>(0));",
+        );
         self.line(1, "var b: MrslBlock;");
-        self.line(1, "b.corners = vec4<u32>(u32(i0.y * n.x + i0.x), u32(i0.y * n.x + i1.x), u32(i1.y * n.x + i0.x), u32(i1.y * n.x + i1.x));");
+        self.line(
+            1,
+            "b.corners = vec4<u32>(u32(i0.y * n.x + i0.x), u32(i0.y * n.x + i1.x), u32(i1.y * n.x + i0.x), u32(i1.y * n.x + i1.x));",
+        );
         self.line(
             1,
             "b.weights = vec4<f32>((1.0 - t.x) * (1.0 - t.y), t.x * (1.0 - t.y), (1.0 - t.x) * t.y, t.x * t.y);",
         );
         self.line(1, "b.nearest = select(0u, 1u, t.x > 0.5) + select(0u, 2u, t.y > 0.5);");
         self.line(1, "var disc = mrsl_ctl.force_refine != 0u;");
+        if level.parent {
+            let tags: Vec<String> = ["x", "y", "z", "w"]
+                .iter()
+                .map(|corner| format!("{buf}[b.corners.{corner} * {stride}u + {}u] != mrsl_ctl.frame + 1u", stride - 1))
+                .collect();
+            self.line(1, format!("disc = disc || {};", tags.join(" || ")));
+        }
         for (i, key) in &keys {
             let name = &c.inputs[*i].name;
             let differs = |a: &str, b: &str| match key {
                 KeyCompare::Exact if c.inputs[*i].ty.components() == 1 => format!("({a} != {b})"),
                 KeyCompare::Exact => format!("any({a} != {b})"),
-                KeyCompare::Threshold { threshold } => {
-                    format!("(distance({a}, {b}) > {})", float_literal(*threshold))
-                }
+                KeyCompare::Threshold { threshold } => format!("(distance({a}, {b}) > {})", float_literal(*threshold)),
             };
             self.line(1, format!("// discontinuity key `{name}`"));
             self.line(1, format!("let k_{name} = mrsl_load_{name}(pos);"));
@@ -969,7 +1177,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         if iface.flag_words > 0 {
             for (ci, corner) in ["x", "y", "z", "w"].iter().enumerate() {
                 for w in 0..iface.flag_words {
-                    self.line(1, format!("let f{ci}_{w} = mrsl_interface[b.corners.{corner} * MRSL_STRIDE + {w}u];"));
+                    self.line(1, format!("let f{ci}_{w} = {buf}[b.corners.{corner} * {stride}u + {w}u];"));
                 }
             }
         }
@@ -1006,7 +1214,12 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
                     (0..4).map(|ci| format!("!({})", self.store_condition(e, &|bit| bit_of_corner(ci, bit)))).collect();
                 terms.push(format!("(({needed}) && ({}))", misses.join(" || ")));
             }
-            self.line(1, format!("let mrsl_r{k} = {}; // `{}`", terms.join(" || "), info.name));
+            let value = if level.parent {
+                format!("mrsl_is_refined(parent, {k}u) && ({})", terms.join(" || "))
+            } else {
+                terms.join(" || ")
+            };
+            self.line(1, format!("let mrsl_r{k} = {value}; // `{}`", info.name));
             self.line(1, format!("if (mrsl_r{k}) {{ b.refined[{}] |= {}u; }}", k / 32, 1u32 << (k % 32)));
         }
         self.line(1, "return b;");
@@ -1018,14 +1231,14 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             };
             let info = &c.effects[e.index()];
             let ty = &info.ty;
-            self.line(0, format!("fn mrsl_get_{}(s: u32) -> {} {{", info.name, ty.wgsl()));
-            self.line(1, format!("let base = s * MRSL_STRIDE + {}u;", slot.offset));
-            self.line(1, format!("return {};", unpack_words(ty)));
+            self.line(0, format!("fn mrsl_get{sfx}_{}(s: u32) -> {} {{", info.name, ty.wgsl()));
+            self.line(1, format!("let base = s * {stride}u + {}u;", slot.offset));
+            self.line(1, format!("return {};", unpack_words(ty, buf)));
             self.line(0, "}");
             let nearest = layout::uses_nearest(c, e);
-            self.line(0, format!("fn mrsl_resample_{}(b: MrslBlock) -> {} {{", info.name, ty.wgsl()));
+            self.line(0, format!("fn mrsl_resample{sfx}_{}(b: MrslBlock) -> {} {{", info.name, ty.wgsl()));
             for (k, corner) in ["x", "y", "z", "w"].iter().enumerate() {
-                self.line(1, format!("let v{k} = mrsl_get_{}(b.corners.{corner});", info.name));
+                self.line(1, format!("let v{k} = mrsl_get{sfx}_{}(b.corners.{corner});", info.name));
             }
             if nearest {
                 self.line(1, "// nearest corner");
@@ -1045,7 +1258,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
     /// Entry point of the fine and reference kernels.
     fn pixel_entry(&mut self) {
         let tile = layout::TILE;
-        let b = if self.kind == KernelKind::Fine { self.block } else { 2 };
+        let b = if self.kind.is_fine() { self.block } else { 2 };
         self.line(0, format!("// Pixel of a {tile}x{tile} tile for lane `li`: {b}x{b} blocks are laid out so that"));
         self.line(0, "// consecutive lanes (a SIMD group) cover whole blocks and share their refine decisions.");
         self.line(0, "fn mrsl_tile_pixel(wg: vec2<u32>, li: u32) -> vec2<i32> {");
@@ -1069,7 +1282,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         );
         self.line(1, "let mrsl_pos = mrsl_tile_pixel(mrsl_wg.xy, mrsl_li);");
         let order = self.i.graph.order.clone();
-        let counted = self.kind == KernelKind::Fine && !self.coarse_live().is_empty();
+        let counted = self.kind.is_fine() && !self.coarse_live().is_empty();
         if !counted {
             self.line(1, "if (any(mrsl_pos >= mrsl_grid())) { return; }");
             self.effect_chain(&order, 1);
@@ -1081,10 +1294,20 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         // so pixels outside the image skip the work instead of returning.
         let nc = self.coarse_live().len();
         self.line(1, "if (all(mrsl_pos < mrsl_grid())) {");
-        self.line(2, "let mrsl_b = mrsl_resolve(mrsl_pos);");
-        self.line(2, "textureStore(mrsl_rate, mrsl_pos, vec4<u32>(mrsl_b.refined[0], 0u, 0u, 1u));");
+        self.resolve_preamble(2);
+        // `mrsl_last` holds the innermost level: effects refined there are evaluated per pixel.
+        if self.kind == KernelKind::DynamicFine {
+            self.line(2, "let mrsl_last = mrsl_b2;");
+            self.line(
+                2,
+                "textureStore(mrsl_rate, mrsl_pos, vec4<u32>(mrsl_b2.refined[0], mrsl_b.refined[0] & ~mrsl_b2.refined[0], 0u, 1u));",
+            );
+        } else {
+            self.line(2, "let mrsl_last = mrsl_b;");
+            self.line(2, "textureStore(mrsl_rate, mrsl_pos, vec4<u32>(mrsl_b.refined[0], 0u, 0u, 1u));");
+        }
         for k in 0..nc {
-            self.line(2, format!("if (mrsl_is_refined(mrsl_b, {k}u)) {{ atomicAdd(&mrsl_wg_stats[{k}], 1u); }}"));
+            self.line(2, format!("if (mrsl_is_refined(mrsl_last, {k}u)) {{ atomicAdd(&mrsl_wg_stats[{k}], 1u); }}"));
         }
         self.effect_chain(&order, 2);
         self.output_stores(&order, 2);
@@ -1136,8 +1359,8 @@ fn pack_words(value: &str, ty: &Type) -> Vec<String> {
 }
 
 /// A WGSL expression reading a value from `mrsl_interface` at word `base`.
-fn unpack_words(ty: &Type) -> String {
-    let word = |k: u32| format!("mrsl_interface[base + {k}u]");
+fn unpack_words(ty: &Type, buffer: &str) -> String {
+    let word = |k: u32| format!("{buffer}[base + {k}u]");
     let scalar = |k: u32, s: Scalar| match s {
         Scalar::Float => format!("bitcast<f32>({})", word(k)),
         Scalar::Int => format!("bitcast<i32>({})", word(k)),

@@ -23,7 +23,10 @@
 
 mod error;
 pub mod gpu;
+pub mod mesh;
+pub mod raster;
 pub mod scene;
+pub mod scene_file;
 mod shader;
 mod stats;
 
@@ -40,25 +43,29 @@ pub enum Mode {
     Coarse2x2,
     /// One coarse sample per 4x4 block, refined per block.
     Coarse4x4,
+    /// He et al.'s DYNAMIC: 4x4 blocks; where refined, 2x2 blocks; where
+    /// refined again, per pixel.
+    Dynamic,
 }
 
 impl Mode {
-    pub const ALL: [Mode; 3] = [Mode::Reference, Mode::Coarse2x2, Mode::Coarse4x4];
+    pub const ALL: [Mode; 4] = [Mode::Reference, Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic];
 
     pub fn name(self) -> &'static str {
         match self {
             Mode::Reference => "reference",
             Mode::Coarse2x2 => "coarse2x2",
             Mode::Coarse4x4 => "coarse4x4",
+            Mode::Dynamic => "dynamic",
         }
     }
 
-    /// The coarse block size, or `None` for per-pixel shading.
+    /// The (first) coarse block size, or `None` for per-pixel shading.
     pub fn block_size(self) -> Option<u32> {
         match self {
             Mode::Reference => None,
             Mode::Coarse2x2 => Some(2),
-            Mode::Coarse4x4 => Some(4),
+            Mode::Coarse4x4 | Mode::Dynamic => Some(4),
         }
     }
 }

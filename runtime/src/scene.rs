@@ -5,11 +5,22 @@
 //! of them runs on any scene: `position` (float3, world space), `normal`
 //! (float3, unit), `uv` (float2), `material` (uint; 255 is the background)
 //! and `depth` (float, distance from the camera).
+//!
+//! [`Scene::Sponza`] is a real model, rasterised on the GPU by
+//! [`crate::raster`]: build it with [`Scene::render_on`] or
+//! [`Scene::textures_on`]. See docs/scenes.md.
 
 use crate::gpu::Gpu;
+use crate::mesh::MeshError;
+use crate::raster::{Camera, RasterError};
 
 /// Material id of background pixels.
 pub const BACKGROUND: u32 = 255;
+
+// Sponza's default camera (see `Scene::sponza_camera`).
+const SPONZA_EYE: [f32; 3] = [-11.5, 2.2, -0.3];
+const SPONZA_TARGET: [f32; 3] = [10.0, 4.5, 0.4];
+const SPONZA_FOV: f32 = 60.0;
 
 /// The data of one channel, row-major, top row first.
 #[derive(Debug, Clone, PartialEq)]
@@ -41,6 +52,18 @@ pub enum Scene {
     Steps { count: u32 },
     /// A surface whose normal oscillates: `frequency` periods across the image along `angle` (degrees).
     Sinusoid { angle: f32, frequency: f32 },
+    /// The Dabrovic Sponza atrium (a real model, 76k triangles, 35
+    /// materials), rasterised on the GPU from [`Scene::sponza_camera`].
+    Sponza,
+}
+
+/// Why a scene could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    #[error(transparent)]
+    Raster(#[from] RasterError),
 }
 
 impl Scene {
@@ -50,12 +73,71 @@ impl Scene {
             "gradient" => Scene::Gradient,
             "steps" => Scene::Steps { count: 8 },
             "sinusoid" => Scene::Sinusoid { angle: 30.0, frequency: 12.0 },
+            "sponza" => Scene::Sponza,
             _ => return None,
         })
     }
 
+    /// The names [`Scene::parse`] accepts.
+    pub const NAMES: [&str; 5] = ["demo", "gradient", "steps", "sinusoid", "sponza"];
+
+    /// Whether the scene is rasterised on the GPU (and so needs [`Scene::render_on`]).
+    pub fn needs_gpu(self) -> bool {
+        matches!(self, Scene::Sponza)
+    }
+
+    /// The camera the scene is seen from, for scenes that have a free one
+    /// (programs with a `camera_pos` uniform want its eye).
+    pub fn camera(self) -> Option<Camera> {
+        match self {
+            Scene::Sponza => Some(Scene::sponza_camera()),
+            _ => None,
+        }
+    }
+
+    /// Sponza's default camera: in the atrium, at head height near its -x
+    /// end, looking along the nave (+x) and slightly up towards the galleries.
+    pub fn sponza_camera() -> Camera {
+        Camera { eye: SPONZA_EYE, target: SPONZA_TARGET, up: [0.0, 1.0, 0.0], fov_y_degrees: SPONZA_FOV }
+    }
+
+    /// The G-buffer on `gpu`: rasterised for [`Scene::Sponza`], made on the
+    /// CPU (as [`Scene::render`]) for the others.
+    pub fn render_on(self, gpu: &Gpu, width: u32, height: u32) -> Result<GBuffer, SceneError> {
+        match self {
+            Scene::Sponza => Ok(crate::raster::read_gbuffer(gpu, &self.textures_on(gpu, width, height)?)?),
+            _ => Ok(self.render(width, height)),
+        }
+    }
+
+    /// The G-buffer as textures on `gpu` (the formats of [`GBuffer::upload`]):
+    /// Sponza's straight from the rasteriser, without a round trip through
+    /// the CPU; the CPU scenes' uploaded.
+    pub fn textures_on(self, gpu: &Gpu, width: u32, height: u32) -> Result<Vec<(String, wgpu::Texture)>, SceneError> {
+        match self {
+            Scene::Sponza => {
+                let mesh = crate::mesh::sponza_shared()?;
+                let rasterizer = crate::raster::Rasterizer::new(gpu)?;
+                let uploaded = rasterizer.upload(gpu, &mesh)?;
+                Ok(rasterizer.render(gpu, &uploaded, &Scene::sponza_camera(), (width, height))?)
+            }
+            _ => Ok(self.render(width, height).upload(gpu)),
+        }
+    }
+
+    /// The G-buffer, made on the CPU.
+    ///
+    /// # Panics
+    ///
+    /// [`Scene::Sponza`] is rasterised on a GPU: here it makes its own device
+    /// and panics if there is none or the model cannot be loaded. Use
+    /// [`Scene::render_on`] to get those failures as errors.
     pub fn render(self, width: u32, height: u32) -> GBuffer {
         match self {
+            Scene::Sponza => {
+                let gpu = Gpu::new().unwrap_or_else(|e| panic!("the Sponza scene needs a GPU adapter: {e}"));
+                self.render_on(&gpu, width, height).unwrap_or_else(|e| panic!("cannot render the Sponza scene: {e}"))
+            }
             Scene::Demo => demo(width, height),
             Scene::Gradient => {
                 surface(width, height, |u, v| (0, [u * 2.0 - 1.0, 1.0 - v * 2.0, 0.2 * u], [0.0, 0.0, 1.0]))

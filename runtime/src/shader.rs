@@ -32,7 +32,8 @@ pub struct DispatchOptions {
     pub force_refine: bool,
 }
 
-const STAGES: usize = 3;
+/// Timestamped passes: reference, coarse, fine, dynamic coarse 2x2.
+const STAGES: usize = 4;
 
 struct Timestamps {
     set: wgpu::QuerySet,
@@ -51,8 +52,10 @@ pub struct Shader {
     control: wgpu::Buffer,
     uniforms: Option<wgpu::Buffer>,
     uniform_values: HashMap<String, Vec<f64>>,
-    /// Interface buffers by block size, with the size they were made for.
-    interfaces: HashMap<u32, (wgpu::Buffer, (u32, u32))>,
+    /// Interface buffers by (block size, tagged), with the size they were made for.
+    interfaces: HashMap<(u32, bool), (wgpu::Buffer, (u32, u32))>,
+    /// Dispatch counter, written to the control block (validity tags of the dynamic mode).
+    frame: u32,
     /// The fine kernel's per-pixel refine mask, with the size it was made for.
     rate: Option<(wgpu::Texture, (u32, u32))>,
     stats: wgpu::Buffer,
@@ -73,7 +76,13 @@ impl Shader {
         let resources_layout = resources_layout(device, &layout);
         let gbuffer_layout = gbuffer_layout(device, &layout);
         let mut stage_layouts = HashMap::new();
-        for kind in [KernelKind::Coarse, KernelKind::Fine, KernelKind::Reference] {
+        for kind in [
+            KernelKind::Coarse,
+            KernelKind::Fine,
+            KernelKind::Reference,
+            KernelKind::DynamicCoarse,
+            KernelKind::DynamicFine,
+        ] {
             stage_layouts.insert(kind, stage_layout(device, &layout, kind));
         }
         let mut pipelines = HashMap::new();
@@ -115,7 +124,8 @@ impl Shader {
                 mapped_at_creation: false,
             })
         });
-        let counters = layout.stats.counters.len().max(1) as u64 * 4;
+        // One counter per coarse effect, plus the dynamic mode's 2x2 sample count.
+        let counters = (layout.stats.counters.len() + 1) as u64 * 4;
         let stats = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("mrsl stats"),
             size: counters,
@@ -161,6 +171,7 @@ impl Shader {
             uniforms,
             uniform_values: HashMap::new(),
             interfaces: HashMap::new(),
+            frame: 0,
             rate: None,
             stats,
             stats_readback,
@@ -316,6 +327,8 @@ impl Shader {
         control[0] = width;
         control[1] = height;
         control[2] = u32::from(options.force_refine);
+        self.frame = self.frame.wrapping_add(1).max(1);
+        control[3] = self.frame;
         queue.write_buffer(&self.control, 0, bytemuck::cast_slice(&control));
         if let Some(buffer) = &self.uniforms {
             queue.write_buffer(buffer, 0, &self.uniform_bytes()?);
@@ -329,7 +342,7 @@ impl Shader {
         let tiles = (width.div_ceil(mrsl::layout::TILE), height.div_ceil(mrsl::layout::TILE));
         match mode.block_size() {
             None => {
-                let stage = self.stage_group(device, KernelKind::Reference, None, &views);
+                let stage = self.stage_group(device, KernelKind::Reference, None, None, &views);
                 self.pass(
                     encoder,
                     "mrsl reference",
@@ -340,10 +353,13 @@ impl Shader {
                 );
             }
             Some(block) => {
-                let interface = self.interface(device, block, bindings.size).clone();
+                let interface = self.interface(device, block, false, bindings.size).clone();
                 self.ensure_rate_image(device, bindings.size);
-                let coarse_stage = self.stage_group(device, KernelKind::Coarse, Some(&interface), &views);
-                let fine_stage = self.stage_group(device, KernelKind::Fine, Some(&interface), &views);
+                let dynamic = mode == Mode::Dynamic;
+                let inner = if dynamic { Some(self.interface(device, 2, true, bindings.size).clone()) } else { None };
+                let coarse_stage = self.stage_group(device, KernelKind::Coarse, Some(&interface), None, &views);
+                let fine_kind = if dynamic { KernelKind::DynamicFine } else { KernelKind::Fine };
+                let fine_stage = self.stage_group(device, fine_kind, Some(&interface), inner.as_ref(), &views);
                 let (nx, ny) = sample_grid(bindings.size, block);
                 let coarse_groups = (nx.div_ceil(8), ny.div_ceil(8));
                 self.pass(
@@ -354,14 +370,20 @@ impl Shader {
                     &[&resources, &gbuffer, &coarse_stage],
                     coarse_groups,
                 );
-                self.pass(
-                    encoder,
-                    "mrsl fine",
-                    2,
-                    (KernelKind::Fine, block),
-                    &[&resources, &gbuffer, &fine_stage],
-                    tiles,
-                );
+                if dynamic {
+                    let stage =
+                        self.stage_group(device, KernelKind::DynamicCoarse, Some(&interface), inner.as_ref(), &views);
+                    let (nx, ny) = sample_grid(bindings.size, 2);
+                    self.pass(
+                        encoder,
+                        "mrsl dynamic coarse 2x2",
+                        3,
+                        (KernelKind::DynamicCoarse, 2),
+                        &[&resources, &gbuffer, &stage],
+                        (nx.div_ceil(8), ny.div_ceil(8)),
+                    );
+                }
+                self.pass(encoder, "mrsl fine", 2, (fine_kind, block), &[&resources, &gbuffer, &fine_stage], tiles);
             }
         }
         encoder.copy_buffer_to_buffer(&self.stats, 0, &self.stats_readback, 0, None);
@@ -400,9 +422,10 @@ impl Shader {
     }
 
     /// The interface buffer for `block`, (re)created when the size changes.
-    fn interface(&mut self, device: &wgpu::Device, block: u32, size: (u32, u32)) -> &wgpu::Buffer {
-        let stride = self.layout.interface.stride_words.max(1) as u64;
-        let fresh = self.interfaces.get(&block).is_none_or(|(_, s)| *s != size);
+    /// Tagged records (the dynamic mode's 2x2 level) have one more word.
+    fn interface(&mut self, device: &wgpu::Device, block: u32, tagged: bool, size: (u32, u32)) -> &wgpu::Buffer {
+        let stride = (self.layout.interface.stride_words + u32::from(tagged)).max(1) as u64;
+        let fresh = self.interfaces.get(&(block, tagged)).is_none_or(|(_, s)| *s != size);
         if fresh {
             let (nx, ny) = sample_grid(size, block);
             let buffer = device.create_buffer(&wgpu::BufferDescriptor {
@@ -411,9 +434,9 @@ impl Shader {
                 usage: wgpu::BufferUsages::STORAGE,
                 mapped_at_creation: false,
             });
-            self.interfaces.insert(block, (buffer, size));
+            self.interfaces.insert((block, tagged), (buffer, size));
         }
-        &self.interfaces[&block].0
+        &self.interfaces[&(block, tagged)].0
     }
 
     fn resources_group(&self, device: &wgpu::Device, bindings: &Bindings) -> wgpu::BindGroup {
@@ -465,6 +488,7 @@ impl Shader {
         device: &wgpu::Device,
         kind: KernelKind,
         interface: Option<&wgpu::Buffer>,
+        inner: Option<&wgpu::Buffer>,
         outputs: &HashMap<&str, wgpu::TextureView>,
     ) -> wgpu::BindGroup {
         let l = &self.layout;
@@ -472,7 +496,13 @@ impl Shader {
         if let (Some(buffer), true) = (interface, kind != KernelKind::Reference) {
             entries.push(wgpu::BindGroupEntry { binding: l.interface.binding, resource: buffer.as_entire_binding() });
         }
-        if kind != KernelKind::Coarse {
+        if let (Some(buffer), true) = (inner, matches!(kind, KernelKind::DynamicCoarse | KernelKind::DynamicFine)) {
+            entries.push(wgpu::BindGroupEntry { binding: l.interface2.binding, resource: buffer.as_entire_binding() });
+        }
+        if kind == KernelKind::DynamicCoarse {
+            entries.push(wgpu::BindGroupEntry { binding: l.stats.binding, resource: self.stats.as_entire_binding() });
+        }
+        if !kind.is_coarse() {
             for o in &l.outputs {
                 entries.push(wgpu::BindGroupEntry {
                     binding: o.binding,
@@ -481,7 +511,7 @@ impl Shader {
             }
         }
         let rate_view = self.rate.as_ref().map(|(t, _)| t.create_view(&Default::default()));
-        if kind == KernelKind::Fine && !l.stats.counters.is_empty() {
+        if kind.is_fine() && !l.stats.counters.is_empty() {
             entries.push(wgpu::BindGroupEntry { binding: l.stats.binding, resource: self.stats.as_entire_binding() });
             if let Some(view) = &rate_view {
                 entries.push(wgpu::BindGroupEntry {
@@ -507,7 +537,7 @@ impl Shader {
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::R32Uint,
+            format: wgpu::TextureFormat::Rg32Uint,
             usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
@@ -532,9 +562,10 @@ impl Shader {
                     let (a, b) = (ticks[2 * stage], ticks[2 * stage + 1]);
                     (b.saturating_sub(a)) as f64 * t.period_ns as f64 / 1e6
                 };
-                Some(match options.mode.block_size() {
-                    None => crate::Timings { coarse_ms: 0.0, fine_ms: ms(0) },
-                    Some(_) => crate::Timings { coarse_ms: ms(1), fine_ms: ms(2) },
+                Some(match options.mode {
+                    Mode::Reference => crate::Timings { coarse_ms: 0.0, coarse2_ms: 0.0, fine_ms: ms(0) },
+                    Mode::Dynamic => crate::Timings { coarse_ms: ms(1), coarse2_ms: ms(3), fine_ms: ms(2) },
+                    _ => crate::Timings { coarse_ms: ms(1), coarse2_ms: 0.0, fine_ms: ms(2) },
                 })
             }
             None => None,
@@ -723,9 +754,18 @@ fn stage_layout(device: &wgpu::Device, l: &Layout, kind: KernelKind) -> wgpu::Bi
     match kind {
         KernelKind::Coarse => entries.push(storage(l.interface.binding, false)),
         KernelKind::Fine => entries.push(storage(l.interface.binding, true)),
+        KernelKind::DynamicCoarse => {
+            entries.push(storage(l.interface.binding, true));
+            entries.push(storage(l.interface2.binding, false));
+            entries.push(storage(l.stats.binding, false));
+        }
+        KernelKind::DynamicFine => {
+            entries.push(storage(l.interface.binding, true));
+            entries.push(storage(l.interface2.binding, true));
+        }
         KernelKind::Reference => {}
     }
-    if kind != KernelKind::Coarse {
+    if !kind.is_coarse() {
         for o in &l.outputs {
             entries.push(wgpu::BindGroupLayoutEntry {
                 binding: o.binding,
@@ -739,14 +779,14 @@ fn stage_layout(device: &wgpu::Device, l: &Layout, kind: KernelKind) -> wgpu::Bi
             });
         }
     }
-    if kind == KernelKind::Fine && !l.stats.counters.is_empty() {
+    if kind.is_fine() && !l.stats.counters.is_empty() {
         entries.push(storage(l.stats.binding, false));
         entries.push(wgpu::BindGroupLayoutEntry {
             binding: l.rate_image.binding,
             visibility: wgpu::ShaderStages::COMPUTE,
             ty: wgpu::BindingType::StorageTexture {
                 access: wgpu::StorageTextureAccess::WriteOnly,
-                format: wgpu::TextureFormat::R32Uint,
+                format: wgpu::TextureFormat::Rg32Uint,
                 view_dimension: wgpu::TextureViewDimension::D2,
             },
             count: None,

@@ -9,6 +9,8 @@ use mrsl::syntax::ast::Rate;
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Timings {
     pub coarse_ms: f64,
+    /// The dynamic mode's 2x2 coarse pass (0 in other modes).
+    pub coarse2_ms: f64,
     pub fine_ms: f64,
 }
 
@@ -48,7 +50,11 @@ impl Stats {
         timings: Option<Timings>,
     ) -> Stats {
         let pixels = size.0 as u64 * size.1 as u64;
-        let samples = options.mode.block_size().map(|b| crate::Shader::coarse_samples(size, b)).unwrap_or(0);
+        let mut samples = options.mode.block_size().map(|b| crate::Shader::coarse_samples(size, b)).unwrap_or(0);
+        if options.mode == crate::Mode::Dynamic {
+            // The 2x2 samples the second level shaded, counted by its kernel.
+            samples += counters.get(layout.stats.counters.len()).copied().unwrap_or(0) as u64;
+        }
         let mut effects = vec![];
         for e in layout.effects.iter().filter(|e| e.live) {
             let (coarse_evaluations, pixel_evaluations) = match (options.mode.block_size(), e.rate) {
@@ -114,7 +120,10 @@ impl Stats {
             ));
         }
         if let Some(t) = self.timings {
-            out.push_str(&format!("  GPU time: coarse {:.3} ms, fine {:.3} ms\n", t.coarse_ms, t.fine_ms));
+            out.push_str(&format!(
+                "  GPU time: coarse {:.3} ms, coarse 2x2 {:.3} ms, fine {:.3} ms\n",
+                t.coarse_ms, t.coarse2_ms, t.fine_ms
+            ));
         }
         out
     }

@@ -9,5 +9,6 @@ mod harness;
 
 mod errors;
 mod modes;
+mod sponza;
 
 pub use harness::*;

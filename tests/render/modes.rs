@@ -4,7 +4,7 @@ use crate::{compile, gpu, max_abs_diff, run, ulps};
 use mrsl_runtime::Mode;
 use mrsl_runtime::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
 
-const COARSE_MODES: [Mode; 2] = [Mode::Coarse2x2, Mode::Coarse4x4];
+const COARSE_MODES: [Mode; 3] = [Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic];
 
 fn examples() -> Vec<(String, String)> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
@@ -161,7 +161,7 @@ fn shaded_fraction_falls_from_reference_to_coarse4x4() {
     let Some(gpu) = gpu() else { return };
     let program = compile(include_str!("../../examples/demo.mrsl"));
     let gbuffer = Scene::Demo.render(160, 96);
-    let fractions: Vec<f64> = [Mode::Reference, Mode::Coarse2x2, Mode::Coarse4x4]
+    let fractions: Vec<f64> = [Mode::Reference, Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic]
         .into_iter()
         .map(|mode| {
             let out = run(gpu, &program, &gbuffer, mode, false).unwrap();
@@ -173,6 +173,9 @@ fn shaded_fraction_falls_from_reference_to_coarse4x4() {
         .collect();
     assert_eq!(fractions[0], 1.0);
     assert!(fractions[1] < 1.0 && fractions[2] < fractions[1], "{fractions:?}");
+    // Dynamic refines 4x4 blocks to 2x2 before going per pixel: it shades
+    // less than 2x2 everywhere (its first level is 4x4).
+    assert!(fractions[3] < fractions[1], "{fractions:?}");
 }
 
 /// A G-buffer made by hand, to check the runtime reads the engine's data

@@ -32,7 +32,11 @@ fn ok_programs() {
                 panic!("{name}: {:?} kernel fails naga validation:\n{e}", kernel.kind);
             }
         }
-        assert_eq!(program.kernels.len(), 5, "coarse+fine for 2x2 and 4x4, plus reference");
+        assert_eq!(
+            program.kernels.len(),
+            7,
+            "coarse+fine for 2x2 and 4x4, reference, and the two dynamic-mode kernels"
+        );
         let mut snapshot = String::new();
         writeln!(snapshot, "----- SOURCE\n{}", source.trim_end()).unwrap();
         if !program.warnings.is_empty() {

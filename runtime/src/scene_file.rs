@@ -1,0 +1,292 @@
+//! Scene files: a mesh, a camera, an image size and uniform values, in TOML.
+//!
+//! ```toml
+//! mesh = "sponza"              # or a path to .obj, .gltf or .glb, relative to this file
+//! size = [960, 540]            # optional: the image size (`mrslc render --size` wins)
+//! crease_angle = 45            # optional: degrees, for models without normals
+//!
+//! [camera]                     # optional: default Sponza's camera, or framing the mesh
+//! eye = [-11.5, 2.2, -0.3]
+//! target = [10.0, 4.5, 0.4]
+//! up = [0, 1, 0]               # optional
+//! fov = 60                     # optional: vertical field of view in degrees (default 50)
+//!
+//! [uniforms]                   # optional: applied before any `mrslc render --set`
+//! light_dir = [0.3, 0.9, 0.3]
+//! shininess = 20
+//! show_checker = true
+//! ```
+
+use crate::gpu::Gpu;
+use crate::mesh::{DEFAULT_CREASE_ANGLE, Mesh, MeshError};
+use crate::raster::{Camera, RasterError, Rasterizer};
+use crate::scene::{GBuffer, Scene};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Default vertical field of view (degrees) of a scene file's camera: the demo scene's.
+pub const DEFAULT_FOV: f32 = 50.0;
+
+/// Why a scene file could not be used; names the file, and the key at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneFileError {
+    #[error("cannot read scene file {}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{}: invalid TOML: {message}", path.display())]
+    Syntax { path: PathBuf, message: String },
+    #[error("{}: `{key}`: {message}", path.display())]
+    Key { path: PathBuf, key: String, message: String },
+    #[error("{}: `mesh`: {source}", path.display())]
+    Mesh {
+        path: PathBuf,
+        #[source]
+        source: MeshError,
+    },
+    #[error("{}: {source}", path.display())]
+    Raster {
+        path: PathBuf,
+        #[source]
+        source: RasterError,
+    },
+}
+
+/// Which mesh a scene file names.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MeshSource {
+    /// The built-in Dabrovic Sponza (`mesh = "sponza"`).
+    Sponza,
+    /// A model file, resolved against the scene file's folder.
+    File(PathBuf),
+}
+
+/// A parsed scene file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneFile {
+    /// The file it was read from (for messages and relative paths).
+    pub path: PathBuf,
+    pub mesh: MeshSource,
+    /// `None`: Sponza's default camera, or one framing the mesh.
+    pub camera: Option<Camera>,
+    pub size: Option<(u32, u32)>,
+    pub crease_angle: Option<f32>,
+    /// Uniform values, in the order of the file (scalars as one value, bools as 0/1).
+    pub uniforms: Vec<(String, Vec<f64>)>,
+}
+
+impl SceneFile {
+    pub fn load(path: impl AsRef<Path>) -> Result<SceneFile, SceneFileError> {
+        let path = path.as_ref();
+        let text =
+            std::fs::read_to_string(path).map_err(|source| SceneFileError::Io { path: path.to_path_buf(), source })?;
+        SceneFile::parse(&text, path)
+    }
+
+    /// Parses scene-file text; `path` resolves relative mesh paths and names the file in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneFileError> {
+        let table: toml::Table = toml::from_str(text).map_err(|e| SceneFileError::Syntax {
+            path: path.to_path_buf(),
+            message: e.to_string().trim().to_string(),
+        })?;
+        let key_error =
+            |key: &str, message: String| SceneFileError::Key { path: path.to_path_buf(), key: key.into(), message };
+        for key in table.keys() {
+            if !["mesh", "size", "crease_angle", "camera", "uniforms"].contains(&key.as_str()) {
+                return Err(key_error(
+                    key,
+                    "unknown key (expected mesh, size, crease_angle, camera or uniforms)".into(),
+                ));
+            }
+        }
+        let mesh = match table.get("mesh") {
+            None => return Err(key_error("mesh", "missing: name a .obj, .gltf or .glb file, or \"sponza\"".into())),
+            Some(toml::Value::String(s)) if s == "sponza" => MeshSource::Sponza,
+            Some(toml::Value::String(s)) => {
+                let base = path.parent().unwrap_or(Path::new(""));
+                MeshSource::File(base.join(s))
+            }
+            Some(other) => return Err(key_error("mesh", format!("expected a string, found {}", other.type_str()))),
+        };
+        let size = match table.get("size") {
+            None => None,
+            Some(v) => {
+                let numbers = numbers(v).filter(|n| n.len() == 2).ok_or_else(|| {
+                    key_error("size", format!("expected [width, height], found {}", describe_value(v)))
+                })?;
+                let side = |x: f64| (x.fract() == 0.0 && (1.0..=16384.0).contains(&x)).then_some(x as u32);
+                match (side(numbers[0]), side(numbers[1])) {
+                    (Some(w), Some(h)) => Some((w, h)),
+                    _ => return Err(key_error("size", "each side must be a whole number from 1 to 16384".into())),
+                }
+            }
+        };
+        let crease_angle = match table.get("crease_angle") {
+            None => None,
+            Some(v) => match scalar(v) {
+                Some(a) if (0.0..=180.0).contains(&a) => Some(a as f32),
+                _ => return Err(key_error("crease_angle", "expected a number of degrees from 0 to 180".into())),
+            },
+        };
+        let camera = match table.get("camera") {
+            None => None,
+            Some(toml::Value::Table(t)) => {
+                for key in t.keys() {
+                    if !["eye", "target", "up", "fov"].contains(&key.as_str()) {
+                        return Err(key_error(
+                            &format!("camera.{key}"),
+                            "unknown key (expected eye, target, up or fov)".into(),
+                        ));
+                    }
+                }
+                let vec3 = |key: &str, default: Option<[f32; 3]>| -> Result<[f32; 3], SceneFileError> {
+                    match t.get(key) {
+                        None => default
+                            .ok_or_else(|| key_error(&format!("camera.{key}"), "missing: expected [x, y, z]".into())),
+                        Some(v) => numbers(v)
+                            .filter(|n| n.len() == 3)
+                            .map(|n| [n[0] as f32, n[1] as f32, n[2] as f32])
+                            .ok_or_else(|| {
+                                key_error(
+                                    &format!("camera.{key}"),
+                                    format!("expected [x, y, z], found {}", describe_value(v)),
+                                )
+                            }),
+                    }
+                };
+                let fov = match t.get("fov") {
+                    None => DEFAULT_FOV,
+                    Some(v) => match scalar(v) {
+                        Some(a) if a > 0.0 && a < 180.0 => a as f32,
+                        _ => {
+                            return Err(key_error(
+                                "camera.fov",
+                                format!("expected degrees between 0 and 180, found {}", describe_value(v)),
+                            ));
+                        }
+                    },
+                };
+                let camera = Camera {
+                    eye: vec3("eye", None)?,
+                    target: vec3("target", None)?,
+                    up: vec3("up", Some([0.0, 1.0, 0.0]))?,
+                    fov_y_degrees: fov,
+                };
+                camera.basis().map_err(|e| key_error("camera", e.to_string()))?;
+                Some(camera)
+            }
+            Some(other) => return Err(key_error("camera", format!("expected a table, found {}", other.type_str()))),
+        };
+        let mut uniforms = vec![];
+        match table.get("uniforms") {
+            None => {}
+            Some(toml::Value::Table(t)) => {
+                for (name, v) in t {
+                    let values = numbers(v).filter(|n| !n.is_empty()).ok_or_else(|| {
+                        key_error(
+                            &format!("uniforms.{name}"),
+                            format!("expected a number, a bool or an array of them, found {}", describe_value(v)),
+                        )
+                    })?;
+                    uniforms.push((name.clone(), values));
+                }
+            }
+            Some(other) => return Err(key_error("uniforms", format!("expected a table, found {}", other.type_str()))),
+        }
+        Ok(SceneFile { path: path.to_path_buf(), mesh, camera, size, crease_angle, uniforms })
+    }
+
+    /// Loads the mesh the file names (Sponza is shared between calls).
+    pub fn load_mesh(&self) -> Result<Arc<Mesh>, SceneFileError> {
+        let wrap = |source| SceneFileError::Mesh { path: self.path.clone(), source };
+        match &self.mesh {
+            MeshSource::Sponza => {
+                if self.crease_angle.is_some_and(|a| a != DEFAULT_CREASE_ANGLE) {
+                    let mut mesh = Mesh::sponza().map_err(wrap)?;
+                    mesh.compute_normals(self.crease_angle.unwrap_or(DEFAULT_CREASE_ANGLE));
+                    Ok(Arc::new(mesh))
+                } else {
+                    crate::mesh::sponza_shared().map_err(wrap)
+                }
+            }
+            MeshSource::File(file) => {
+                let mut mesh = Mesh::load(file).map_err(wrap)?;
+                if let Some(angle) = self.crease_angle {
+                    mesh.compute_normals(angle);
+                }
+                Ok(Arc::new(mesh))
+            }
+        }
+    }
+
+    /// The camera: the file's, else Sponza's default, else one that frames
+    /// the mesh's bounds for the given aspect ratio.
+    pub fn camera_for(&self, mesh: &Mesh, aspect: f32) -> Camera {
+        match (&self.camera, &self.mesh) {
+            (Some(c), _) => *c,
+            (None, MeshSource::Sponza) => Scene::sponza_camera(),
+            (None, MeshSource::File(_)) => match mesh.bounds() {
+                Some(b) => Camera::frame(&b, DEFAULT_FOV, aspect),
+                None => Camera::look_at([0.0, 0.0, 5.0], [0.0; 3], DEFAULT_FOV),
+            },
+        }
+    }
+
+    /// Rasterises the scene: G-buffer textures (see [`crate::raster`]) and the camera used.
+    pub fn textures_on(
+        &self,
+        gpu: &Gpu,
+        size: (u32, u32),
+    ) -> Result<(Vec<(String, wgpu::Texture)>, Camera), SceneFileError> {
+        let mesh = self.load_mesh()?;
+        let camera = self.camera_for(&mesh, size.0 as f32 / size.1.max(1) as f32);
+        let raster = |source| SceneFileError::Raster { path: self.path.clone(), source };
+        let rasterizer = Rasterizer::new(gpu).map_err(raster)?;
+        let uploaded = rasterizer.upload(gpu, &mesh).map_err(raster)?;
+        let textures = rasterizer.render(gpu, &uploaded, &camera, size).map_err(raster)?;
+        Ok((textures, camera))
+    }
+
+    /// Rasterises the scene and reads the G-buffer back.
+    pub fn render_on(&self, gpu: &Gpu, size: (u32, u32)) -> Result<GBuffer, SceneFileError> {
+        let (textures, _) = self.textures_on(gpu, size)?;
+        crate::raster::read_gbuffer(gpu, &textures)
+            .map_err(|source| SceneFileError::Raster { path: self.path.clone(), source })
+    }
+}
+
+/// A single number.
+fn scalar(v: &toml::Value) -> Option<f64> {
+    v.as_float().or_else(|| v.as_integer().map(|i| i as f64))
+}
+
+/// A number, a bool, or a (nested) array of them, flattened.
+fn numbers(v: &toml::Value) -> Option<Vec<f64>> {
+    match v {
+        toml::Value::Integer(i) => Some(vec![*i as f64]),
+        toml::Value::Float(f) => Some(vec![*f]),
+        toml::Value::Boolean(b) => Some(vec![if *b { 1.0 } else { 0.0 }]),
+        toml::Value::Array(items) => {
+            let mut out = vec![];
+            for item in items {
+                out.extend(numbers(item)?);
+            }
+            Some(out)
+        }
+        _ => None,
+    }
+}
+
+fn describe_value(v: &toml::Value) -> String {
+    match v {
+        toml::Value::Array(items) => format!("an array of {} item(s)", items.len()),
+        toml::Value::String(s) => format!("string {s:?}"),
+        toml::Value::Integer(i) => format!("integer {i}"),
+        toml::Value::Float(f) => format!("float {f}"),
+        toml::Value::Boolean(b) => format!("boolean {b}"),
+        toml::Value::Datetime(d) => format!("datetime {d}"),
+        toml::Value::Table(_) => "a table".into(),
+    }
+}
