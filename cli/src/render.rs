@@ -144,8 +144,15 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
                 None => PathBuf::from(format!("{stem}.{mode}.heatmap.png")),
             };
             if let Some(rate) = shader.rate_image() {
-                save_heatmap(&gpu, rate, shader.layout().stats.counters.len(), &path)?;
-                written.push(path);
+                let counters = shader.layout().stats.counters.clone();
+                save_heatmap(&gpu, rate, counters.len(), None, &path)?;
+                written.push(path.clone());
+                // One map per coarse effect: where that effect was evaluated per pixel.
+                for (bit, effect) in counters.iter().enumerate().take(32) {
+                    let per_effect = with_suffix(&path, &format!(".{effect}"));
+                    save_heatmap(&gpu, rate, counters.len(), Some(bit as u32), &per_effect)?;
+                    written.push(per_effect);
+                }
             }
         }
         if args.stats || args.output.is_none() {
@@ -263,14 +270,21 @@ fn save_output(gpu: &Gpu, texture: &wgpu::Texture, path: &Path) -> Result<(), St
 /// style of He et al.'s heatmaps: blue = every coarse effect resampled from
 /// the first (2x2 or 4x4) level, green = some taken from the dynamic mode's
 /// 2x2 level, then yellow to red as the fraction evaluated per pixel grows.
-fn save_heatmap(gpu: &Gpu, rate: &wgpu::Texture, effects: usize, path: &Path) -> Result<(), String> {
+fn save_heatmap(gpu: &Gpu, rate: &wgpu::Texture, effects: usize, only: Option<u32>, path: &Path) -> Result<(), String> {
     let (w, h) = (rate.width(), rate.height());
     let bytes = gpu.read_texture(rate).map_err(|e| e.to_string())?;
     let mut img = image::RgbImage::new(w, h);
     let counted = effects.clamp(1, 32) as f32;
     for (i, b) in bytes.chunks_exact(8).enumerate() {
-        let mask = u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
-        let level2 = u32::from_le_bytes([b[4], b[5], b[6], b[7]]);
+        let mut mask = u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+        let mut level2 = u32::from_le_bytes([b[4], b[5], b[6], b[7]]);
+        let mut counted = counted;
+        if let Some(bit) = only {
+            // A single effect: red where it was evaluated per pixel.
+            mask = (mask >> bit) & 1;
+            level2 = (level2 >> bit) & 1;
+            counted = 1.0;
+        }
         let f = mask.count_ones() as f32 / counted;
         let (r, g, bl) = if f <= 0.0 && level2 != 0 {
             (60, 190, 80)

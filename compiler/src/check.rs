@@ -809,6 +809,42 @@ impl<'a> Checker<'a> {
         }
     }
 
+    /// Whether an expression is made only of literals and constants (WGSL
+    /// evaluates such expressions when the shader is created).
+    fn is_constant(&self, e: &Expr) -> bool {
+        let mut constant = true;
+        crate::deriv::visit_expr(e, &mut |x| match &x.kind {
+            ExprKind::Name(n) => constant &= matches!(self.globals.get(n), Some((Global::Const(_), _))),
+            ExprKind::Call { callee, .. } => constant &= Type::from_name(&callee.name).is_some(),
+            ExprKind::Index { .. } | ExprKind::Field { .. } | ExprKind::Ternary(..) => constant = false,
+            _ => {}
+        });
+        constant
+    }
+
+    /// Reports a constant expression whose value does not fit its type (as
+    /// WGSL would at shader creation); returns whether it fits.
+    fn constant_in_range(&mut self, e: &Expr, ty: &Type) -> bool {
+        let Some(value) = self.const_eval(e) else { return true };
+        let fits = |x: f64| match ty.scalar() {
+            _ if *ty == Type::AbstractInt => (i32::MIN as f64..=i32::MAX as f64).contains(&x),
+            Some(Scalar::Int) => (i32::MIN as f64..=i32::MAX as f64).contains(&x),
+            Some(Scalar::Uint) => (0.0..=u32::MAX as f64).contains(&x),
+            Some(Scalar::Float) => x.is_finite() && x.abs() <= f32::MAX as f64,
+            _ => true,
+        };
+        if value.values.iter().all(|x| fits(*x)) {
+            return true;
+        }
+        let what = if value.values.iter().any(|x| x.is_infinite() || x.is_nan()) {
+            "divides by zero or overflows"
+        } else {
+            "out of range"
+        };
+        self.error(err("E0205", format!("constant expression out of range for `{}`", ty.concretize()), e.span, what));
+        false
+    }
+
     // ---- Bodies -------------------------------------------------------------
 
     fn check_bodies(&mut self) {
@@ -1359,9 +1395,14 @@ impl<'a> Checker<'a> {
                 match binary_type(*op, &ta, &tb) {
                     // WGSL folds literal-only arithmetic at shader creation;
                     // what it would reject must be reported here.
-                    Ok(t) if t.is_abstract() => {
+                    // WGSL folds constant arithmetic (literals, typed or not) at
+                    // shader creation; what it would reject is reported here.
+                    Ok(t) if self.is_constant(a) && self.is_constant(b) => {
+                        let integer = matches!(t.scalar(), Some(Scalar::Int | Scalar::Uint)) && !t.is_abstract()
+                            || t == Type::AbstractInt;
                         if matches!(op, BinaryOp::Div | BinaryOp::Rem)
-                            && self.const_eval(b).is_some_and(|v| v.values.iter().all(|x| *x == 0.0))
+                            && integer
+                            && self.const_eval(b).is_some_and(|v| v.values.iter().any(|x| *x == 0.0))
                         {
                             self.error(err(
                                 "E0205",
@@ -1371,15 +1412,8 @@ impl<'a> Checker<'a> {
                             ));
                             return Type::Error;
                         }
-                        if let Some(v) = self.const_eval(e) {
-                            let bad = v.values.iter().any(|x| {
-                                !x.is_finite()
-                                    || (t == Type::AbstractInt && (*x > i32::MAX as f64 || *x < i32::MIN as f64))
-                            });
-                            if bad {
-                                self.error(err("E0205", "constant expression out of range", e.span, "overflows"));
-                                return Type::Error;
-                            }
+                        if !self.constant_in_range(e, &t) {
+                            return Type::Error;
                         }
                         t
                     }
@@ -1621,6 +1655,16 @@ impl<'a> Checker<'a> {
         if let Some(ty) = Type::from_name(name) {
             self.out.callees.insert(e.id, Callee::Construct(ty.clone()));
             return match construct_check(&ty, &arg_types) {
+                Ok(()) if args.iter().all(|a| self.is_constant(a)) => {
+                    // `uint(-1)` and friends: WGSL rejects them when creating the shader.
+                    let negative_to_uint = ty.scalar() == Some(Scalar::Uint)
+                        && args.iter().any(|a| self.const_eval(a).is_some_and(|v| v.values.iter().any(|x| *x < 0.0)));
+                    if negative_to_uint {
+                        self.error(err("E0205", format!("`{name}` of a negative constant"), e.span, "out of range"));
+                        return Type::Error;
+                    }
+                    if self.constant_in_range(e, &ty) { ty } else { Type::Error }
+                }
                 Ok(()) => ty,
                 Err(message) => {
                     self.error(err("E0210", message, e.span, format!("in this `{name}` constructor")));
