@@ -67,13 +67,22 @@ pub enum SceneError {
 }
 
 impl Scene {
+    /// Parses a scene name; the patterns take parameters after colons:
+    /// `steps:COUNT` (default 8) and `sinusoid:ANGLE_DEGREES:PERIODS` (default 30:12).
     pub fn parse(name: &str) -> Option<Scene> {
-        Some(match name {
-            "demo" => Scene::Demo,
-            "gradient" => Scene::Gradient,
-            "steps" => Scene::Steps { count: 8 },
-            "sinusoid" => Scene::Sinusoid { angle: 30.0, frequency: 12.0 },
-            "sponza" => Scene::Sponza,
+        let mut parts = name.split(':');
+        let base = parts.next()?;
+        let args: Vec<f32> = parts.map(|p| p.parse::<f32>().ok().filter(|v| v.is_finite())).collect::<Option<_>>()?;
+        Some(match (base, args.as_slice()) {
+            ("demo", []) => Scene::Demo,
+            ("gradient", []) => Scene::Gradient,
+            ("steps", []) => Scene::Steps { count: 8 },
+            ("steps", [n]) if *n >= 1.0 && n.fract() == 0.0 && *n <= 4096.0 => Scene::Steps { count: *n as u32 },
+            ("sinusoid", []) => Scene::Sinusoid { angle: 30.0, frequency: 12.0 },
+            ("sinusoid", [angle, frequency]) if *frequency > 0.0 => {
+                Scene::Sinusoid { angle: *angle, frequency: *frequency }
+            }
+            ("sponza", []) => Scene::Sponza,
             _ => return None,
         })
     }

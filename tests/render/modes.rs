@@ -196,3 +196,46 @@ fn hand_made_gbuffer_reads_back() {
     }
     let _ = out.width;
 }
+
+/// Sinusoids at several angles and frequencies: a coarse effect that follows
+/// the oscillation refines where it bends fastest, and every mode stays
+/// within a tolerance of the reference that shrinks as the blocks shrink.
+#[test]
+fn sinusoids_at_many_angles_and_frequencies() {
+    let Some(gpu) = gpu() else { return };
+    let program = compile(
+        "in float3 normal;
+uniform float threshold = 0.08;
+coarse effect float shade {
+    shade = saturate(dot(normal, normalize(float3(0.3, 0.4, 0.85))));
+    if (fwidth(shade) > threshold) refine;
+}
+fine out float4 color = float4(shade, shade, shade, 1.0);",
+    );
+    // Periods stay above 8 pixels (the Nyquist limit of 4x4 sampling): a
+    // derivative taken between samples 4 pixels apart cannot see a pattern
+    // that repeats every 4 pixels, so no refine predicate can catch it.
+    let mut refined_4x4 = vec![];
+    for (angle, frequency) in [(0.0, 2.0), (30.0, 4.0), (45.0, 6.0), (80.0, 8.0)] {
+        let scene = mrsl_runtime::scene::Scene::parse(&format!("sinusoid:{angle}:{frequency}")).unwrap();
+        let gbuffer = scene.render(160, 96);
+        let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
+        for mode in COARSE_MODES {
+            let out = run(gpu, &program, &gbuffer, mode, false).unwrap();
+            let err = max_abs_diff(&out.pixels, &reference.pixels);
+            // Unrefined blocks change by at most `threshold` between corners per
+            // derivative step; bilinear resampling between them stays within a
+            // few thresholds of the truth. Blocks that bend more are refined.
+            assert!(err < 0.1, "sinusoid {angle}/{frequency} {mode}: error {err}");
+            if mode == Mode::Coarse4x4 {
+                refined_4x4.push(out.stats.effects[0].pixel_evaluations);
+            }
+        }
+    }
+    // Higher frequencies bend more between samples: refinement must grow.
+    assert!(
+        refined_4x4.windows(2).all(|w| w[0] <= w[1]) && refined_4x4[0] < refined_4x4[3],
+        "refined pixels by frequency: {refined_4x4:?}"
+    );
+    assert!(refined_4x4[0] < 160 * 96 / 2, "a slow sinusoid is mostly coarse: {refined_4x4:?}");
+}
