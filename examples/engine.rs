@@ -102,7 +102,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for (mode, file) in [(Mode::Dynamic, "engine.png"), (Mode::Reference, "engine-reference.png")] {
         // 4. The engine's frame: its own passes, then mrsl's, in one encoder.
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
-        shader.encode(&device, &queue, &mut encoder, &bindings, DispatchOptions { mode, force_refine: false })?;
+        shader.encode(&device, &queue, &mut encoder, &bindings, DispatchOptions::new(mode))?;
         let readback = copy_out(&device, &mut encoder, &color);
         queue.submit([encoder.finish()]);
         println!("{}", shader.read_stats(&device)?.table());

@@ -121,7 +121,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
                 &gpu.queue,
                 &mut encoder,
                 &bindings,
-                DispatchOptions { mode, force_refine: args.force_refine },
+                DispatchOptions { force_refine: args.force_refine, ..DispatchOptions::new(mode) },
             )
             .map_err(|e| e.to_string())?;
         gpu.queue.submit([encoder.finish()]);

@@ -42,7 +42,32 @@ pub struct Layout {
     /// The dynamic mode's second (2x2) level of coarse samples: records of
     /// `interface.stride_words + 1` words, the last being a validity tag.
     pub interface2: ResourceBinding,
+    /// The hierarchical (DACS) mode's buffers.
+    pub hierarchical: HierarchicalLayout,
     pub effects: Vec<EffectLayout>,
+}
+
+/// Buffers of the hierarchical mode (group 2): a record per pixel, the work
+/// lists of pixels to shade per level, and per-level counters that double as
+/// indirect dispatch arguments.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct HierarchicalLayout {
+    /// Per pixel: `flag_words` refine flags, `mask_words` "evaluated here" bits
+    /// (bit k = coarse effect k), then every live coarse effect's value.
+    pub values_binding: u32,
+    pub record_words: u32,
+    pub flag_words: u32,
+    pub mask_words: u32,
+    /// Word offset of each live coarse effect's value in a record, in stats-counter order.
+    pub value_offsets: Vec<u32>,
+    /// `array<u32>`: pixel indices to shade, level 1 to 4 one after another.
+    pub work_binding: u32,
+    /// `array<atomic<u32>>` of 4 words per level (index 0..4): the first counts queued pixels.
+    pub queue_binding: u32,
+    /// Indirect dispatch arguments (x, y, z, unused) per level (index 0..4), written by
+    /// the `hier_args_*` entry points only: bind group `args_group`, binding 0. It is
+    /// a separate group because a buffer cannot be indirect and writable in one dispatch.
+    pub args_group: u32,
 }
 
 /// Counters the fine kernel accumulates (when the program has live coarse effects).
@@ -177,7 +202,7 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface) -> L
     let control = ControlBlock {
         group: GROUP_RESOURCES,
         binding: BINDING_CONTROL,
-        size: 16,
+        size: 32,
         fields: vec![
             Field {
                 name: "size".into(),
@@ -200,6 +225,14 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface) -> L
                 ty: "uint".into(),
                 wgsl_type: "u32".into(),
                 offset: 12,
+                size: 4,
+                default: Some(vec![0.0]),
+            },
+            Field {
+                name: "similarity".into(),
+                ty: "float".into(),
+                wgsl_type: "f32".into(),
+                offset: 16,
                 size: 4,
                 default: Some(vec![0.0]),
             },
@@ -350,6 +383,31 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface) -> L
             group: GROUP_STAGE,
             binding: 3 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
             kind: "storage",
+        },
+        hierarchical: {
+            let outputs = checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32;
+            let coarse: Vec<&crate::check::EffectInfo> =
+                graph.order.iter().map(|e| &checked.effects[e.index()]).filter(|e| e.rate == Rate::Coarse).collect();
+            let mask_words = (coarse.len() as u32).div_ceil(32).max(1);
+            let mut offset = interface.flag_words + mask_words;
+            let value_offsets = coarse
+                .iter()
+                .map(|e| {
+                    let at = offset;
+                    offset += e.ty.components();
+                    at
+                })
+                .collect();
+            HierarchicalLayout {
+                values_binding: 0,
+                record_words: offset,
+                flag_words: interface.flag_words,
+                mask_words,
+                value_offsets,
+                work_binding: 4 + outputs,
+                queue_binding: 5 + outputs,
+                args_group: 3,
+            }
         },
         outputs,
         effects,

@@ -47,6 +47,8 @@ pub struct Options {
     pub reference: bool,
     /// The dynamic mode's kernels (4x4, refined to 2x2, then per pixel).
     pub dynamic: bool,
+    /// The hierarchical (DACS) mode's kernel.
+    pub hierarchical: bool,
     /// Name written in the header comment of every generated kernel.
     pub file_name: String,
 }
@@ -59,6 +61,7 @@ impl Default for Options {
             fine: true,
             reference: true,
             dynamic: true,
+            hierarchical: true,
             file_name: "program.mrsl".into(),
         }
     }
@@ -73,7 +76,10 @@ pub struct Kernel {
     pub kind: KernelKind,
     /// Coarse block size; `None` for the reference kernel.
     pub block_size: Option<u32>,
+    /// The main entry point.
     pub entry_point: &'static str,
+    /// Every entry point, in dispatch order (one for all but the hierarchical kernel).
+    pub entry_points: Vec<&'static str>,
     pub workgroup_size: [u32; 3],
     pub wgsl: String,
 }
@@ -90,7 +96,10 @@ pub struct Program {
 impl Program {
     /// The kernel of `kind` for block size `block` (ignored for the reference kernel).
     pub fn kernel(&self, kind: KernelKind, block: u32) -> Option<&Kernel> {
-        let any_block = matches!(kind, KernelKind::Reference | KernelKind::DynamicCoarse | KernelKind::DynamicFine);
+        let any_block = matches!(
+            kind,
+            KernelKind::Reference | KernelKind::DynamicCoarse | KernelKind::DynamicFine | KernelKind::Hierarchical
+        );
         self.kernels.iter().find(|k| k.kind == kind && (any_block || k.block_size == Some(block)))
     }
 }
@@ -155,6 +164,9 @@ pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnosti
         wanted.push((KernelKind::DynamicCoarse, Some(2)));
         wanted.push((KernelKind::DynamicFine, Some(4)));
     }
+    if options.hierarchical {
+        wanted.push((KernelKind::Hierarchical, None));
+    }
     let texts: Vec<(KernelKind, Option<u32>, String)> = wanted
         .into_iter()
         .map(|(kind, block)| (kind, block, wgsl::write_string(&inputs, kind, block.unwrap_or(1))))
@@ -183,6 +195,11 @@ pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnosti
             kind,
             block_size: block,
             entry_point: kind.entry_point(),
+            entry_points: if kind == KernelKind::Hierarchical {
+                wgsl::HIERARCHICAL_ENTRY_POINTS.to_vec()
+            } else {
+                vec![kind.entry_point()]
+            },
             workgroup_size: kind.workgroup_size(),
             wgsl,
         });

@@ -30,7 +30,29 @@ pub enum KernelKind {
     DynamicCoarse,
     /// Dynamic mode, per pixel: 4x4 value, else 2x2 value, else evaluated.
     DynamicFine,
+    /// Hierarchical (DACS) mode: one module with the entry points of every
+    /// level (see [`HIERARCHICAL_ENTRY_POINTS`]).
+    Hierarchical,
 }
+
+/// Entry points of the hierarchical kernel, in dispatch order: level 0, then
+/// for each level 1 to 4 classify, args and (indirect) shade, then final.
+pub const HIERARCHICAL_ENTRY_POINTS: [&str; 14] = [
+    "hier_level0",
+    "hier_classify_1",
+    "hier_args_1",
+    "hier_shade_1",
+    "hier_classify_2",
+    "hier_args_2",
+    "hier_shade_2",
+    "hier_classify_3",
+    "hier_args_3",
+    "hier_shade_3",
+    "hier_classify_4",
+    "hier_args_4",
+    "hier_shade_4",
+    "hier_final",
+];
 
 /// One level of coarse samples as the fine stage reads it.
 struct Level {
@@ -55,6 +77,7 @@ impl KernelKind {
             KernelKind::Reference => "reference",
             KernelKind::DynamicCoarse => "dynamic_coarse",
             KernelKind::DynamicFine => "dynamic_fine",
+            KernelKind::Hierarchical => "hierarchical",
         }
     }
     pub fn entry_point(self) -> &'static str {
@@ -64,6 +87,7 @@ impl KernelKind {
             KernelKind::Reference => "reference_main",
             KernelKind::DynamicCoarse => "dynamic_coarse_main",
             KernelKind::DynamicFine => "dynamic_fine_main",
+            KernelKind::Hierarchical => "hier_final",
         }
     }
     /// Whether the kernel runs per coarse sample (else per pixel).
@@ -185,6 +209,9 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
                 "dynamic mode, second level: one invocation per 2x2 coarse sample inside refined 4x4 blocks".to_string()
             }
             KernelKind::DynamicFine => "dynamic mode, fine kernel: 4x4, then 2x2, then per pixel".to_string(),
+            KernelKind::Hierarchical => {
+                "hierarchical (DACS) mode: every 4th pixel, then four levels interpolated or shaded".to_string()
+            }
         };
         self.line(
             0,
@@ -226,6 +253,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
                 self.pixel_entry();
             }
             KernelKind::Reference => self.pixel_entry(),
+            KernelKind::Hierarchical => self.hierarchical_entries(),
         }
     }
 
@@ -235,6 +263,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         self.line(1, "size: vec2<u32>,");
         self.line(1, "force_refine: u32,");
         self.line(1, "frame: u32,");
+        self.line(1, "similarity: f32, // hierarchical mode: largest neighbour variance still interpolated");
         self.line(0, "}");
         self.line(
             0,
@@ -333,9 +362,28 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
                     ),
                 );
             }
+            KernelKind::Hierarchical => {
+                let h = &l.hierarchical;
+                self.line(
+                    0,
+                    "// Hierarchical mode: per pixel record (flags, evaluated-mask, values), work lists, queues.",
+                );
+                for (binding, decl) in [
+                    (h.values_binding, "var<storage, read_write> mrsl_values: array<u32>;"),
+                    (h.work_binding, "var<storage, read_write> mrsl_work: array<u32>;"),
+                    (h.queue_binding, "var<storage, read_write> mrsl_queue: array<atomic<u32>>;"),
+                ] {
+                    self.line(0, format!("@group({}) @binding({binding}) {decl}", l.interface.group));
+                }
+                self.line(0, "// Indirect dispatch arguments, bound only for the `hier_args_*` entry points.");
+                self.line(
+                    0,
+                    format!("@group({}) @binding(0) var<storage, read_write> mrsl_args: array<u32>;", h.args_group),
+                );
+            }
             KernelKind::Reference => {}
         }
-        if self.kind.is_fine() && !self.coarse_live().is_empty() {
+        if (self.kind.is_fine() || self.kind == KernelKind::Hierarchical) && !self.coarse_live().is_empty() {
             self.line(
                 0,
                 "// Statistics: element k counts the pixels that re-evaluated coarse effect k (layout `stats`).",
@@ -1316,6 +1364,344 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         self.line(1, format!("for (var k = mrsl_li; k < {nc}u; k += {}u) {{", layout::TILE * layout::TILE));
         self.line(2, "atomicAdd(&mrsl_stats[k], atomicLoad(&mrsl_wg_stats[k]));");
         self.line(1, "}");
+        self.line(0, "}");
+    }
+
+    // ---- Hierarchical (DACS) kernel ------------------------------------------------
+
+    fn hierarchical_entries(&mut self) {
+        let c = self.checked();
+        let l = self.i.layout;
+        let h = &l.hierarchical;
+        let iface = self.i.interface;
+        let coarse = self.coarse_live();
+        let (fw, mw, rec) = (h.flag_words, h.mask_words, h.record_words);
+        self.line(0, format!("const MRSL_RECORD: u32 = {rec}u;"));
+        self.line(0, "");
+        self.line(0, "fn mrsl_rec(p: vec2<i32>) -> u32 {");
+        self.line(1, "return (u32(p.y) * mrsl_ctl.size.x + u32(p.x)) * MRSL_RECORD;");
+        self.line(0, "}");
+        self.line(0, "");
+        self.line(0, "// Pixels of a lattice starting at `start` with step `step` along one axis of length `n`.");
+        self.line(0, "fn mrsl_count(start: u32, step: u32, n: u32) -> u32 {");
+        self.line(1, "return select(0u, (n - start - 1u) / step + 1u, n > start);");
+        self.line(0, "}");
+        self.line(0, "");
+        self.line(0, "// Start of each level's work list: levels 1..4 take at most their dispatch grid's size.");
+        self.line(0, "fn mrsl_work_offset(level: u32) -> u32 {");
+        self.line(1, "let w = mrsl_ctl.size.x;");
+        self.line(1, "let h = mrsl_ctl.size.y;");
+        self.line(1, "let c1 = mrsl_count(2u, 4u, w) * mrsl_count(2u, 4u, h);");
+        self.line(1, "let c2 = mrsl_count(0u, 2u, w) * mrsl_count(0u, 2u, h);");
+        self.line(1, "let c3 = mrsl_count(1u, 2u, w) * mrsl_count(1u, 2u, h);");
+        self.line(
+            1,
+            "return select(select(select(0u, c1, level >= 2u), c1 + c2, level >= 3u), c1 + c2 + c3, level >= 4u);",
+        );
+        self.line(0, "}");
+        self.line(0, "");
+        // Value access.
+        for (k, &e) in coarse.iter().enumerate() {
+            let info = &c.effects[e.index()];
+            let offset = h.value_offsets[k];
+            self.line(0, format!("fn mrsl_hget_{}(p: vec2<i32>) -> {} {{", info.name, info.ty.wgsl()));
+            self.line(1, format!("let base = mrsl_rec(p) + {offset}u;"));
+            self.line(1, format!("return {};", unpack_words(&info.ty, "mrsl_values")));
+            self.line(0, "}");
+            self.line(0, format!("fn mrsl_hput_{}(p: vec2<i32>, v: {}) {{", info.name, info.ty.wgsl()));
+            self.line(1, format!("let base = mrsl_rec(p) + {offset}u;"));
+            for (j, word) in pack_words("v", &info.ty).iter().enumerate() {
+                self.line(1, format!("mrsl_values[base + {j}u] = {word};"));
+            }
+            self.line(0, "}");
+        }
+        self.line(0, "");
+        // Shading a pixel: the effects its mask names are evaluated, the others read.
+        self.line(0, "// Evaluates the coarse effects `mrsl_pos`'s mask names (reading the others) and stores");
+        self.line(0, "// their values and refine flags.");
+        self.line(0, "fn mrsl_shade(mrsl_pos: vec2<i32>) {");
+        self.line(1, "let mrsl_r0 = mrsl_rec(mrsl_pos);");
+        for w in 0..fw {
+            self.line(1, format!("var mrsl_flags{w} = 0u;"));
+        }
+        self.line(1, "let mrsl_force = mrsl_ctl.force_refine != 0u;");
+        for &e in &coarse {
+            let info = &c.effects[e.index()];
+            let k = self.coarse_index[&e];
+            let name = self.effect_name(e);
+            let mut args = vec!["mrsl_pos".to_string()];
+            if info.has_refine {
+                args.push(format!("&mrsl_r_{}", info.name));
+            }
+            args.extend(self.deps_params(e).into_iter().map(|d| self.effect_name(d)));
+            self.line(1, format!("var {name}: {};", info.ty.wgsl()));
+            self.line(1, format!("if ((mrsl_values[mrsl_r0 + {}u] & {}u) != 0u) {{", fw + k / 32, 1u32 << (k % 32)));
+            if info.has_refine {
+                self.line(2, format!("var mrsl_r_{} = false;", info.name));
+            }
+            self.line(2, format!("{name} = mrsl_eval_{}({});", info.name, args.join(", ")));
+            self.line(2, format!("mrsl_hput_{}(mrsl_pos, {name});", info.name));
+            if let Some(bit) = iface.refine_bit[e.index()] {
+                self.line(
+                    2,
+                    format!(
+                        "if (mrsl_r_{} || mrsl_force) {{ mrsl_flags{} |= {}u; }}",
+                        info.name,
+                        bit / 32,
+                        1u32 << (bit % 32)
+                    ),
+                );
+            }
+            self.line(1, "} else {");
+            self.line(2, format!("{name} = mrsl_hget_{}(mrsl_pos);", info.name));
+            self.line(1, "}");
+        }
+        for w in 0..fw {
+            self.line(1, format!("mrsl_values[mrsl_r0 + {w}u] = mrsl_flags{w};"));
+        }
+        self.line(0, "}");
+        self.line(0, "");
+        // Level 0.
+        self.line(0, "// Level 0: every 4th pixel in both directions is shaded.");
+        self.line(0, "@compute @workgroup_size(8, 8, 1)");
+        self.line(0, "fn hier_level0(@builtin(global_invocation_id) gid: vec3<u32>) {");
+        self.line(1, "let p = vec2<i32>(gid.xy) * 4;");
+        self.line(1, "if (any(p >= vec2<i32>(mrsl_ctl.size))) { return; }");
+        self.line(1, "let r = mrsl_rec(p);");
+        for w in 0..mw {
+            let bits = (coarse.len() as u32).saturating_sub(w * 32).min(32);
+            let mask = if bits == 32 { u32::MAX } else { (1u32 << bits) - 1 };
+            self.line(1, format!("mrsl_values[r + {}u] = {mask}u;", fw + w));
+        }
+        self.line(1, "mrsl_shade(p);");
+        self.line(0, "}");
+        self.line(0, "");
+        // Classification shared by the levels.
+        let keys: Vec<(usize, KeyCompare)> =
+            c.inputs.iter().enumerate().filter_map(|(i, x)| x.key.map(|k| (i, k))).collect();
+        self.line(0, "// Decides, per coarse effect, whether pixel `p` interpolates its four previous-level");
+        self.line(0, "// neighbours `n` (those inside the image) or is shaded; queues it for shading if any.");
+        self.line(0, "fn mrsl_classify(p: vec2<i32>, n: array<vec2<i32>, 4>, level: u32) {");
+        self.line(1, "let size = vec2<i32>(mrsl_ctl.size);");
+        self.line(1, "var ok: array<bool, 4>;");
+        self.line(1, "var q: array<vec2<i32>, 4>;");
+        self.line(1, "var total = 0.0;");
+        self.line(1, "for (var k = 0; k < 4; k++) {");
+        self.line(2, "ok[k] = all(n[k] >= vec2<i32>(0)) && all(n[k] < size);");
+        self.line(1, "}");
+        self.line(1, "// Neighbours come in opposite pairs (0, 1) and (2, 3); at a border only complete pairs");
+        self.line(1, "// are used, so interpolation stays centred (exact for linear values). A pixel with no");
+        self.line(1, "// complete pair is shaded.");
+        self.line(1, "let pair_a = ok[0] && ok[1];");
+        self.line(1, "let pair_b = ok[2] && ok[3];");
+        self.line(1, "ok = array<bool, 4>(pair_a, pair_a, pair_b, pair_b);");
+        self.line(1, "for (var k = 0; k < 4; k++) {");
+        self.line(2, "q[k] = select(p, n[k], ok[k]);");
+        self.line(2, "total += select(0.0, 1.0, ok[k]);");
+        self.line(1, "}");
+        self.line(1, "var disc = mrsl_ctl.force_refine != 0u || total == 0.0;");
+        for (i, key) in &keys {
+            let name = &c.inputs[*i].name;
+            let differs = |a: &str, b: &str| match key {
+                KeyCompare::Exact if c.inputs[*i].ty.components() == 1 => format!("({a} != {b})"),
+                KeyCompare::Exact => format!("any({a} != {b})"),
+                KeyCompare::Threshold { threshold } => format!("(distance({a}, {b}) > {})", float_literal(*threshold)),
+            };
+            self.line(1, format!("let k_{name} = mrsl_load_{name}(p);"));
+            self.line(1, "for (var k = 0; k < 4; k++) {");
+            self.line(
+                2,
+                format!(
+                    "disc = disc || (ok[k] && {});",
+                    differs(&format!("k_{name}"), &format!("mrsl_load_{name}(q[k])"))
+                ),
+            );
+            self.line(1, "}");
+        }
+        self.line(1, "let r = mrsl_rec(p);");
+        for w in 0..mw {
+            self.line(1, format!("var mask{w} = 0u;"));
+        }
+        for &e in &coarse {
+            let info = &c.effects[e.index()];
+            let k = self.coarse_index[&e];
+            let ty = info.ty.wgsl();
+            self.line(1, format!("// `{}`", info.name));
+            self.line(1, "{");
+            for j in 0..4 {
+                self.line(2, format!("let v{j} = mrsl_hget_{}(q[{j}]);", info.name));
+            }
+            let mut need = vec!["disc".to_string()];
+            if let Some(bit) = iface.refine_bit[e.index()] {
+                // The program's own predicate, as evaluated at the neighbours.
+                self.line(2, "var flagged = false;");
+                self.line(2, "for (var j = 0; j < 4; j++) {");
+                self.line(
+                    3,
+                    format!(
+                        "flagged = flagged || (ok[j] && (mrsl_values[mrsl_rec(q[j]) + {}u] & {}u) != 0u);",
+                        bit / 32,
+                        1u32 << (bit % 32)
+                    ),
+                );
+                self.line(2, "}");
+                need.push("flagged".into());
+            }
+            let interpolable = matches!(info.ty, Type::Scalar(Scalar::Float) | Type::Vector(Scalar::Float, _));
+            if interpolable {
+                let zero = format!("{ty}(0.0)");
+                let w = |j: usize| format!("select({zero}, v{j}, ok[{j}])");
+                self.line(2, format!("let mean = ({} + {} + {} + {}) / total;", w(0), w(1), w(2), w(3)));
+                let dev = |j: usize| format!("select({zero}, (v{j} - mean) * (v{j} - mean), ok[{j}])");
+                self.line(2, format!("let variance = ({} + {} + {} + {}) / total;", dev(0), dev(1), dev(2), dev(3)));
+                let spread = match info.ty.components() {
+                    1 => "variance".to_string(),
+                    2 => "max(variance.x, variance.y)".to_string(),
+                    3 => "max(max(variance.x, variance.y), variance.z)".to_string(),
+                    _ => "max(max(variance.x, variance.y), max(variance.z, variance.w))".to_string(),
+                };
+                need.push(format!("!({spread} <= mrsl_ctl.similarity)"));
+                self.line(2, format!("if ({}) {{", need.join(" || ")));
+                self.line(3, format!("mask{} |= {}u;", k / 32, 1u32 << (k % 32)));
+                self.line(2, "} else {");
+                self.line(3, format!("mrsl_hput_{}(p, mean);", info.name));
+                self.line(2, "}");
+            } else {
+                // Integer, bool and matrix values are copied only when every neighbour agrees.
+                let agree = if matches!(info.ty, Type::Matrix(_)) {
+                    "false".to_string()
+                } else {
+                    let eq = |j: usize| {
+                        if info.ty.components() == 1 {
+                            format!("(!ok[{j}] || v{j} == v0)")
+                        } else {
+                            format!("(!ok[{j}] || all(v{j} == v0))")
+                        }
+                    };
+                    format!("{} && {} && {}", eq(1), eq(2), eq(3))
+                };
+                need.push(format!("!({agree})"));
+                self.line(2, format!("if ({}) {{", need.join(" || ")));
+                self.line(3, format!("mask{} |= {}u;", k / 32, 1u32 << (k % 32)));
+                self.line(2, "} else {");
+                self.line(3, format!("mrsl_hput_{}(p, v0);", info.name));
+                self.line(2, "}");
+            }
+            self.line(1, "}");
+        }
+        for w in 0..fw {
+            self.line(1, format!("mrsl_values[r + {w}u] = 0u;"));
+        }
+        for w in 0..mw {
+            self.line(1, format!("mrsl_values[r + {}u] = mask{w};", fw + w));
+        }
+        let any: Vec<String> = (0..mw).map(|w| format!("mask{w}")).collect();
+        self.line(1, format!("if (({}) != 0u) {{", any.join(" | ")));
+        self.line(2, "let slot = atomicAdd(&mrsl_queue[level * 4u], 1u);");
+        self.line(2, "mrsl_work[mrsl_work_offset(level) + slot] = u32(p.y) * mrsl_ctl.size.x + u32(p.x);");
+        self.line(1, "}");
+        self.line(0, "}");
+        self.line(0, "");
+        // The four levels.
+        let levels: [(&str, &str, &str, [(i32, i32); 4]); 4] = [
+            (
+                "every 4th pixel offset by (2, 2), from its diagonal neighbours at distance 2",
+                "vec2<i32>(2) + vec2<i32>(gid.xy) * 4",
+                "true",
+                [(-2, -2), (2, 2), (2, -2), (-2, 2)],
+            ),
+            (
+                "the remaining pixels of the 2-grid, from axis neighbours at distance 2",
+                "vec2<i32>(gid.xy) * 2",
+                "((gid.x + gid.y) & 1u) == 1u",
+                [(-2, 0), (2, 0), (0, -2), (0, 2)],
+            ),
+            (
+                "odd pixels, from diagonal neighbours at distance 1",
+                "vec2<i32>(1) + vec2<i32>(gid.xy) * 2",
+                "true",
+                [(-1, -1), (1, 1), (1, -1), (-1, 1)],
+            ),
+            (
+                "the rest, from axis neighbours at distance 1",
+                "vec2<i32>(gid.xy)",
+                "((gid.x + gid.y) & 1u) == 1u",
+                [(-1, 0), (1, 0), (0, -1), (0, 1)],
+            ),
+        ];
+        for (index, (what, pixel, valid, offsets)) in levels.iter().enumerate() {
+            let level = index + 1;
+            self.line(0, format!("// Level {level}: {what}."));
+            self.line(0, "@compute @workgroup_size(8, 8, 1)");
+            self.line(0, format!("fn hier_classify_{level}(@builtin(global_invocation_id) gid: vec3<u32>) {{"));
+            self.line(1, format!("let p = {pixel};"));
+            self.line(1, format!("if (any(p >= vec2<i32>(mrsl_ctl.size)) || !({valid})) {{ return; }}"));
+            let n: Vec<String> = offsets.iter().map(|(x, y)| format!("p + vec2<i32>({x}, {y})")).collect();
+            self.line(1, format!("mrsl_classify(p, array<vec2<i32>, 4>({}), {level}u);", n.join(", ")));
+            self.line(0, "}");
+            self.line(0, "");
+            self.line(0, "@compute @workgroup_size(1, 1, 1)");
+            self.line(0, format!("fn hier_args_{level}() {{"));
+            self.line(1, format!("let count = atomicLoad(&mrsl_queue[{}u]);", level * 4));
+            self.line(1, format!("mrsl_args[{}u] = (count + 63u) / 64u;", level * 4));
+            self.line(1, format!("mrsl_args[{}u] = 1u;", level * 4 + 1));
+            self.line(1, format!("mrsl_args[{}u] = 1u;", level * 4 + 2));
+            self.line(0, "}");
+            self.line(0, "");
+            self.line(0, "// Shades the compacted work list of the level: every lane has a pixel to shade.");
+            self.line(0, "@compute @workgroup_size(64, 1, 1)");
+            self.line(0, format!("fn hier_shade_{level}(@builtin(global_invocation_id) gid: vec3<u32>) {{"));
+            self.line(1, format!("if (gid.x >= atomicLoad(&mrsl_queue[{}u])) {{ return; }}", level * 4));
+            self.line(1, format!("let index = mrsl_work[mrsl_work_offset({level}u) + gid.x];"));
+            self.line(1, "mrsl_shade(vec2<i32>(i32(index % mrsl_ctl.size.x), i32(index / mrsl_ctl.size.x)));");
+            self.line(0, "}");
+            self.line(0, "");
+        }
+        // Final pass: coarse values from the records, fine effects and outputs per pixel.
+        self.line(0, "fn mrsl_tile_pixel(wg: vec2<u32>, li: u32) -> vec2<i32> {");
+        self.line(1, "return vec2<i32>(wg * 8u + vec2<u32>(li % 8u, li / 8u));");
+        self.line(0, "}");
+        self.line(0, "");
+        self.line(0, "@compute @workgroup_size(64, 1, 1)");
+        self.line(
+            0,
+            "fn hier_final(@builtin(workgroup_id) mrsl_wg: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {",
+        );
+        self.line(1, "let mrsl_pos = mrsl_tile_pixel(mrsl_wg.xy, mrsl_li);");
+        let order = self.i.graph.order.clone();
+        let nc = coarse.len();
+        self.line(1, "if (all(mrsl_pos < mrsl_grid())) {");
+        if nc > 0 {
+            self.line(2, "let mrsl_r0 = mrsl_rec(mrsl_pos);");
+            self.line(2, format!("let mrsl_mask = mrsl_values[mrsl_r0 + {fw}u];"));
+            self.line(2, "textureStore(mrsl_rate, mrsl_pos, vec4<u32>(mrsl_mask, 0u, 0u, 1u));");
+            for k in 0..nc {
+                self.line(
+                    2,
+                    format!(
+                        "if ((mrsl_values[mrsl_r0 + {}u] & {}u) != 0u) {{ atomicAdd(&mrsl_wg_stats[{k}], 1u); }}",
+                        fw + k as u32 / 32,
+                        1u32 << (k % 32)
+                    ),
+                );
+            }
+        }
+        for &e in &order {
+            let info = &c.effects[e.index()];
+            if info.rate == Rate::Coarse {
+                self.line(2, format!("let {} = mrsl_hget_{}(mrsl_pos);", self.effect_name(e), info.name));
+            } else {
+                self.effect_chain(&[e], 2);
+            }
+        }
+        self.output_stores(&order, 2);
+        self.line(1, "}");
+        if nc > 0 {
+            self.line(1, "workgroupBarrier();");
+            self.line(1, format!("for (var k = mrsl_li; k < {nc}u; k += 64u) {{"));
+            self.line(2, "atomicAdd(&mrsl_stats[k], atomicLoad(&mrsl_wg_stats[k]));");
+            self.line(1, "}");
+        }
         self.line(0, "}");
     }
 

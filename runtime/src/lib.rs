@@ -14,7 +14,7 @@
 //! bindings.channels.insert("normal".into(), normal);
 //! bindings.outputs.insert("color".into(), color);
 //! let mut encoder = device.create_command_encoder(&Default::default());
-//! shader.encode(device, queue, &mut encoder, &bindings, DispatchOptions { mode: Mode::Coarse4x4, force_refine: false })?;
+//! shader.encode(device, queue, &mut encoder, &bindings, DispatchOptions::new(Mode::Coarse4x4))?;
 //! queue.submit([encoder.finish()]);
 //! let stats = shader.read_stats(device)?;
 //! println!("shaded {:.1}% of the reference's work", 100.0 * stats.shaded_fraction);
@@ -24,6 +24,7 @@
 mod error;
 pub mod gpu;
 pub mod mesh;
+pub mod metrics;
 pub mod raster;
 pub mod scene;
 pub mod scene_file;
@@ -46,10 +47,13 @@ pub enum Mode {
     /// He et al.'s DYNAMIC: 4x4 blocks; where refined, 2x2 blocks; where
     /// refined again, per pixel.
     Dynamic,
+    /// Mallett & Yuksel's DACS: every 4th pixel shaded, then four levels each
+    /// interpolated from previous-level neighbours or shaded (compacted work lists).
+    Hierarchical,
 }
 
 impl Mode {
-    pub const ALL: [Mode; 4] = [Mode::Reference, Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic];
+    pub const ALL: [Mode; 5] = [Mode::Reference, Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic, Mode::Hierarchical];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -57,13 +61,14 @@ impl Mode {
             Mode::Coarse2x2 => "coarse2x2",
             Mode::Coarse4x4 => "coarse4x4",
             Mode::Dynamic => "dynamic",
+            Mode::Hierarchical => "hierarchical",
         }
     }
 
     /// The (first) coarse block size, or `None` for per-pixel shading.
     pub fn block_size(self) -> Option<u32> {
         match self {
-            Mode::Reference => None,
+            Mode::Reference | Mode::Hierarchical => None,
             Mode::Coarse2x2 => Some(2),
             Mode::Coarse4x4 | Mode::Dynamic => Some(4),
         }

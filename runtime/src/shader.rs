@@ -30,6 +30,26 @@ pub struct DispatchOptions {
     /// Treat every refine predicate as true (and refine every coarse effect):
     /// the output must then equal the reference.
     pub force_refine: bool,
+    /// Hierarchical mode: a pixel is interpolated only while the variance of
+    /// its four neighbours' values (each component, linear) is at most this.
+    pub similarity: f32,
+}
+
+impl DispatchOptions {
+    /// Default similarity threshold of the hierarchical mode (variance, linear units).
+    pub const DEFAULT_SIMILARITY: f32 = 1e-3;
+
+    pub fn new(mode: Mode) -> DispatchOptions {
+        DispatchOptions { mode, force_refine: false, similarity: Self::DEFAULT_SIMILARITY }
+    }
+}
+
+/// Buffers of the hierarchical mode.
+struct HierBuffers {
+    values: wgpu::Buffer,
+    work: wgpu::Buffer,
+    queue: wgpu::Buffer,
+    args: wgpu::Buffer,
 }
 
 /// Timestamped passes: reference, coarse, fine, dynamic coarse 2x2.
@@ -49,6 +69,12 @@ pub struct Shader {
     gbuffer_layout: wgpu::BindGroupLayout,
     stage_layouts: HashMap<KernelKind, wgpu::BindGroupLayout>,
     pipelines: HashMap<(KernelKind, u32), wgpu::ComputePipeline>,
+    /// The hierarchical kernel's pipelines, by index in `HIERARCHICAL_ENTRY_POINTS`.
+    hierarchical: HashMap<usize, wgpu::ComputePipeline>,
+    /// Hierarchical mode buffers (values, work lists, queues) and the size they were made for.
+    hier_buffers: Option<(HierBuffers, (u32, u32))>,
+    args_group_layout: wgpu::BindGroupLayout,
+    queue_readback: wgpu::Buffer,
     control: wgpu::Buffer,
     uniforms: Option<wgpu::Buffer>,
     uniform_values: HashMap<String, Vec<f64>>,
@@ -82,10 +108,25 @@ impl Shader {
             KernelKind::Reference,
             KernelKind::DynamicCoarse,
             KernelKind::DynamicFine,
+            KernelKind::Hierarchical,
         ] {
             stage_layouts.insert(kind, stage_layout(device, &layout, kind));
         }
         let mut pipelines = HashMap::new();
+        let mut hierarchical = HashMap::new();
+        let args_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("mrsl hierarchical args"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: false },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
         for kernel in &program.kernels {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some(kernel.entry_point),
@@ -100,15 +141,33 @@ impl Shader {
                 ],
                 immediate_size: 0,
             });
-            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(kernel.entry_point),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(kernel.entry_point),
-                compilation_options: Default::default(),
-                cache: None,
+            // The hierarchical `args` entry points also see the indirect arguments (group 3).
+            let args_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("mrsl hierarchical args"),
+                bind_group_layouts: &[
+                    Some(&resources_layout),
+                    Some(&gbuffer_layout),
+                    Some(&stage_layouts[&kernel.kind]),
+                    Some(&args_group_layout),
+                ],
+                immediate_size: 0,
             });
-            pipelines.insert((kernel.kind, kernel.block_size.unwrap_or(1)), pipeline);
+            for (k, entry) in kernel.entry_points.iter().enumerate() {
+                let layout = if entry.starts_with("hier_args") { &args_layout } else { &pipeline_layout };
+                let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(entry),
+                    layout: Some(layout),
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    cache: None,
+                });
+                if kernel.kind == KernelKind::Hierarchical {
+                    hierarchical.insert(k, pipeline);
+                } else {
+                    pipelines.insert((kernel.kind, kernel.block_size.unwrap_or(1)), pipeline);
+                }
+            }
         }
         let control = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("mrsl control"),
@@ -167,6 +226,15 @@ impl Shader {
             gbuffer_layout,
             stage_layouts,
             pipelines,
+            hierarchical,
+            hier_buffers: None,
+            args_group_layout,
+            queue_readback: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("mrsl hierarchical queue readback"),
+                size: 80,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
             control,
             uniforms,
             uniform_values: HashMap::new(),
@@ -236,6 +304,19 @@ impl Shader {
         }
         if width > 16384 || height > 16384 {
             return Err(Error::BadSize { width, height, reason: "the largest supported side is 16384".into() });
+        }
+        if mode == Mode::Hierarchical {
+            let bytes = width as u64 * height as u64 * self.layout.hierarchical.record_words as u64 * 4;
+            if bytes > 128 << 20 {
+                return Err(Error::BadSize {
+                    width,
+                    height,
+                    reason: format!(
+                        "the hierarchical records would need {} MiB, more than a 128 MiB storage binding",
+                        bytes >> 20
+                    ),
+                });
+            }
         }
         if let Some(block) = mode.block_size() {
             let (nx, ny) = sample_grid(bindings.size, block);
@@ -323,12 +404,13 @@ impl Shader {
         let mode = options.mode;
         self.validate(bindings, mode)?;
         let (width, height) = bindings.size;
-        let mut control = [0u32; 4];
+        let mut control = [0u32; 8];
         control[0] = width;
         control[1] = height;
         control[2] = u32::from(options.force_refine);
         self.frame = self.frame.wrapping_add(1).max(1);
         control[3] = self.frame;
+        control[4] = options.similarity.to_bits();
         queue.write_buffer(&self.control, 0, bytemuck::cast_slice(&control));
         if let Some(buffer) = &self.uniforms {
             queue.write_buffer(buffer, 0, &self.uniform_bytes()?);
@@ -340,50 +422,60 @@ impl Shader {
             bindings.outputs.iter().map(|(k, t)| (k.as_str(), t.create_view(&Default::default()))).collect();
         encoder.clear_buffer(&self.stats, 0, None);
         let tiles = (width.div_ceil(mrsl::layout::TILE), height.div_ceil(mrsl::layout::TILE));
-        match mode.block_size() {
-            None => {
-                let stage = self.stage_group(device, KernelKind::Reference, None, None, &views);
-                self.pass(
-                    encoder,
-                    "mrsl reference",
-                    0,
-                    (KernelKind::Reference, 1),
-                    &[&resources, &gbuffer, &stage],
-                    tiles,
-                );
-            }
-            Some(block) => {
-                let interface = self.interface(device, block, false, bindings.size).clone();
-                self.ensure_rate_image(device, bindings.size);
-                let dynamic = mode == Mode::Dynamic;
-                let inner = if dynamic { Some(self.interface(device, 2, true, bindings.size).clone()) } else { None };
-                let coarse_stage = self.stage_group(device, KernelKind::Coarse, Some(&interface), None, &views);
-                let fine_kind = if dynamic { KernelKind::DynamicFine } else { KernelKind::Fine };
-                let fine_stage = self.stage_group(device, fine_kind, Some(&interface), inner.as_ref(), &views);
-                let (nx, ny) = sample_grid(bindings.size, block);
-                let coarse_groups = (nx.div_ceil(8), ny.div_ceil(8));
-                self.pass(
-                    encoder,
-                    "mrsl coarse",
-                    1,
-                    (KernelKind::Coarse, block),
-                    &[&resources, &gbuffer, &coarse_stage],
-                    coarse_groups,
-                );
-                if dynamic {
-                    let stage =
-                        self.stage_group(device, KernelKind::DynamicCoarse, Some(&interface), inner.as_ref(), &views);
-                    let (nx, ny) = sample_grid(bindings.size, 2);
+        if mode == Mode::Hierarchical {
+            self.encode_hierarchical(device, encoder, bindings, &resources, &gbuffer, &views);
+        } else {
+            match mode.block_size() {
+                None => {
+                    let stage = self.stage_group(device, KernelKind::Reference, None, None, &views);
                     self.pass(
                         encoder,
-                        "mrsl dynamic coarse 2x2",
-                        3,
-                        (KernelKind::DynamicCoarse, 2),
+                        "mrsl reference",
+                        0,
+                        (KernelKind::Reference, 1),
                         &[&resources, &gbuffer, &stage],
-                        (nx.div_ceil(8), ny.div_ceil(8)),
+                        tiles,
                     );
                 }
-                self.pass(encoder, "mrsl fine", 2, (fine_kind, block), &[&resources, &gbuffer, &fine_stage], tiles);
+                Some(block) => {
+                    let interface = self.interface(device, block, false, bindings.size).clone();
+                    self.ensure_rate_image(device, bindings.size);
+                    let dynamic = mode == Mode::Dynamic;
+                    let inner =
+                        if dynamic { Some(self.interface(device, 2, true, bindings.size).clone()) } else { None };
+                    let coarse_stage = self.stage_group(device, KernelKind::Coarse, Some(&interface), None, &views);
+                    let fine_kind = if dynamic { KernelKind::DynamicFine } else { KernelKind::Fine };
+                    let fine_stage = self.stage_group(device, fine_kind, Some(&interface), inner.as_ref(), &views);
+                    let (nx, ny) = sample_grid(bindings.size, block);
+                    let coarse_groups = (nx.div_ceil(8), ny.div_ceil(8));
+                    self.pass(
+                        encoder,
+                        "mrsl coarse",
+                        1,
+                        (KernelKind::Coarse, block),
+                        &[&resources, &gbuffer, &coarse_stage],
+                        coarse_groups,
+                    );
+                    if dynamic {
+                        let stage = self.stage_group(
+                            device,
+                            KernelKind::DynamicCoarse,
+                            Some(&interface),
+                            inner.as_ref(),
+                            &views,
+                        );
+                        let (nx, ny) = sample_grid(bindings.size, 2);
+                        self.pass(
+                            encoder,
+                            "mrsl dynamic coarse 2x2",
+                            3,
+                            (KernelKind::DynamicCoarse, 2),
+                            &[&resources, &gbuffer, &stage],
+                            (nx.div_ceil(8), ny.div_ceil(8)),
+                        );
+                    }
+                    self.pass(encoder, "mrsl fine", 2, (fine_kind, block), &[&resources, &gbuffer, &fine_stage], tiles);
+                }
             }
         }
         encoder.copy_buffer_to_buffer(&self.stats, 0, &self.stats_readback, 0, None);
@@ -396,6 +488,135 @@ impl Shader {
         }
         self.last = Some((options, bindings.size));
         Ok(())
+    }
+
+    /// The hierarchical mode: level 0, then per level classify, args and an
+    /// indirect shade over the compacted work list, then the final per-pixel pass.
+    fn encode_hierarchical(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        bindings: &Bindings,
+        resources: &wgpu::BindGroup,
+        gbuffer: &wgpu::BindGroup,
+        views: &HashMap<&str, wgpu::TextureView>,
+    ) {
+        let (w, h) = bindings.size;
+        self.ensure_rate_image(device, bindings.size);
+        self.ensure_hier_buffers(device, bindings.size);
+        let (buffers, _) = self.hier_buffers.as_ref().expect("created above");
+        encoder.clear_buffer(&buffers.queue, 0, None);
+        let l = &self.layout;
+        let hl = &l.hierarchical;
+        let rate_view = self.rate.as_ref().map(|(t, _)| t.create_view(&Default::default()));
+        let mut entries = vec![
+            wgpu::BindGroupEntry { binding: hl.values_binding, resource: buffers.values.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: hl.work_binding, resource: buffers.work.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: hl.queue_binding, resource: buffers.queue.as_entire_binding() },
+        ];
+        for o in &l.outputs {
+            entries.push(wgpu::BindGroupEntry {
+                binding: o.binding,
+                resource: wgpu::BindingResource::TextureView(&views[o.name.as_str()]),
+            });
+        }
+        if !l.stats.counters.is_empty() {
+            entries.push(wgpu::BindGroupEntry { binding: l.stats.binding, resource: self.stats.as_entire_binding() });
+            if let Some(view) = &rate_view {
+                entries.push(wgpu::BindGroupEntry {
+                    binding: l.rate_image.binding,
+                    resource: wgpu::BindingResource::TextureView(view),
+                });
+            }
+        }
+        let stage = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("mrsl hierarchical"),
+            layout: &self.stage_layouts[&KernelKind::Hierarchical],
+            entries: &entries,
+        });
+        let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("mrsl hierarchical args"),
+            layout: &self.args_group_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffers.args.as_entire_binding() }],
+        });
+        let count = |start: u32, step: u32, n: u32| if n > start { (n - start - 1) / step + 1 } else { 0 };
+        let groups = |x: u32, y: u32| (x.div_ceil(8).max(1), y.div_ceil(8).max(1));
+        let lattices = [
+            groups(count(2, 4, w), count(2, 4, h)),
+            groups(count(0, 2, w), count(0, 2, h)),
+            groups(count(1, 2, w), count(1, 2, h)),
+            groups(w, h),
+        ];
+        {
+            let timestamp_writes = self.timestamps.as_ref().map(|t| wgpu::ComputePassTimestampWrites {
+                query_set: &t.set,
+                beginning_of_pass_write_index: Some(2),
+                end_of_pass_write_index: Some(3),
+            });
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("mrsl hierarchical levels"),
+                timestamp_writes,
+            });
+            pass.set_bind_group(0, Some(resources), &[]);
+            pass.set_bind_group(1, Some(gbuffer), &[]);
+            pass.set_bind_group(2, Some(&stage), &[]);
+            let (gx, gy) = groups(count(0, 4, w), count(0, 4, h));
+            pass.set_pipeline(&self.hierarchical[&0]);
+            pass.dispatch_workgroups(gx, gy, 1);
+            for (level, (gx, gy)) in lattices.iter().enumerate() {
+                let base = 1 + 3 * level;
+                pass.set_pipeline(&self.hierarchical[&base]);
+                pass.dispatch_workgroups(*gx, *gy, 1);
+                pass.set_pipeline(&self.hierarchical[&(base + 1)]);
+                pass.set_bind_group(3, Some(&args), &[]);
+                pass.dispatch_workgroups(1, 1, 1);
+                pass.set_pipeline(&self.hierarchical[&(base + 2)]);
+                pass.dispatch_workgroups_indirect(&buffers.args, 4 * (level as u64 + 1) * 4);
+            }
+        }
+        {
+            let timestamp_writes = self.timestamps.as_ref().map(|t| wgpu::ComputePassTimestampWrites {
+                query_set: &t.set,
+                beginning_of_pass_write_index: Some(4),
+                end_of_pass_write_index: Some(5),
+            });
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("mrsl hierarchical final"),
+                timestamp_writes,
+            });
+            pass.set_bind_group(0, Some(resources), &[]);
+            pass.set_bind_group(1, Some(gbuffer), &[]);
+            pass.set_bind_group(2, Some(&stage), &[]);
+            pass.set_pipeline(&self.hierarchical[&13]);
+            pass.dispatch_workgroups(w.div_ceil(mrsl::layout::TILE), h.div_ceil(mrsl::layout::TILE), 1);
+        }
+        encoder.copy_buffer_to_buffer(&buffers.queue, 0, &self.queue_readback, 0, None);
+    }
+
+    fn ensure_hier_buffers(&mut self, device: &wgpu::Device, size: (u32, u32)) {
+        if self.hier_buffers.as_ref().is_some_and(|(_, s)| *s == size) {
+            return;
+        }
+        let (w, h) = (size.0 as u64, size.1 as u64);
+        let count = |start: u64, step: u64, n: u64| if n > start { (n - start - 1) / step + 1 } else { 0 };
+        let work_words =
+            count(2, 4, w) * count(2, 4, h) + count(0, 2, w) * count(0, 2, h) + count(1, 2, w) * count(1, 2, h) + w * h;
+        let storage = |label, bytes: u64, extra| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(4),
+                usage: wgpu::BufferUsages::STORAGE | extra,
+                mapped_at_creation: false,
+            })
+        };
+        let record = self.layout.hierarchical.record_words as u64;
+        let buffers = HierBuffers {
+            values: storage("mrsl hierarchical values", w * h * record * 4, wgpu::BufferUsages::empty()),
+            work: storage("mrsl hierarchical work lists", work_words * 4, wgpu::BufferUsages::empty()),
+            queue: storage("mrsl hierarchical queues", 80, wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC),
+            args: storage("mrsl hierarchical dispatch arguments", 80, wgpu::BufferUsages::INDIRECT),
+        };
+        self.hier_buffers = Some((buffers, size));
     }
 
     fn pass(
@@ -564,13 +785,22 @@ impl Shader {
                 };
                 Some(match options.mode {
                     Mode::Reference => crate::Timings { coarse_ms: 0.0, coarse2_ms: 0.0, fine_ms: ms(0) },
+                    Mode::Hierarchical => crate::Timings { coarse_ms: ms(1), coarse2_ms: 0.0, fine_ms: ms(2) },
                     Mode::Dynamic => crate::Timings { coarse_ms: ms(1), coarse2_ms: ms(3), fine_ms: ms(2) },
                     _ => crate::Timings { coarse_ms: ms(1), coarse2_ms: 0.0, fine_ms: ms(2) },
                 })
             }
             None => None,
         };
-        Ok(Stats::new(&self.layout, options, size, &counters, timings))
+        let mut stats = Stats::new(&self.layout, options, size, &counters, timings);
+        if options.mode == Mode::Hierarchical {
+            let queue: Vec<u32> = read_buffer(device, &self.queue_readback)?;
+            stats.work_lists = (1..=4).map(|l| queue[4 * l] as u64).collect();
+            let queued: u64 = stats.work_lists.iter().sum();
+            let lanes: u64 = stats.work_lists.iter().map(|c| c.div_ceil(64) * 64).sum();
+            stats.lane_utilisation = Some(if lanes == 0 { 1.0 } else { queued as f64 / lanes as f64 });
+        }
+        Ok(stats)
     }
 
     /// Number of coarse samples for a size and block size (as the kernels compute it).
@@ -763,6 +993,11 @@ fn stage_layout(device: &wgpu::Device, l: &Layout, kind: KernelKind) -> wgpu::Bi
             entries.push(storage(l.interface.binding, true));
             entries.push(storage(l.interface2.binding, true));
         }
+        KernelKind::Hierarchical => {
+            entries.push(storage(l.hierarchical.values_binding, false));
+            entries.push(storage(l.hierarchical.work_binding, false));
+            entries.push(storage(l.hierarchical.queue_binding, false));
+        }
         KernelKind::Reference => {}
     }
     if !kind.is_coarse() {
@@ -779,7 +1014,7 @@ fn stage_layout(device: &wgpu::Device, l: &Layout, kind: KernelKind) -> wgpu::Bi
             });
         }
     }
-    if kind.is_fine() && !l.stats.counters.is_empty() {
+    if (kind.is_fine() || kind == KernelKind::Hierarchical) && !l.stats.counters.is_empty() {
         entries.push(storage(l.stats.binding, false));
         entries.push(wgpu::BindGroupLayoutEntry {
             binding: l.rate_image.binding,

@@ -39,6 +39,10 @@ pub struct Stats {
     /// Effect evaluations relative to the reference's (pixels x live effects).
     pub shaded_fraction: f64,
     pub timings: Option<Timings>,
+    /// Hierarchical mode: pixels queued for shading at levels 1 to 4.
+    pub work_lists: Vec<u64>,
+    /// Hierarchical mode: queued pixels / lanes dispatched to shade them.
+    pub lane_utilisation: Option<f64>,
 }
 
 impl Stats {
@@ -57,7 +61,12 @@ impl Stats {
         }
         let mut effects = vec![];
         for e in layout.effects.iter().filter(|e| e.live) {
+            let hierarchical = options.mode == crate::Mode::Hierarchical;
             let (coarse_evaluations, pixel_evaluations) = match (options.mode.block_size(), e.rate) {
+                (_, Rate::Coarse) if hierarchical => {
+                    let k = layout.stats.counters.iter().position(|c| *c == e.name);
+                    (0, k.map(|k| counters.get(k).copied().unwrap_or(0) as u64).unwrap_or(0))
+                }
                 (Some(_), Rate::Coarse) => {
                     let k = layout.stats.counters.iter().position(|c| *c == e.name);
                     (samples, k.map(|k| counters.get(k).copied().unwrap_or(0) as u64).unwrap_or(0))
@@ -85,6 +94,8 @@ impl Stats {
             effects,
             shaded_fraction,
             timings,
+            work_lists: vec![],
+            lane_utilisation: None,
         }
     }
 
@@ -117,6 +128,13 @@ impl Stats {
                 e.pixel_evaluations,
                 e.resampled,
                 100.0 * e.shaded_fraction
+            ));
+        }
+        if !self.work_lists.is_empty() {
+            out.push_str(&format!(
+                "  work lists (levels 1-4): {:?} pixels, lane utilisation {:.1}%\n",
+                self.work_lists,
+                100.0 * self.lane_utilisation.unwrap_or(0.0)
             ));
         }
         if let Some(t) = self.timings {

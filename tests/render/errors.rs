@@ -16,13 +16,7 @@ fine out float4 color = float4(d);
 
 fn dispatch(gpu: &Gpu, shader: &mut Shader, bindings: &Bindings) -> Result<(), Error> {
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    shader.encode(
-        &gpu.device,
-        &gpu.queue,
-        &mut encoder,
-        bindings,
-        DispatchOptions { mode: Mode::Coarse4x4, force_refine: false },
-    )
+    shader.encode(&gpu.device, &gpu.queue, &mut encoder, bindings, DispatchOptions::new(Mode::Coarse4x4))
 }
 
 #[test]

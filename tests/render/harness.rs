@@ -90,7 +90,13 @@ pub fn run(
         bindings.outputs.insert(name.clone(), t);
     }
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, DispatchOptions { mode, force_refine })?;
+    shader.encode(
+        &gpu.device,
+        &gpu.queue,
+        &mut encoder,
+        &bindings,
+        DispatchOptions { force_refine, ..DispatchOptions::new(mode) },
+    )?;
     gpu.queue.submit([encoder.finish()]);
     let stats = shader.read_stats(&gpu.device)?;
     let pixels = gpu.read_rgba32f(&outputs[0].1)?;

