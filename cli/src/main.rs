@@ -65,7 +65,7 @@ struct Render {
     /// Scene: demo, gradient, steps, sinusoid, sponza, or a .toml scene file (docs/scenes.md).
     #[arg(long, default_value = "demo")]
     scene: String,
-    /// reference, coarse2x2, coarse4x4, dynamic or all.
+    /// reference, coarse2x2, coarse4x4, dynamic, hierarchical or all.
     #[arg(long, default_value = "coarse4x4")]
     mode: String,
     /// Image size, WIDTHxHEIGHT (default: the scene file's, else 960x540).
@@ -86,6 +86,13 @@ struct Render {
     /// Force every refine predicate (the output must equal the reference).
     #[arg(long)]
     force_refine: bool,
+    /// Also render the reference and report RMSE, PSNR, MSSIM and FLIP of each mode
+    /// against it, writing PROGRAM.MODE.error.png.
+    #[arg(long)]
+    compare: bool,
+    /// Hierarchical mode: largest variance of four neighbours that is still interpolated.
+    #[arg(long, default_value_t = mrsl_runtime::DispatchOptions::DEFAULT_SIMILARITY)]
+    similarity: f32,
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq)]
@@ -139,6 +146,8 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
                 heatmap: r.heatmap.clone(),
                 stats: r.stats,
                 force_refine: r.force_refine,
+                compare: r.compare,
+                similarity: r.similarity,
             };
             match render::render(&args) {
                 Ok(paths) => {

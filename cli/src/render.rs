@@ -27,6 +27,19 @@ pub struct RenderArgs {
     pub heatmap: Option<PathBuf>,
     pub stats: bool,
     pub force_refine: bool,
+    /// Compare each mode's first output with the reference: metrics and an error image.
+    pub compare: bool,
+    /// The hierarchical mode's similarity threshold.
+    pub similarity: f32,
+}
+
+/// One mode's run, as written to the stats JSON.
+#[derive(serde::Serialize)]
+struct Run {
+    #[serde(flatten)]
+    stats: Stats,
+    /// Against the reference image (with `--compare`).
+    metrics: Option<mrsl_runtime::metrics::Metrics>,
 }
 
 fn progress(what: &str, start: Instant) {
@@ -111,22 +124,67 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
     }
 
     let mut written = vec![];
-    let mut all_stats: Vec<Stats> = vec![];
+    let mut all_stats: Vec<Run> = vec![];
+    let options = |mode| DispatchOptions {
+        force_refine: args.force_refine,
+        similarity: args.similarity,
+        ..DispatchOptions::new(mode)
+    };
+    let first_output = &outputs.first().ok_or("the program has no output")?.1;
+    let comparable = first_output.format() == wgpu::TextureFormat::Rgba32Float;
+    if args.compare && !comparable {
+        return Err("--compare needs the first output to be rgba32float".into());
+    }
+    // The reference image the other modes are compared with.
+    let mut reference: Option<Vec<[f32; 4]>> = None;
+    if args.compare && !args.modes.contains(&Mode::Reference) {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        shader
+            .encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options(Mode::Reference))
+            .map_err(|e| e.to_string())?;
+        gpu.queue.submit([encoder.finish()]);
+        reference = Some(gpu.read_rgba32f(first_output).map_err(|e| e.to_string())?);
+    }
     for &mode in &args.modes {
         let start = Instant::now();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        shader
-            .encode(
-                &gpu.device,
-                &gpu.queue,
-                &mut encoder,
-                &bindings,
-                DispatchOptions { force_refine: args.force_refine, ..DispatchOptions::new(mode) },
-            )
-            .map_err(|e| e.to_string())?;
+        shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options(mode)).map_err(|e| e.to_string())?;
         gpu.queue.submit([encoder.finish()]);
         let stats = shader.read_stats(&gpu.device).map_err(|e| e.to_string())?;
         progress(&format!("rendered {mode}"), start);
+        let mut metrics = None;
+        if args.compare {
+            let pixels = gpu.read_rgba32f(first_output).map_err(|e| e.to_string())?;
+            if mode == Mode::Reference {
+                reference = Some(pixels);
+            } else if let Some(reference) = &reference {
+                let start = Instant::now();
+                let m =
+                    mrsl_runtime::metrics::compare(&pixels, reference, size.0, size.1).map_err(|e| e.to_string())?;
+                progress(
+                    &format!(
+                        "{mode} vs reference: RMSE {:.5}, PSNR {:.2} dB, MSSIM {:.5}, FLIP {:.5}",
+                        m.rmse, m.psnr, m.mssim, m.flip
+                    ),
+                    start,
+                );
+                let error = mrsl_runtime::metrics::error_image(
+                    &pixels,
+                    reference,
+                    size.0,
+                    size.1,
+                    mrsl_runtime::metrics::DEFAULT_ERROR_SCALE,
+                )
+                .map_err(|e| e.to_string())?;
+                let path = PathBuf::from(format!("{stem}.{mode}.error.png"));
+                image::RgbaImage::from_raw(size.0, size.1, error)
+                    .ok_or("error image has the wrong size")?
+                    .save(&path)
+                    .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+                written.push(path);
+                metrics = Some(m);
+            }
+        }
         let suffix = if args.modes.len() > 1 || args.output.is_none() { format!(".{mode}") } else { String::new() };
         for (k, (name, texture)) in outputs.iter().enumerate() {
             let path = match (&args.output, k) {
@@ -138,7 +196,10 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
             save_output(&gpu, texture, &path)?;
             written.push(path);
         }
-        if mode != Mode::Reference && program.kernel(KernelKind::Fine, 4).is_some() {
+        if mode != Mode::Reference
+            && program.kernel(KernelKind::Fine, 4).is_some()
+            && !shader.layout().stats.counters.is_empty()
+        {
             let path = match &args.heatmap {
                 Some(p) => with_suffix(p, if args.modes.len() > 1 { &suffix } else { "" }),
                 None => PathBuf::from(format!("{stem}.{mode}.heatmap.png")),
@@ -158,7 +219,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
         if args.stats || args.output.is_none() {
             println!("{}", stats.table());
         }
-        all_stats.push(stats);
+        all_stats.push(Run { stats, metrics });
     }
     let stats_path = match &args.output {
         Some(p) => p.with_extension("stats.json"),
