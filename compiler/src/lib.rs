@@ -49,6 +49,8 @@ pub struct Options {
     pub dynamic: bool,
     /// The hierarchical (DACS) mode's kernel.
     pub hierarchical: bool,
+    /// The checkerboard baseline's kernel.
+    pub checkerboard: bool,
     /// Name written in the header comment of every generated kernel.
     pub file_name: String,
 }
@@ -62,6 +64,7 @@ impl Default for Options {
             reference: true,
             dynamic: true,
             hierarchical: true,
+            checkerboard: true,
             file_name: "program.mrsl".into(),
         }
     }
@@ -98,7 +101,11 @@ impl Program {
     pub fn kernel(&self, kind: KernelKind, block: u32) -> Option<&Kernel> {
         let any_block = matches!(
             kind,
-            KernelKind::Reference | KernelKind::DynamicCoarse | KernelKind::DynamicFine | KernelKind::Hierarchical
+            KernelKind::Reference
+                | KernelKind::DynamicCoarse
+                | KernelKind::DynamicFine
+                | KernelKind::Hierarchical
+                | KernelKind::Checkerboard
         );
         self.kernels.iter().find(|k| k.kind == kind && (any_block || k.block_size == Some(block)))
     }
@@ -167,6 +174,9 @@ pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnosti
     if options.hierarchical {
         wanted.push((KernelKind::Hierarchical, None));
     }
+    if options.checkerboard {
+        wanted.push((KernelKind::Checkerboard, None));
+    }
     let texts: Vec<(KernelKind, Option<u32>, String)> = wanted
         .into_iter()
         .map(|(kind, block)| (kind, block, wgsl::write_string(&inputs, kind, block.unwrap_or(1))))
@@ -195,10 +205,10 @@ pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnosti
             kind,
             block_size: block,
             entry_point: kind.entry_point(),
-            entry_points: if kind == KernelKind::Hierarchical {
-                wgsl::HIERARCHICAL_ENTRY_POINTS.to_vec()
-            } else {
-                vec![kind.entry_point()]
+            entry_points: match kind {
+                KernelKind::Hierarchical => wgsl::HIERARCHICAL_ENTRY_POINTS.to_vec(),
+                KernelKind::Checkerboard => vec!["cb_shade", "cb_final"],
+                _ => vec![kind.entry_point()],
             },
             workgroup_size: kind.workgroup_size(),
             wgsl,

@@ -33,6 +33,9 @@ pub enum KernelKind {
     /// Hierarchical (DACS) mode: one module with the entry points of every
     /// level (see [`HIERARCHICAL_ENTRY_POINTS`]).
     Hierarchical,
+    /// Checkerboard baseline: coarse effects shaded in half the 2x2 quads,
+    /// reconstructed in the others (entry points `cb_shade`, then `cb_final`).
+    Checkerboard,
 }
 
 /// Entry points of the hierarchical kernel, in dispatch order: level 0, then
@@ -78,6 +81,7 @@ impl KernelKind {
             KernelKind::DynamicCoarse => "dynamic_coarse",
             KernelKind::DynamicFine => "dynamic_fine",
             KernelKind::Hierarchical => "hierarchical",
+            KernelKind::Checkerboard => "checkerboard",
         }
     }
     pub fn entry_point(self) -> &'static str {
@@ -88,6 +92,7 @@ impl KernelKind {
             KernelKind::DynamicCoarse => "dynamic_coarse_main",
             KernelKind::DynamicFine => "dynamic_fine_main",
             KernelKind::Hierarchical => "hier_final",
+            KernelKind::Checkerboard => "cb_final",
         }
     }
     /// Whether the kernel runs per coarse sample (else per pixel).
@@ -212,6 +217,9 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             KernelKind::Hierarchical => {
                 "hierarchical (DACS) mode: every 4th pixel, then four levels interpolated or shaded".to_string()
             }
+            KernelKind::Checkerboard => {
+                "checkerboard baseline: half the 2x2 quads shaded, the rest reconstructed".to_string()
+            }
         };
         self.line(
             0,
@@ -254,6 +262,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             }
             KernelKind::Reference => self.pixel_entry(),
             KernelKind::Hierarchical => self.hierarchical_entries(),
+            KernelKind::Checkerboard => self.checkerboard_entries(),
         }
     }
 
@@ -362,6 +371,19 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
                     ),
                 );
             }
+            KernelKind::Checkerboard => {
+                self.line(
+                    0,
+                    "// Checkerboard mode: per pixel records of the coarse effects' values (layout `hierarchical`).",
+                );
+                self.line(
+                    0,
+                    format!(
+                        "@group({}) @binding({}) var<storage, read_write> mrsl_values: array<u32>;",
+                        l.interface.group, l.hierarchical.values_binding
+                    ),
+                );
+            }
             KernelKind::Hierarchical => {
                 let h = &l.hierarchical;
                 self.line(
@@ -383,7 +405,9 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             }
             KernelKind::Reference => {}
         }
-        if (self.kind.is_fine() || self.kind == KernelKind::Hierarchical) && !self.coarse_live().is_empty() {
+        if (self.kind.is_fine() || matches!(self.kind, KernelKind::Hierarchical | KernelKind::Checkerboard))
+            && !self.coarse_live().is_empty()
+        {
             self.line(
                 0,
                 "// Statistics: element k counts the pixels that re-evaluated coarse effect k (layout `stats`).",
@@ -943,6 +967,19 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         }
     }
 
+    /// Evaluates effect `e` into an already declared variable of its name.
+    fn effect_chain_into(&mut self, e: EffectId, indent: usize) {
+        let c = self.checked();
+        let info = &c.effects[e.index()];
+        let mut args = vec!["mrsl_pos".to_string()];
+        if info.has_refine {
+            self.line(indent, format!("var mrsl_r_{} = false;", info.name));
+            args.push(format!("&mrsl_r_{}", info.name));
+        }
+        args.extend(self.deps_params(e).into_iter().map(|d| self.effect_name(d)));
+        self.line(indent, format!("{} = mrsl_eval_{}({});", self.effect_name(e), info.name, args.join(", ")));
+    }
+
     /// Declares `mrsl_b` (and in the dynamic mode `mrsl_b2`) for the pixel at `mrsl_pos`.
     fn resolve_preamble(&mut self, indent: usize) {
         match self.kind {
@@ -1375,13 +1412,8 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         let h = &l.hierarchical;
         let iface = self.i.interface;
         let coarse = self.coarse_live();
-        let (fw, mw, rec) = (h.flag_words, h.mask_words, h.record_words);
-        self.line(0, format!("const MRSL_RECORD: u32 = {rec}u;"));
-        self.line(0, "");
-        self.line(0, "fn mrsl_rec(p: vec2<i32>) -> u32 {");
-        self.line(1, "return (u32(p.y) * mrsl_ctl.size.x + u32(p.x)) * MRSL_RECORD;");
-        self.line(0, "}");
-        self.line(0, "");
+        let (fw, mw) = (h.flag_words, h.mask_words);
+        self.record_helpers();
         self.line(0, "// Pixels of a lattice starting at `start` with step `step` along one axis of length `n`.");
         self.line(0, "fn mrsl_count(start: u32, step: u32, n: u32) -> u32 {");
         self.line(1, "return select(0u, (n - start - 1u) / step + 1u, n > start);");
@@ -1400,22 +1432,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         );
         self.line(0, "}");
         self.line(0, "");
-        // Value access.
-        for (k, &e) in coarse.iter().enumerate() {
-            let info = &c.effects[e.index()];
-            let offset = h.value_offsets[k];
-            self.line(0, format!("fn mrsl_hget_{}(p: vec2<i32>) -> {} {{", info.name, info.ty.wgsl()));
-            self.line(1, format!("let base = mrsl_rec(p) + {offset}u;"));
-            self.line(1, format!("return {};", unpack_words(&info.ty, "mrsl_values")));
-            self.line(0, "}");
-            self.line(0, format!("fn mrsl_hput_{}(p: vec2<i32>, v: {}) {{", info.name, info.ty.wgsl()));
-            self.line(1, format!("let base = mrsl_rec(p) + {offset}u;"));
-            for (j, word) in pack_words("v", &info.ty).iter().enumerate() {
-                self.line(1, format!("mrsl_values[base + {j}u] = {word};"));
-            }
-            self.line(0, "}");
-        }
-        self.line(0, "");
+
         // Shading a pixel: the effects its mask names are evaluated, the others read.
         self.line(0, "// Evaluates the coarse effects `mrsl_pos`'s mask names (reading the others) and stores");
         self.line(0, "// their values and refine flags.");
@@ -1690,6 +1707,172 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             let info = &c.effects[e.index()];
             if info.rate == Rate::Coarse {
                 self.line(2, format!("let {} = mrsl_hget_{}(mrsl_pos);", self.effect_name(e), info.name));
+            } else {
+                self.effect_chain(&[e], 2);
+            }
+        }
+        self.output_stores(&order, 2);
+        self.line(1, "}");
+        if nc > 0 {
+            self.line(1, "workgroupBarrier();");
+            self.line(1, format!("for (var k = mrsl_li; k < {nc}u; k += 64u) {{"));
+            self.line(2, "atomicAdd(&mrsl_stats[k], atomicLoad(&mrsl_wg_stats[k]));");
+            self.line(1, "}");
+        }
+        self.line(0, "}");
+    }
+
+    /// Per-pixel records of the hierarchical and checkerboard modes:
+    /// `mrsl_rec`, and `mrsl_hget_X` / `mrsl_hput_X` for every live coarse effect.
+    fn record_helpers(&mut self) {
+        let c = self.checked();
+        let h = &self.i.layout.hierarchical;
+        self.line(0, format!("const MRSL_RECORD: u32 = {}u;", h.record_words));
+        self.line(0, "");
+        self.line(0, "fn mrsl_rec(p: vec2<i32>) -> u32 {");
+        self.line(1, "return (u32(p.y) * mrsl_ctl.size.x + u32(p.x)) * MRSL_RECORD;");
+        self.line(0, "}");
+        self.line(0, "");
+        for (k, &e) in self.coarse_live().iter().enumerate() {
+            let info = &c.effects[e.index()];
+            let offset = h.value_offsets[k];
+            self.line(0, format!("fn mrsl_hget_{}(p: vec2<i32>) -> {} {{", info.name, info.ty.wgsl()));
+            self.line(1, format!("let base = mrsl_rec(p) + {offset}u;"));
+            self.line(1, format!("return {};", unpack_words(&info.ty, "mrsl_values")));
+            self.line(0, "}");
+            self.line(0, format!("fn mrsl_hput_{}(p: vec2<i32>, v: {}) {{", info.name, info.ty.wgsl()));
+            self.line(1, format!("let base = mrsl_rec(p) + {offset}u;"));
+            for (j, word) in pack_words("v", &info.ty).iter().enumerate() {
+                self.line(1, format!("mrsl_values[base + {j}u] = {word};"));
+            }
+            self.line(0, "}");
+        }
+        self.line(0, "");
+    }
+
+    // ---- Checkerboard kernel -------------------------------------------------------
+
+    fn checkerboard_entries(&mut self) {
+        let c = self.checked();
+        let coarse = self.coarse_live();
+        self.record_helpers();
+        self.line(0, "// Quad (qx, qy) of 2x2 pixels is shaded when qx + qy is even (a checkerboard of quads).");
+        self.line(0, "fn mrsl_shaded_quad(p: vec2<i32>) -> bool {");
+        self.line(1, "return ((p.x / 2 + p.y / 2) & 1) == 0;");
+        self.line(0, "}");
+        self.line(0, "");
+        self.line(0, "// One lane per pixel of the shaded quads only: 16 quads of 4 lanes per workgroup, along");
+        self.line(0, "// one row of quads (workgroup y), every other quad (shifted on odd rows).");
+        self.line(0, "@compute @workgroup_size(64, 1, 1)");
+        self.line(0, "fn cb_shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {");
+        self.line(1, "let qy = i32(wg.y);");
+        self.line(1, "// Forced refinement shades every quad (the runtime dispatches twice as many).");
+        self.line(1, "let k = i32(wg.x) * 16 + i32(li / 4u);");
+        self.line(1, "let qx = select(2 * k + (qy & 1), k, mrsl_ctl.force_refine != 0u);");
+        self.line(1, "let mrsl_pos = vec2<i32>(qx * 2 + i32(li % 2u), qy * 2 + i32((li / 2u) % 2u));");
+        self.line(1, "if (any(mrsl_pos >= mrsl_grid())) { return; }");
+        for &e in &coarse {
+            self.effect_chain(&[e], 1);
+            let info = &c.effects[e.index()];
+            self.line(1, format!("mrsl_hput_{}(mrsl_pos, {});", info.name, self.effect_name(e)));
+        }
+        self.line(0, "}");
+        self.line(0, "");
+        self.line(0, "// Reconstruction of a pixel in an unshaded quad from the pixels at the same place in the");
+        self.line(0, "// edge-adjacent quads, (x +- 2, y) and (x, y +- 2), which are all shaded. Taps across a");
+        self.line(0, "// discontinuity key are rejected, and only complete opposite pairs are used (a centred");
+        self.line(0, "// mean, exact for linear values). `ok` is all false when no pair is usable: the pixel is");
+        self.line(0, "// then shaded in place.");
+        self.line(0, "fn mrsl_taps(p: vec2<i32>) -> array<bool, 4> {");
+        self.line(1, "let size = vec2<i32>(mrsl_ctl.size);");
+        self.line(1, "let taps = array<vec2<i32>, 4>(p + vec2<i32>(-2, 0), p + vec2<i32>(2, 0), p + vec2<i32>(0, -2), p + vec2<i32>(0, 2));");
+        self.line(1, "var ok: array<bool, 4>;");
+        self.line(1, "for (var k = 0; k < 4; k++) {");
+        self.line(2, "ok[k] = all(taps[k] >= vec2<i32>(0)) && all(taps[k] < size);");
+        for input in c.inputs.iter() {
+            let Some(key) = input.key else { continue };
+            let name = &input.name;
+            let same = match key {
+                KeyCompare::Exact if input.ty.components() == 1 => {
+                    format!("mrsl_load_{name}(taps[k]) == mrsl_load_{name}(p)")
+                }
+                KeyCompare::Exact => format!("all(mrsl_load_{name}(taps[k]) == mrsl_load_{name}(p))"),
+                KeyCompare::Threshold { threshold } => {
+                    format!("distance(mrsl_load_{name}(taps[k]), mrsl_load_{name}(p)) <= {}", float_literal(threshold))
+                }
+            };
+            self.line(2, format!("ok[k] = ok[k] && ({same});"));
+        }
+        self.line(1, "}");
+        self.line(1, "let pair_x = ok[0] && ok[1];");
+        self.line(1, "let pair_y = ok[2] && ok[3];");
+        self.line(1, "// Without a complete pair the pixel is shaded in place: one-sided means would extrapolate.");
+        self.line(1, "return array<bool, 4>(pair_x, pair_x, pair_y, pair_y);");
+        self.line(0, "}");
+        self.line(0, "");
+        for &e in &coarse {
+            let info = &c.effects[e.index()];
+            let ty = info.ty.wgsl();
+            let blendable =
+                matches!(info.ty, Type::Scalar(Scalar::Float) | Type::Vector(Scalar::Float, _) | Type::Matrix(_));
+            self.line(0, format!("fn mrsl_reconstruct_{}(p: vec2<i32>, ok: array<bool, 4>) -> {ty} {{", info.name));
+            self.line(1, "let taps = array<vec2<i32>, 4>(p + vec2<i32>(-2, 0), p + vec2<i32>(2, 0), p + vec2<i32>(0, -2), p + vec2<i32>(0, 2));");
+            if blendable {
+                self.line(1, format!("var sum = {ty}();"));
+                self.line(1, "var n = 0.0;");
+                self.line(1, "for (var k = 0; k < 4; k++) {");
+                self.line(2, format!("if (ok[k]) {{ sum = sum + mrsl_hget_{}(taps[k]); n += 1.0; }}", info.name));
+                self.line(1, "}");
+                self.line(1, "return sum * (1.0 / n);");
+            } else {
+                self.line(1, "// Not blendable: the first usable tap.");
+                self.line(1, "for (var k = 0; k < 4; k++) {");
+                self.line(2, format!("if (ok[k]) {{ return mrsl_hget_{}(taps[k]); }}", info.name));
+                self.line(1, "}");
+                self.line(1, format!("return mrsl_hget_{}(p);", info.name));
+            }
+            self.line(0, "}");
+        }
+        self.line(0, "");
+        self.line(0, "fn mrsl_tile_pixel(wg: vec2<u32>, li: u32) -> vec2<i32> {");
+        self.line(1, "return vec2<i32>(wg * 8u + vec2<u32>(li % 8u, li / 8u));");
+        self.line(0, "}");
+        self.line(0, "");
+        self.line(0, "@compute @workgroup_size(64, 1, 1)");
+        self.line(
+            0,
+            "fn cb_final(@builtin(workgroup_id) mrsl_wg: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {",
+        );
+        self.line(1, "let mrsl_pos = mrsl_tile_pixel(mrsl_wg.xy, mrsl_li);");
+        let order = self.i.graph.order.clone();
+        let nc = coarse.len();
+        self.line(1, "if (all(mrsl_pos < mrsl_grid())) {");
+        self.line(2, "let mrsl_shaded = mrsl_shaded_quad(mrsl_pos) || mrsl_ctl.force_refine != 0u;");
+        self.line(2, "let mrsl_ok = mrsl_taps(mrsl_pos);");
+        self.line(2, "// No usable tap (isolated by discontinuities): shaded here instead.");
+        self.line(2, "let mrsl_alone = !mrsl_shaded && !(mrsl_ok[0] || mrsl_ok[1] || mrsl_ok[2] || mrsl_ok[3]);");
+        if nc > 0 {
+            let all = if nc >= 32 { u32::MAX } else { (1u32 << nc) - 1 };
+            self.line(2, format!("textureStore(mrsl_rate, mrsl_pos, vec4<u32>(select(0u, {all}u, mrsl_shaded || mrsl_alone), 0u, 0u, 1u));"));
+            self.line(2, "if (mrsl_shaded || mrsl_alone) {");
+            for k in 0..nc {
+                self.line(3, format!("atomicAdd(&mrsl_wg_stats[{k}], 1u);"));
+            }
+            self.line(2, "}");
+        }
+        for &e in &order {
+            let info = &c.effects[e.index()];
+            if info.rate == Rate::Coarse {
+                let name = self.effect_name(e);
+                self.line(2, format!("var {name}: {};", info.ty.wgsl()));
+                self.line(2, format!("if (mrsl_shaded) {{ {name} = mrsl_hget_{0}(mrsl_pos); }}", info.name));
+                self.line(
+                    2,
+                    format!("else if (!mrsl_alone) {{ {name} = mrsl_reconstruct_{0}(mrsl_pos, mrsl_ok); }}", info.name),
+                );
+                self.line(2, "else {");
+                self.effect_chain_into(e, 3);
+                self.line(2, "}");
             } else {
                 self.effect_chain(&[e], 2);
             }

@@ -35,7 +35,7 @@ pub enum Error {
     BadSize { width: u32, height: u32, reason: String },
     #[error("mode `{0}` is not supported by this program: {1}")]
     UnsupportedMode(String, String),
-    #[error("unknown mode `{0}` (expected reference, coarse2x2, coarse4x4, dynamic, hierarchical)")]
+    #[error("unknown mode `{0}` (expected reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard)")]
     UnknownMode(String),
     #[error("the device rejected a pipeline: {0}")]
     Pipeline(String),

@@ -50,10 +50,14 @@ pub enum Mode {
     /// Mallett & Yuksel's DACS: every 4th pixel shaded, then four levels each
     /// interpolated from previous-level neighbours or shaded (compacted work lists).
     Hierarchical,
+    /// The baseline DACS compares with: coarse effects shaded in half the 2x2
+    /// quads (a checkerboard), reconstructed in the others; not adaptive.
+    Checkerboard,
 }
 
 impl Mode {
-    pub const ALL: [Mode; 5] = [Mode::Reference, Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic, Mode::Hierarchical];
+    pub const ALL: [Mode; 6] =
+        [Mode::Reference, Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic, Mode::Hierarchical, Mode::Checkerboard];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -62,13 +66,14 @@ impl Mode {
             Mode::Coarse4x4 => "coarse4x4",
             Mode::Dynamic => "dynamic",
             Mode::Hierarchical => "hierarchical",
+            Mode::Checkerboard => "checkerboard",
         }
     }
 
     /// The (first) coarse block size, or `None` for per-pixel shading.
     pub fn block_size(self) -> Option<u32> {
         match self {
-            Mode::Reference | Mode::Hierarchical => None,
+            Mode::Reference | Mode::Hierarchical | Mode::Checkerboard => None,
             Mode::Coarse2x2 => Some(2),
             Mode::Coarse4x4 | Mode::Dynamic => Some(4),
         }

@@ -73,6 +73,10 @@ pub struct Shader {
     hierarchical: HashMap<usize, wgpu::ComputePipeline>,
     /// Hierarchical mode buffers (values, work lists, queues) and the size they were made for.
     hier_buffers: Option<(HierBuffers, (u32, u32))>,
+    /// The checkerboard kernel's pipelines: `cb_shade`, `cb_final`.
+    checkerboard: Vec<wgpu::ComputePipeline>,
+    /// Whether the dispatch being encoded forces refinement.
+    forced: bool,
     args_group_layout: wgpu::BindGroupLayout,
     queue_readback: wgpu::Buffer,
     control: wgpu::Buffer,
@@ -109,11 +113,13 @@ impl Shader {
             KernelKind::DynamicCoarse,
             KernelKind::DynamicFine,
             KernelKind::Hierarchical,
+            KernelKind::Checkerboard,
         ] {
             stage_layouts.insert(kind, stage_layout(device, &layout, kind));
         }
         let mut pipelines = HashMap::new();
         let mut hierarchical = HashMap::new();
+        let mut checkerboard = vec![];
         let args_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("mrsl hierarchical args"),
             entries: &[wgpu::BindGroupLayoutEntry {
@@ -164,6 +170,8 @@ impl Shader {
                 });
                 if kernel.kind == KernelKind::Hierarchical {
                     hierarchical.insert(k, pipeline);
+                } else if kernel.kind == KernelKind::Checkerboard {
+                    checkerboard.push(pipeline);
                 } else {
                     pipelines.insert((kernel.kind, kernel.block_size.unwrap_or(1)), pipeline);
                 }
@@ -228,6 +236,8 @@ impl Shader {
             pipelines,
             hierarchical,
             hier_buffers: None,
+            checkerboard,
+            forced: false,
             args_group_layout,
             queue_readback: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("mrsl hierarchical queue readback"),
@@ -305,7 +315,7 @@ impl Shader {
         if width > 16384 || height > 16384 {
             return Err(Error::BadSize { width, height, reason: "the largest supported side is 16384".into() });
         }
-        if mode == Mode::Hierarchical {
+        if matches!(mode, Mode::Hierarchical | Mode::Checkerboard) {
             let bytes = width as u64 * height as u64 * self.layout.hierarchical.record_words as u64 * 4;
             if bytes > 128 << 20 {
                 return Err(Error::BadSize {
@@ -409,6 +419,7 @@ impl Shader {
         control[1] = height;
         control[2] = u32::from(options.force_refine);
         self.frame = self.frame.wrapping_add(1).max(1);
+        self.forced = options.force_refine;
         control[3] = self.frame;
         control[4] = options.similarity.to_bits();
         queue.write_buffer(&self.control, 0, bytemuck::cast_slice(&control));
@@ -424,6 +435,8 @@ impl Shader {
         let tiles = (width.div_ceil(mrsl::layout::TILE), height.div_ceil(mrsl::layout::TILE));
         if mode == Mode::Hierarchical {
             self.encode_hierarchical(device, encoder, bindings, &resources, &gbuffer, &views);
+        } else if mode == Mode::Checkerboard {
+            self.encode_checkerboard(device, encoder, bindings, &resources, &gbuffer, &views);
         } else {
             match mode.block_size() {
                 None => {
@@ -591,6 +604,66 @@ impl Shader {
             pass.dispatch_workgroups(w.div_ceil(mrsl::layout::TILE), h.div_ceil(mrsl::layout::TILE), 1);
         }
         encoder.copy_buffer_to_buffer(&buffers.queue, 0, &self.queue_readback, 0, None);
+    }
+
+    /// The checkerboard baseline: shade the coarse effects in half the quads,
+    /// then reconstruct and finish every pixel.
+    fn encode_checkerboard(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        bindings: &Bindings,
+        resources: &wgpu::BindGroup,
+        gbuffer: &wgpu::BindGroup,
+        views: &HashMap<&str, wgpu::TextureView>,
+    ) {
+        let (w, h) = bindings.size;
+        self.ensure_rate_image(device, bindings.size);
+        self.ensure_hier_buffers(device, bindings.size);
+        let (buffers, _) = self.hier_buffers.as_ref().expect("created above");
+        let l = &self.layout;
+        let rate_view = self.rate.as_ref().map(|(t, _)| t.create_view(&Default::default()));
+        let mut entries = vec![wgpu::BindGroupEntry {
+            binding: l.hierarchical.values_binding,
+            resource: buffers.values.as_entire_binding(),
+        }];
+        for o in &l.outputs {
+            entries.push(wgpu::BindGroupEntry {
+                binding: o.binding,
+                resource: wgpu::BindingResource::TextureView(&views[o.name.as_str()]),
+            });
+        }
+        if !l.stats.counters.is_empty() {
+            entries.push(wgpu::BindGroupEntry { binding: l.stats.binding, resource: self.stats.as_entire_binding() });
+            if let Some(view) = &rate_view {
+                entries.push(wgpu::BindGroupEntry {
+                    binding: l.rate_image.binding,
+                    resource: wgpu::BindingResource::TextureView(view),
+                });
+            }
+        }
+        let stage = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("mrsl checkerboard"),
+            layout: &self.stage_layouts[&KernelKind::Checkerboard],
+            entries: &entries,
+        });
+        let timestamp_writes = self.timestamps.as_ref().map(|t| wgpu::ComputePassTimestampWrites {
+            query_set: &t.set,
+            beginning_of_pass_write_index: Some(2),
+            end_of_pass_write_index: Some(3),
+        });
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("mrsl checkerboard"), timestamp_writes });
+        pass.set_bind_group(0, Some(resources), &[]);
+        pass.set_bind_group(1, Some(gbuffer), &[]);
+        pass.set_bind_group(2, Some(&stage), &[]);
+        // cb_shade: 16 shaded quads per workgroup along a row of quads.
+        let (quads_x, quads_y) = (w.div_ceil(2), h.div_ceil(2));
+        pass.set_pipeline(&self.checkerboard[0]);
+        let shaded_per_row = if self.forced { quads_x } else { quads_x.div_ceil(2) };
+        pass.dispatch_workgroups(shaded_per_row.div_ceil(16).max(1), quads_y, 1);
+        pass.set_pipeline(&self.checkerboard[1]);
+        pass.dispatch_workgroups(w.div_ceil(mrsl::layout::TILE), h.div_ceil(mrsl::layout::TILE), 1);
     }
 
     fn ensure_hier_buffers(&mut self, device: &wgpu::Device, size: (u32, u32)) {
@@ -786,6 +859,7 @@ impl Shader {
                 Some(match options.mode {
                     Mode::Reference => crate::Timings { coarse_ms: 0.0, coarse2_ms: 0.0, fine_ms: ms(0) },
                     Mode::Hierarchical => crate::Timings { coarse_ms: ms(1), coarse2_ms: 0.0, fine_ms: ms(2) },
+                    Mode::Checkerboard => crate::Timings { coarse_ms: 0.0, coarse2_ms: 0.0, fine_ms: ms(1) },
                     Mode::Dynamic => crate::Timings { coarse_ms: ms(1), coarse2_ms: ms(3), fine_ms: ms(2) },
                     _ => crate::Timings { coarse_ms: ms(1), coarse2_ms: 0.0, fine_ms: ms(2) },
                 })
@@ -993,6 +1067,7 @@ fn stage_layout(device: &wgpu::Device, l: &Layout, kind: KernelKind) -> wgpu::Bi
             entries.push(storage(l.interface.binding, true));
             entries.push(storage(l.interface2.binding, true));
         }
+        KernelKind::Checkerboard => entries.push(storage(l.hierarchical.values_binding, false)),
         KernelKind::Hierarchical => {
             entries.push(storage(l.hierarchical.values_binding, false));
             entries.push(storage(l.hierarchical.work_binding, false));
@@ -1014,7 +1089,9 @@ fn stage_layout(device: &wgpu::Device, l: &Layout, kind: KernelKind) -> wgpu::Bi
             });
         }
     }
-    if (kind.is_fine() || kind == KernelKind::Hierarchical) && !l.stats.counters.is_empty() {
+    if (kind.is_fine() || matches!(kind, KernelKind::Hierarchical | KernelKind::Checkerboard))
+        && !l.stats.counters.is_empty()
+    {
         entries.push(storage(l.stats.binding, false));
         entries.push(wgpu::BindGroupLayoutEntry {
             binding: l.rate_image.binding,

@@ -61,7 +61,7 @@ impl Stats {
         }
         let mut effects = vec![];
         for e in layout.effects.iter().filter(|e| e.live) {
-            let hierarchical = options.mode == crate::Mode::Hierarchical;
+            let hierarchical = matches!(options.mode, crate::Mode::Hierarchical | crate::Mode::Checkerboard);
             let (coarse_evaluations, pixel_evaluations) = match (options.mode.block_size(), e.rate) {
                 (_, Rate::Coarse) if hierarchical => {
                     let k = layout.stats.counters.iter().position(|c| *c == e.name);

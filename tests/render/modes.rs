@@ -4,7 +4,8 @@ use crate::{compile, gpu, max_abs_diff, run, ulps};
 use mrsl_runtime::Mode;
 use mrsl_runtime::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
 
-const COARSE_MODES: [Mode; 4] = [Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic, Mode::Hierarchical];
+const COARSE_MODES: [Mode; 5] =
+    [Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic, Mode::Hierarchical, Mode::Checkerboard];
 
 fn examples() -> Vec<(String, String)> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
@@ -100,7 +101,9 @@ fn steps_keep_their_edges() {
             let err = max_abs_diff(&out.pixels, &reference.pixels);
             assert!(err <= 2e-7, "{w}x{h} {mode}: a step was blended (error {err})");
             let shade = &out.stats.effects[0];
-            assert!(shade.pixel_evaluations > 0 && shade.pixel_evaluations < (w * h) as u64 / 2, "{mode}: {shade:?}");
+            // Checkerboard shades half the quads by construction (plus border pixels).
+            let limit = if mode == Mode::Checkerboard { (w * h) as u64 * 3 / 4 } else { (w * h) as u64 / 2 };
+            assert!(shade.pixel_evaluations > 0 && shade.pixel_evaluations < limit, "{mode}: {shade:?}");
         }
     }
 }
@@ -127,7 +130,12 @@ fn silhouettes_are_never_blended() {
         let err = max_abs_diff(&out.pixels, &reference.pixels);
         assert!(err <= 2e-7, "{mode}: colours blended across a silhouette (error {err})");
         let tint = &out.stats.effects[0];
-        assert!(tint.resampled > tint.pixel_evaluations, "{mode}: most pixels should be resampled: {tint:?}");
+        // Checkerboard resamples about half; the adaptive modes most pixels.
+        let half = mode == Mode::Checkerboard;
+        assert!(
+            if half { tint.resampled * 2 >= tint.pixel_evaluations } else { tint.resampled > tint.pixel_evaluations },
+            "{mode}: too few pixels resampled: {tint:?}"
+        );
     }
     // The scene really has silhouettes next to the background.
     let Some(ChannelData::Uint(material)) = gbuffer.channel("material") else { panic!() };
@@ -161,22 +169,25 @@ fn shaded_fraction_falls_from_reference_to_coarse4x4() {
     let Some(gpu) = gpu() else { return };
     let program = compile(include_str!("../../examples/demo.mrsl"));
     let gbuffer = Scene::Demo.render(160, 96);
-    let fractions: Vec<f64> = [Mode::Reference, Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic, Mode::Hierarchical]
-        .into_iter()
-        .map(|mode| {
-            let out = run(gpu, &program, &gbuffer, mode, false).unwrap();
-            for e in &out.stats.effects {
-                assert_eq!(e.pixel_evaluations + e.resampled, 160 * 96, "{mode} {}", e.name);
-            }
-            out.stats.shaded_fraction
-        })
-        .collect();
+    let fractions: Vec<f64> =
+        [Mode::Reference, Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic, Mode::Hierarchical, Mode::Checkerboard]
+            .into_iter()
+            .map(|mode| {
+                let out = run(gpu, &program, &gbuffer, mode, false).unwrap();
+                for e in &out.stats.effects {
+                    assert_eq!(e.pixel_evaluations + e.resampled, 160 * 96, "{mode} {}", e.name);
+                }
+                out.stats.shaded_fraction
+            })
+            .collect();
     assert_eq!(fractions[0], 1.0);
     assert!(fractions[1] < 1.0 && fractions[2] < fractions[1], "{fractions:?}");
     // Dynamic refines 4x4 blocks to 2x2 before going per pixel: it shades
     // less than 2x2 everywhere (its first level is 4x4).
     assert!(fractions[3] < fractions[1], "{fractions:?}");
     assert!(fractions[4] < 1.0, "{fractions:?}");
+    // Checkerboard shades half the quads' coarse effects (plus isolated pixels).
+    assert!(fractions[5] < 1.0 && fractions[5] > fractions[2], "{fractions:?}");
 }
 
 /// A G-buffer made by hand, to check the runtime reads the engine's data
@@ -279,4 +290,20 @@ fn hierarchical_work_lists_keep_lanes_full() {
     let lanes = queued + partial_groups * 64;
     assert!(out.stats.lane_utilisation.unwrap() >= queued as f64 / lanes as f64);
     assert!(out.stats.lane_utilisation.unwrap() > 0.9, "{:?}", out.stats);
+}
+
+/// The checkerboard baseline reconstructs a linear ramp exactly from the
+/// centred pairs of taps, shading half the quads plus the border pixels that
+/// lack a complete pair.
+#[test]
+fn checkerboard_reconstructs_a_gradient_at_half_rate() {
+    let Some(gpu) = gpu() else { return };
+    let program = compile(GRADIENT);
+    let gbuffer = Scene::Gradient.render(128, 96);
+    let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
+    let out = run(gpu, &program, &gbuffer, Mode::Checkerboard, false).unwrap();
+    let err = max_abs_diff(&out.pixels, &reference.pixels);
+    assert!(err <= 5e-7, "checkerboard gradient error {err}");
+    let ramp = &out.stats.effects[0];
+    assert!((0.5..0.55).contains(&ramp.shaded_fraction), "{ramp:?}");
 }

@@ -34,8 +34,8 @@ fn ok_programs() {
         }
         assert_eq!(
             program.kernels.len(),
-            8,
-            "coarse+fine for 2x2 and 4x4, reference, two dynamic-mode kernels, hierarchical"
+            9,
+            "coarse+fine for 2x2 and 4x4, reference, two dynamic-mode kernels, hierarchical, checkerboard"
         );
         let mut snapshot = String::new();
         writeln!(snapshot, "----- SOURCE\n{}", source.trim_end()).unwrap();
