@@ -1373,7 +1373,9 @@ impl<'a> Checker<'a> {
                         matches!(t.scalar(), Some(Scalar::Int | Scalar::Uint)) && !matches!(t, Type::Matrix(_))
                     }
                 };
-                if ok {
+                if ok && matches!(op, UnaryOp::Neg) && self.is_constant(inner) && !self.constant_in_range(e, &t) {
+                    Type::Error
+                } else if ok {
                     t
                 } else {
                     let sym = match op {

@@ -129,12 +129,19 @@ pub fn write_string(inputs: &Inputs, kind: KernelKind, block: u32) -> String {
     w.out
 }
 
+/// Entry point names of the generated kernels (user names are kept clear of them).
+const ENTRY_POINT_NAMES: [&str; 6] =
+    ["coarse_main", "fine_main", "reference_main", "dynamic_coarse_main", "dynamic_fine_main", "cb_final"];
+
 /// Renames user identifiers that collide with WGSL keywords, WGSL builtins or
 /// the generated `mrsl_` namespace, so source names survive everywhere else.
 fn wgsl_ident(name: &str) -> String {
     let reserved = naga::keywords::wgsl::RESERVED.contains(&name)
         || naga::keywords::wgsl::BUILTIN_IDENTIFIERS.contains(&name)
         || name.to_ascii_lowercase().starts_with("mrsl")
+        || ENTRY_POINT_NAMES.contains(&name)
+        || name.starts_with("hier_")
+        || name.starts_with("cb_")
         || name.starts_with("__")
         || matches!(name, "u" | "pos");
     if reserved { format!("{name}_") } else { name.to_string() }

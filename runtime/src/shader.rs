@@ -309,11 +309,58 @@ impl Shader {
     /// Checks `bindings` against the layout.
     fn validate(&self, bindings: &Bindings, mode: Mode) -> Result<(), Error> {
         let (width, height) = bindings.size;
+        let missing = |what: &str| {
+            Err(Error::UnsupportedMode(mode.name().into(), format!("the program was compiled without {what}")))
+        };
+        match mode {
+            Mode::Reference if !self.pipelines.contains_key(&(KernelKind::Reference, 1)) => {
+                return missing("its reference kernel");
+            }
+            Mode::Coarse2x2 | Mode::Coarse4x4 | Mode::Dynamic => {
+                let block = mode.block_size().unwrap_or(4);
+                if !self.pipelines.contains_key(&(KernelKind::Coarse, block))
+                    || !self.pipelines.contains_key(&(KernelKind::Fine, block))
+                {
+                    return missing(&format!("{block}x{block} coarse and fine kernels"));
+                }
+                if mode == Mode::Dynamic
+                    && (!self.pipelines.contains_key(&(KernelKind::DynamicCoarse, 2))
+                        || !self.pipelines.contains_key(&(KernelKind::DynamicFine, 4)))
+                {
+                    return missing("the dynamic-mode kernels");
+                }
+            }
+            Mode::Hierarchical if self.hierarchical.is_empty() => return missing("the hierarchical kernel"),
+            Mode::Checkerboard if self.checkerboard.is_empty() => return missing("the checkerboard kernel"),
+            _ => {}
+        }
         if width == 0 || height == 0 {
             return Err(Error::BadSize { width, height, reason: "it is empty".into() });
         }
         if width > 16384 || height > 16384 {
             return Err(Error::BadSize { width, height, reason: "the largest supported side is 16384".into() });
+        }
+        if mode == Mode::Dynamic {
+            let (nx, ny) = sample_grid(bindings.size, 2);
+            let bytes = nx as u64 * ny as u64 * (self.layout.interface.stride_words as u64 + 1) * 4;
+            if bytes > 128 << 20 {
+                return Err(Error::BadSize {
+                    width,
+                    height,
+                    reason: format!(
+                        "the 2x2 level would need {} MiB, more than a 128 MiB storage binding",
+                        bytes >> 20
+                    ),
+                });
+            }
+        }
+        if mode == Mode::Hierarchical {
+            // Work lists hold about 1.56 words per pixel; a level's shading
+            // dispatch covers at most 65535 workgroups of 64 lanes.
+            let pixels = width as u64 * height as u64;
+            if pixels * 2 * 4 > 128 << 20 || pixels / 2 > 65535 * 64 {
+                return Err(Error::BadSize { width, height, reason: "the hierarchical work lists would exceed the storage or dispatch limits (about 4 million pixels per level)".into() });
+            }
         }
         if matches!(mode, Mode::Hierarchical | Mode::Checkerboard) {
             let bytes = width as u64 * height as u64 * self.layout.hierarchical.record_words as u64 * 4;

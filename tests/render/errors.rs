@@ -94,3 +94,20 @@ fn extra_channels_are_ignored() {
     let empty = GBuffer { width: 8, height: 8, channels: vec![] };
     assert_eq!(run(gpu, &program, &empty, Mode::Reference, false).err(), Some(Error::MissingChannel("depth".into())));
 }
+
+/// A mode whose kernels were not compiled is a typed error, not a panic.
+#[test]
+fn modes_without_kernels_are_unsupported() {
+    let Some(gpu) = gpu() else { return };
+    let source = "in float depth;\ncoarse effect float d = depth * 2.0;\nfine out float4 color = float4(d);";
+    let options = mrsl::Options { hierarchical: false, dynamic: false, block_sizes: vec![4], ..Default::default() };
+    let program = mrsl::compile(source, &options).unwrap();
+    let gbuffer = Scene::Gradient.render(8, 8);
+    for mode in [Mode::Hierarchical, Mode::Dynamic, Mode::Coarse2x2] {
+        assert!(
+            matches!(run(gpu, &program, &gbuffer, mode, false), Err(Error::UnsupportedMode(ref m, _)) if m == mode.name()),
+            "{mode}"
+        );
+    }
+    run(gpu, &program, &gbuffer, Mode::Coarse4x4, false).unwrap();
+}
