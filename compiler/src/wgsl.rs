@@ -1682,10 +1682,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             self.line(0, "");
         }
         // Final pass: coarse values from the records, fine effects and outputs per pixel.
-        self.line(0, "fn mrsl_tile_pixel(wg: vec2<u32>, li: u32) -> vec2<i32> {");
-        self.line(1, "return vec2<i32>(wg * 8u + vec2<u32>(li % 8u, li / 8u));");
-        self.line(0, "}");
-        self.line(0, "");
+        self.row_major_tile_pixel();
         self.line(0, "@compute @workgroup_size(64, 1, 1)");
         self.line(
             0,
@@ -1720,13 +1717,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         }
         self.output_stores(&order, 2);
         self.line(1, "}");
-        if nc > 0 {
-            self.line(1, "workgroupBarrier();");
-            self.line(1, format!("for (var k = mrsl_li; k < {nc}u; k += 64u) {{"));
-            self.line(2, "atomicAdd(&mrsl_stats[k], atomicLoad(&mrsl_wg_stats[k]));");
-            self.line(1, "}");
-        }
-        self.line(0, "}");
+        self.stats_flush(nc);
     }
 
     /// Per-pixel records of the hierarchical and checkerboard modes:
@@ -1841,10 +1832,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             self.line(0, "}");
         }
         self.line(0, "");
-        self.line(0, "fn mrsl_tile_pixel(wg: vec2<u32>, li: u32) -> vec2<i32> {");
-        self.line(1, "return vec2<i32>(wg * 8u + vec2<u32>(li % 8u, li / 8u));");
-        self.line(0, "}");
-        self.line(0, "");
+        self.row_major_tile_pixel();
         self.line(0, "@compute @workgroup_size(64, 1, 1)");
         self.line(
             0,
@@ -1886,9 +1874,23 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         }
         self.output_stores(&order, 2);
         self.line(1, "}");
-        if nc > 0 {
+        self.stats_flush(nc);
+    }
+
+    /// `mrsl_tile_pixel` for the record-based modes: an 8x8 tile in row-major lane order.
+    fn row_major_tile_pixel(&mut self) {
+        self.line(0, "fn mrsl_tile_pixel(wg: vec2<u32>, li: u32) -> vec2<i32> {");
+        self.line(1, "return vec2<i32>(wg * 8u + vec2<u32>(li % 8u, li / 8u));");
+        self.line(0, "}");
+        self.line(0, "");
+    }
+
+    /// Ends a per-pixel entry point: adds the workgroup's counters to the global
+    /// statistics once every lane has counted, then closes the function.
+    fn stats_flush(&mut self, counters: usize) {
+        if counters > 0 {
             self.line(1, "workgroupBarrier();");
-            self.line(1, format!("for (var k = mrsl_li; k < {nc}u; k += 64u) {{"));
+            self.line(1, format!("for (var k = mrsl_li; k < {counters}u; k += 64u) {{"));
             self.line(2, "atomicAdd(&mrsl_stats[k], atomicLoad(&mrsl_wg_stats[k]));");
             self.line(1, "}");
         }

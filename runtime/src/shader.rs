@@ -566,34 +566,7 @@ impl Shader {
         self.ensure_hier_buffers(device, bindings.size);
         let (buffers, _) = self.hier_buffers.as_ref().expect("created above");
         encoder.clear_buffer(&buffers.queue, 0, None);
-        let l = &self.layout;
-        let hl = &l.hierarchical;
-        let rate_view = self.rate.as_ref().map(|(t, _)| t.create_view(&Default::default()));
-        let mut entries = vec![
-            wgpu::BindGroupEntry { binding: hl.values_binding, resource: buffers.values.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: hl.work_binding, resource: buffers.work.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: hl.queue_binding, resource: buffers.queue.as_entire_binding() },
-        ];
-        for o in &l.outputs {
-            entries.push(wgpu::BindGroupEntry {
-                binding: o.binding,
-                resource: wgpu::BindingResource::TextureView(&views[o.name.as_str()]),
-            });
-        }
-        if !l.stats.counters.is_empty() {
-            entries.push(wgpu::BindGroupEntry { binding: l.stats.binding, resource: self.stats.as_entire_binding() });
-            if let Some(view) = &rate_view {
-                entries.push(wgpu::BindGroupEntry {
-                    binding: l.rate_image.binding,
-                    resource: wgpu::BindingResource::TextureView(view),
-                });
-            }
-        }
-        let stage = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("mrsl hierarchical"),
-            layout: &self.stage_layouts[&KernelKind::Hierarchical],
-            entries: &entries,
-        });
+        let stage = self.record_stage_group(device, KernelKind::Hierarchical, buffers, views);
         let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("mrsl hierarchical args"),
             layout: &self.args_group_layout,
@@ -668,32 +641,7 @@ impl Shader {
         self.ensure_rate_image(device, bindings.size);
         self.ensure_hier_buffers(device, bindings.size);
         let (buffers, _) = self.hier_buffers.as_ref().expect("created above");
-        let l = &self.layout;
-        let rate_view = self.rate.as_ref().map(|(t, _)| t.create_view(&Default::default()));
-        let mut entries = vec![wgpu::BindGroupEntry {
-            binding: l.hierarchical.values_binding,
-            resource: buffers.values.as_entire_binding(),
-        }];
-        for o in &l.outputs {
-            entries.push(wgpu::BindGroupEntry {
-                binding: o.binding,
-                resource: wgpu::BindingResource::TextureView(&views[o.name.as_str()]),
-            });
-        }
-        if !l.stats.counters.is_empty() {
-            entries.push(wgpu::BindGroupEntry { binding: l.stats.binding, resource: self.stats.as_entire_binding() });
-            if let Some(view) = &rate_view {
-                entries.push(wgpu::BindGroupEntry {
-                    binding: l.rate_image.binding,
-                    resource: wgpu::BindingResource::TextureView(view),
-                });
-            }
-        }
-        let stage = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("mrsl checkerboard"),
-            layout: &self.stage_layouts[&KernelKind::Checkerboard],
-            entries: &entries,
-        });
+        let stage = self.record_stage_group(device, KernelKind::Checkerboard, buffers, views);
         let timestamp_writes = self.timestamps.as_ref().map(|t| wgpu::ComputePassTimestampWrites {
             query_set: &t.set,
             beginning_of_pass_write_index: Some(2),
@@ -711,6 +659,48 @@ impl Shader {
         pass.dispatch_workgroups(shaded_per_row.div_ceil(16).max(1), quads_y, 1);
         pass.set_pipeline(&self.checkerboard[1]);
         pass.dispatch_workgroups(w.div_ceil(mrsl::layout::TILE), h.div_ceil(mrsl::layout::TILE), 1);
+    }
+
+    /// Group 2 of the modes that keep a record per pixel (hierarchical, checkerboard):
+    /// the records (and for the hierarchical mode its work lists and queues), the
+    /// outputs, the statistics and the rate image.
+    fn record_stage_group(
+        &self,
+        device: &wgpu::Device,
+        kind: KernelKind,
+        buffers: &HierBuffers,
+        views: &HashMap<&str, wgpu::TextureView>,
+    ) -> wgpu::BindGroup {
+        let l = &self.layout;
+        let hl = &l.hierarchical;
+        let rate_view = self.rate.as_ref().map(|(t, _)| t.create_view(&Default::default()));
+        let mut entries =
+            vec![wgpu::BindGroupEntry { binding: hl.values_binding, resource: buffers.values.as_entire_binding() }];
+        if kind == KernelKind::Hierarchical {
+            entries.push(wgpu::BindGroupEntry { binding: hl.work_binding, resource: buffers.work.as_entire_binding() });
+            entries
+                .push(wgpu::BindGroupEntry { binding: hl.queue_binding, resource: buffers.queue.as_entire_binding() });
+        }
+        for o in &l.outputs {
+            entries.push(wgpu::BindGroupEntry {
+                binding: o.binding,
+                resource: wgpu::BindingResource::TextureView(&views[o.name.as_str()]),
+            });
+        }
+        if !l.stats.counters.is_empty() {
+            entries.push(wgpu::BindGroupEntry { binding: l.stats.binding, resource: self.stats.as_entire_binding() });
+            if let Some(view) = &rate_view {
+                entries.push(wgpu::BindGroupEntry {
+                    binding: l.rate_image.binding,
+                    resource: wgpu::BindingResource::TextureView(view),
+                });
+            }
+        }
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(kind.name()),
+            layout: &self.stage_layouts[&kind],
+            entries: &entries,
+        })
     }
 
     fn ensure_hier_buffers(&mut self, device: &wgpu::Device, size: (u32, u32)) {
