@@ -36,7 +36,9 @@ enum Command {
     /// Compile a program to WGSL kernels and a layout description.
     ///
     /// Writes <name>.coarse.bB.wgsl, <name>.fine.bB.wgsl (B = each block size),
-    /// <name>.reference.wgsl and <name>.layout.json into the output directory.
+    /// <name>.reference.wgsl, the dynamic, hierarchical and checkerboard kernels
+    /// (<name>.dynamic_coarse.b2.wgsl, <name>.dynamic_fine.b4.wgsl, <name>.hierarchical.wgsl,
+    /// <name>.checkerboard.wgsl) and <name>.layout.json into the output directory.
     Compile {
         /// The .mrsl program.
         file: PathBuf,
@@ -65,7 +67,7 @@ struct Render {
     /// Scene: demo, gradient, steps, sinusoid, sponza, or a .toml scene file (docs/scenes.md).
     #[arg(long, default_value = "demo")]
     scene: String,
-    /// reference, coarse2x2, coarse4x4, dynamic, hierarchical or all.
+    /// reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard or all.
     #[arg(long, default_value = "coarse4x4")]
     mode: String,
     /// Image size, WIDTHxHEIGHT (default: the scene file's, else 960x540).

@@ -1762,12 +1762,18 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         self.line(0, "// One lane per pixel of the shaded quads only: 16 quads of 4 lanes per workgroup, along");
         self.line(0, "// one row of quads (workgroup y), every other quad (shifted on odd rows).");
         self.line(0, "@compute @workgroup_size(64, 1, 1)");
-        self.line(0, "fn cb_shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {");
-        self.line(1, "let qy = i32(wg.y);");
+        self.line(
+            0,
+            "fn cb_shade(@builtin(workgroup_id) mrsl_wg: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {",
+        );
+        self.line(1, "let mrsl_qy = i32(mrsl_wg.y);");
         self.line(1, "// Forced refinement shades every quad (the runtime dispatches twice as many).");
-        self.line(1, "let k = i32(wg.x) * 16 + i32(li / 4u);");
-        self.line(1, "let qx = select(2 * k + (qy & 1), k, mrsl_ctl.force_refine != 0u);");
-        self.line(1, "let mrsl_pos = vec2<i32>(qx * 2 + i32(li % 2u), qy * 2 + i32((li / 2u) % 2u));");
+        self.line(1, "let mrsl_k = i32(mrsl_wg.x) * 16 + i32(mrsl_li / 4u);");
+        self.line(1, "let mrsl_qx = select(2 * mrsl_k + (mrsl_qy & 1), mrsl_k, mrsl_ctl.force_refine != 0u);");
+        self.line(
+            1,
+            "let mrsl_pos = vec2<i32>(mrsl_qx * 2 + i32(mrsl_li % 2u), mrsl_qy * 2 + i32((mrsl_li / 2u) % 2u));",
+        );
         self.line(1, "if (any(mrsl_pos >= mrsl_grid())) { return; }");
         for &e in &coarse {
             self.effect_chain(&[e], 1);
