@@ -1174,16 +1174,24 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         self.line(1, "corners: vec4<u32>, // coarse samples c00, c10, c01, c11");
         self.line(1, "weights: vec4<f32>, // bilinear weights of the corners");
         self.line(1, "nearest: u32,       // index of the nearest corner");
-        self.line(1, format!("refined: array<u32, {mask_words}>, // bit k: coarse effect k is evaluated per pixel"));
+        // Separate words, not an array: llvmpipe spills dynamically indexed
+        // arrays in structs to memory, which made every lookup a memory access.
+        for w in 0..mask_words {
+            self.line(1, format!("refined{w}: u32, // bit k: coarse effect 32 * {w} + k is evaluated per pixel"));
+        }
         self.line(0, "}");
         self.line(0, "");
         self.line(0, "fn mrsl_is_refined(b: MrslBlock, k: u32) -> bool {");
-        self.line(1, "return ((b.refined[k / 32u] >> (k % 32u)) & 1u) != 0u;");
+        let mut word = "b.refined0".to_string();
+        for w in 1..mask_words {
+            word = format!("select({word}, b.refined{w}, k >= {}u)", 32 * w);
+        }
+        self.line(1, format!("return (({word} >> (k % 32u)) & 1u) != 0u;"));
         self.line(0, "}");
         self.line(0, "");
         if self.kind == KernelKind::DynamicFine {
             self.line(0, "fn mrsl_any_refined(b: MrslBlock) -> bool {");
-            let words: Vec<String> = (0..mask_words).map(|w| format!("b.refined[{w}]")).collect();
+            let words: Vec<String> = (0..mask_words).map(|w| format!("b.refined{w}")).collect();
             self.line(1, format!("return ({}) != 0u;", words.join(" | ")));
             self.line(0, "}");
             self.line(0, "");
@@ -1312,7 +1320,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
                 terms.join(" || ")
             };
             self.line(1, format!("let mrsl_r{k} = {value}; // `{}`", info.name));
-            self.line(1, format!("if (mrsl_r{k}) {{ b.refined[{}] |= {}u; }}", k / 32, 1u32 << (k % 32)));
+            self.line(1, format!("if (mrsl_r{k}) {{ b.refined{} |= {}u; }}", k / 32, 1u32 << (k % 32)));
         }
         self.line(1, "return b;");
         self.line(0, "}");
@@ -1392,11 +1400,11 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             self.line(2, "let mrsl_last = mrsl_b2;");
             self.line(
                 2,
-                "textureStore(mrsl_rate, mrsl_pos, vec4<u32>(mrsl_b2.refined[0], mrsl_b.refined[0] & ~mrsl_b2.refined[0], 0u, 1u));",
+                "textureStore(mrsl_rate, mrsl_pos, vec4<u32>(mrsl_b2.refined0, mrsl_b.refined0 & ~mrsl_b2.refined0, 0u, 1u));",
             );
         } else {
             self.line(2, "let mrsl_last = mrsl_b;");
-            self.line(2, "textureStore(mrsl_rate, mrsl_pos, vec4<u32>(mrsl_b.refined[0], 0u, 0u, 1u));");
+            self.line(2, "textureStore(mrsl_rate, mrsl_pos, vec4<u32>(mrsl_b.refined0, 0u, 0u, 1u));");
         }
         for k in 0..nc {
             self.line(2, format!("if (mrsl_is_refined(mrsl_last, {k}u)) {{ atomicAdd(&mrsl_wg_stats[{k}], 1u); }}"));
