@@ -318,8 +318,10 @@ impl Shader {
             }
             Mode::Coarse2x2 | Mode::Coarse4x4 | Mode::Dynamic => {
                 let block = mode.block_size().unwrap_or(4);
+                // The dynamic mode runs the 4x4 coarse kernel but its own fine kernel.
+                let fine_needed = mode != Mode::Dynamic;
                 if !self.pipelines.contains_key(&(KernelKind::Coarse, block))
-                    || !self.pipelines.contains_key(&(KernelKind::Fine, block))
+                    || (fine_needed && !self.pipelines.contains_key(&(KernelKind::Fine, block)))
                 {
                     return missing(&format!("{block}x{block} coarse and fine kernels"));
                 }
