@@ -114,10 +114,7 @@ impl Program {
 /// Parses and checks a program without generating code: every diagnostic,
 /// errors and warnings, in source order.
 pub fn check(source: &str) -> Vec<Diagnostic> {
-    match analyse(source, "program.mrsl") {
-        Ok((_, warnings)) => warnings,
-        Err(diagnostics) => diagnostics,
-    }
+    front_end(source, |_, _, _, warnings| warnings).unwrap_or_else(|errors| errors)
 }
 
 /// Compiles a program to kernels and a layout, or returns its diagnostics
@@ -129,23 +126,27 @@ pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnosti
                 .with_note("supported block sizes: 2, 4"),
         ]);
     }
-    let program = syntax::parse(source).map_err(|d| vec![d])?;
-    let (checked, mut diagnostics) = check::check(&program);
-    let (graph, graph_diagnostics) = graph::build(&checked);
-    diagnostics.extend(graph_diagnostics);
-    let (deriv, deriv_diagnostics) = deriv::analyse(&checked);
-    diagnostics.extend(deriv_diagnostics);
-    sort(&mut diagnostics);
-    if diagnostics.iter().any(|d| d.is_error()) {
-        return Err(diagnostics);
-    }
-    let interface = interface::allocate(&checked, &graph);
-    let layout = layout::build(&checked, &graph, &interface);
+    front_end(source, |checked, graph, deriv, diagnostics| {
+        generate(source, options, checked, graph, deriv, diagnostics)
+    })?
+}
+
+/// Everything after the checks: interface, layout, kernels and their validation.
+fn generate(
+    source: &str,
+    options: &Options,
+    checked: &check::Checked,
+    graph: &graph::EffectGraph,
+    deriv: &deriv::DerivInfo,
+    diagnostics: Vec<Diagnostic>,
+) -> Result<Program, Vec<Diagnostic>> {
+    let interface = interface::allocate(checked, graph);
+    let layout = layout::build(checked, graph, &interface);
     let inputs = wgsl::Inputs {
-        checked: &checked,
-        graph: &graph,
+        checked,
+        graph,
         interface: &interface,
-        deriv: &deriv,
+        deriv,
         layout: &layout,
         file_name: &options.file_name,
         source,
@@ -217,16 +218,23 @@ pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnosti
     Ok(Program { kernels, layout, warnings: diagnostics })
 }
 
-/// Runs the front end and all checks; returns warnings on success.
-fn analyse(source: &str, _file_name: &str) -> Result<((), Vec<Diagnostic>), Vec<Diagnostic>> {
+/// Parses and checks `source` (all stages that report diagnostics), then
+/// hands the analyses and the warnings to `then`; errors stop before it.
+fn front_end<R>(
+    source: &str,
+    then: impl FnOnce(&check::Checked, &graph::EffectGraph, &deriv::DerivInfo, Vec<Diagnostic>) -> R,
+) -> Result<R, Vec<Diagnostic>> {
     let program = syntax::parse(source).map_err(|d| vec![d])?;
     let (checked, mut diagnostics) = check::check(&program);
-    let (_, graph_diagnostics) = graph::build(&checked);
+    let (graph, graph_diagnostics) = graph::build(&checked);
     diagnostics.extend(graph_diagnostics);
-    let (_, deriv_diagnostics) = deriv::analyse(&checked);
+    let (deriv, deriv_diagnostics) = deriv::analyse(&checked);
     diagnostics.extend(deriv_diagnostics);
     sort(&mut diagnostics);
-    if diagnostics.iter().any(|d| d.is_error()) { Err(diagnostics) } else { Ok(((), diagnostics)) }
+    if diagnostics.iter().any(|d| d.is_error()) {
+        return Err(diagnostics);
+    }
+    Ok(then(&checked, &graph, &deriv, diagnostics))
 }
 
 fn sort(diagnostics: &mut [Diagnostic]) {

@@ -1690,13 +1690,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             self.line(0, "");
         }
         // Final pass: coarse values from the records, fine effects and outputs per pixel.
-        self.row_major_tile_pixel();
-        self.line(0, "@compute @workgroup_size(64, 1, 1)");
-        self.line(
-            0,
-            "fn hier_final(@builtin(workgroup_id) mrsl_wg: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {",
-        );
-        self.line(1, "let mrsl_pos = mrsl_tile_pixel(mrsl_wg.xy, mrsl_li);");
+        self.record_final_entry("hier_final");
         let order = self.i.graph.order.clone();
         let nc = coarse.len();
         self.line(1, "if (all(mrsl_pos < mrsl_grid())) {");
@@ -1846,13 +1840,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             self.line(0, "}");
         }
         self.line(0, "");
-        self.row_major_tile_pixel();
-        self.line(0, "@compute @workgroup_size(64, 1, 1)");
-        self.line(
-            0,
-            "fn cb_final(@builtin(workgroup_id) mrsl_wg: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {",
-        );
-        self.line(1, "let mrsl_pos = mrsl_tile_pixel(mrsl_wg.xy, mrsl_li);");
+        self.record_final_entry("cb_final");
         let order = self.i.graph.order.clone();
         let nc = coarse.len();
         self.line(1, "if (all(mrsl_pos < mrsl_grid())) {");
@@ -1891,12 +1879,21 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         self.stats_flush(nc);
     }
 
-    /// `mrsl_tile_pixel` for the record-based modes: an 8x8 tile in row-major lane order.
-    fn row_major_tile_pixel(&mut self) {
+    /// Opens the final per-pixel entry point of a record-based mode (an 8x8 tile
+    /// per workgroup, lanes in row-major order) up to `mrsl_pos`; closed by [`Self::stats_flush`].
+    fn record_final_entry(&mut self, name: &str) {
         self.line(0, "fn mrsl_tile_pixel(wg: vec2<u32>, li: u32) -> vec2<i32> {");
         self.line(1, "return vec2<i32>(wg * 8u + vec2<u32>(li % 8u, li / 8u));");
         self.line(0, "}");
         self.line(0, "");
+        self.line(0, "@compute @workgroup_size(64, 1, 1)");
+        self.line(
+            0,
+            format!(
+                "fn {name}(@builtin(workgroup_id) mrsl_wg: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {{"
+            ),
+        );
+        self.line(1, "let mrsl_pos = mrsl_tile_pixel(mrsl_wg.xy, mrsl_li);");
     }
 
     /// Ends a per-pixel entry point: adds the workgroup's counters to the global

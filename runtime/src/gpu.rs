@@ -40,16 +40,8 @@ impl Gpu {
         format: wgpu::TextureFormat,
         data: &[u8],
     ) -> wgpu::Texture {
-        let texture = self.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+        let texture =
+            self.texture_2d(label, size, format, wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST);
         let bytes_per_pixel = format.block_copy_size(None).unwrap_or(4);
         self.queue.write_texture(
             texture.as_image_copy(),
@@ -64,8 +56,14 @@ impl Gpu {
         texture
     }
 
-    /// Creates an output texture a kernel can write and a copy can read.
-    pub fn output_texture(&self, label: &str, size: (u32, u32), format: wgpu::TextureFormat) -> wgpu::Texture {
+    /// A single-level 2D texture.
+    fn texture_2d(
+        &self,
+        label: &str,
+        size: (u32, u32),
+        format: wgpu::TextureFormat,
+        usage: wgpu::TextureUsages,
+    ) -> wgpu::Texture {
         self.device.create_texture(&wgpu::TextureDescriptor {
             label: Some(label),
             size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
@@ -73,11 +71,19 @@ impl Gpu {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format,
-            usage: wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::TEXTURE_BINDING,
+            usage,
             view_formats: &[],
         })
+    }
+
+    /// Creates an output texture a kernel can write and a copy can read.
+    pub fn output_texture(&self, label: &str, size: (u32, u32), format: wgpu::TextureFormat) -> wgpu::Texture {
+        self.texture_2d(
+            label,
+            size,
+            format,
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::TEXTURE_BINDING,
+        )
     }
 
     /// Reads a texture back as rows of raw texel bytes, tightly packed.

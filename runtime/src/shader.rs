@@ -675,7 +675,6 @@ impl Shader {
     ) -> wgpu::BindGroup {
         let l = &self.layout;
         let hl = &l.hierarchical;
-        let rate_view = self.rate.as_ref().map(|(t, _)| t.create_view(&Default::default()));
         let mut entries =
             vec![wgpu::BindGroupEntry { binding: hl.values_binding, resource: buffers.values.as_entire_binding() }];
         if kind == KernelKind::Hierarchical {
@@ -683,26 +682,7 @@ impl Shader {
             entries
                 .push(wgpu::BindGroupEntry { binding: hl.queue_binding, resource: buffers.queue.as_entire_binding() });
         }
-        for o in &l.outputs {
-            entries.push(wgpu::BindGroupEntry {
-                binding: o.binding,
-                resource: wgpu::BindingResource::TextureView(&views[o.name.as_str()]),
-            });
-        }
-        if !l.stats.counters.is_empty() {
-            entries.push(wgpu::BindGroupEntry { binding: l.stats.binding, resource: self.stats.as_entire_binding() });
-            if let Some(view) = &rate_view {
-                entries.push(wgpu::BindGroupEntry {
-                    binding: l.rate_image.binding,
-                    resource: wgpu::BindingResource::TextureView(view),
-                });
-            }
-        }
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(kind.name()),
-            layout: &self.stage_layouts[&kind],
-            entries: &entries,
-        })
+        self.finish_stage_group(device, kind, entries, Some(views))
     }
 
     fn ensure_hier_buffers(&mut self, device: &wgpu::Device, size: (u32, u32)) {
@@ -835,16 +815,30 @@ impl Shader {
         if kind == KernelKind::DynamicCoarse {
             entries.push(wgpu::BindGroupEntry { binding: l.stats.binding, resource: self.stats.as_entire_binding() });
         }
-        if !kind.is_coarse() {
-            for o in &l.outputs {
-                entries.push(wgpu::BindGroupEntry {
-                    binding: o.binding,
-                    resource: wgpu::BindingResource::TextureView(&outputs[o.name.as_str()]),
-                });
-            }
-        }
+        let outputs = (!kind.is_coarse()).then_some(outputs);
+        self.finish_stage_group(device, kind, entries, outputs)
+    }
+
+    /// Adds the outputs (when given), the statistics and the rate image (for the
+    /// kernels that count) to a stage group's entries, and creates the group.
+    fn finish_stage_group(
+        &self,
+        device: &wgpu::Device,
+        kind: KernelKind,
+        entries: Vec<wgpu::BindGroupEntry<'_>>,
+        outputs: Option<&HashMap<&str, wgpu::TextureView>>,
+    ) -> wgpu::BindGroup {
+        let l = &self.layout;
         let rate_view = self.rate.as_ref().map(|(t, _)| t.create_view(&Default::default()));
-        if kind.is_fine() && !l.stats.counters.is_empty() {
+        // Rebound so the entries may also borrow the views made here.
+        let mut entries: Vec<wgpu::BindGroupEntry<'_>> = entries;
+        for o in outputs.map(|_| &l.outputs[..]).unwrap_or_default() {
+            let view = &outputs.expect("checked above")[o.name.as_str()];
+            entries
+                .push(wgpu::BindGroupEntry { binding: o.binding, resource: wgpu::BindingResource::TextureView(view) });
+        }
+        let counts = kind.is_fine() || matches!(kind, KernelKind::Hierarchical | KernelKind::Checkerboard);
+        if counts && !l.stats.counters.is_empty() {
             entries.push(wgpu::BindGroupEntry { binding: l.stats.binding, resource: self.stats.as_entire_binding() });
             if let Some(view) = &rate_view {
                 entries.push(wgpu::BindGroupEntry {
