@@ -7,7 +7,9 @@ use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+mod bench;
 mod render;
+mod report;
 
 #[derive(Parser)]
 #[command(name = "mrslc", version, about = "Compiler for mrsl, a multi-rate shading language", long_about = None)]
@@ -58,6 +60,51 @@ enum Command {
     /// 960x540 in coarse 4x4 mode, writing demo.coarse4x4.png, a heatmap and
     /// demo.stats.json into the current directory.
     Render(Render),
+    /// Benchmark the modes: sweep refinement thresholds, measure shaded
+    /// fraction, GPU and wall time and quality against the reference, and run
+    /// the dynamic-threshold controller along a camera path.
+    ///
+    /// With no arguments: examples/sponza_lights.mrsl (built in) over Sponza
+    /// at 960x540, every mode; writes bench.md, bench.csv, controller.csv,
+    /// quality_vs_time.sponza.png and controller.png into bench-out/
+    /// (docs/evaluation.md explains every figure).
+    Bench(Bench),
+}
+
+#[derive(clap::Args)]
+struct Bench {
+    /// The .mrsl program (default: the built-in Sponza lights-and-shadows workload).
+    program: Option<PathBuf>,
+    /// Scene(s), as for `render` (repeatable).
+    #[arg(long = "scene", default_values = ["sponza"])]
+    scenes: Vec<String>,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, value_parser = render::parse_size, default_value = "960x540")]
+    size: (u32, u32),
+    /// Modes, comma-separated, or all.
+    #[arg(long, default_value = "all")]
+    modes: String,
+    /// The block and dynamic modes' knob: a float uniform of the program.
+    #[arg(long, default_value = "light_tolerance")]
+    knob: String,
+    /// The knob's values (comma-separated).
+    #[arg(long, value_delimiter = ',', default_values_t = [0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0])]
+    values: Vec<f64>,
+    /// The hierarchical mode's similarity thresholds (comma-separated).
+    #[arg(long, value_delimiter = ',', default_values_t = [1e-6, 1e-5, 1e-4, 3e-4, 1e-3, 3e-3, 1e-2])]
+    similarities: Vec<f64>,
+    /// Timed runs per point (after one warm-up); the median is reported.
+    #[arg(long, default_value_t = 3)]
+    runs: usize,
+    /// Output directory.
+    #[arg(short, long, default_value = "bench-out")]
+    out_dir: PathBuf,
+    /// Frames of the dynamic-threshold camera path (0 skips it).
+    #[arg(long, default_value_t = 24)]
+    path_frames: usize,
+    /// The controller's target shaded fraction.
+    #[arg(long, default_value_t = 0.5)]
+    target_fraction: f64,
 }
 
 #[derive(clap::Args)]
@@ -152,6 +199,44 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
                 similarity: r.similarity,
             };
             match render::render(&args) {
+                Ok(paths) => {
+                    for p in paths {
+                        eprintln!("wrote {}", p.display());
+                    }
+                    Ok(ExitCode::SUCCESS)
+                }
+                Err(message) => {
+                    eprintln!("{message}");
+                    Ok(ExitCode::from(1))
+                }
+            }
+        }
+        Command::Bench(b) => {
+            let modes: Vec<mrsl_runtime::Mode> = if b.modes == "all" {
+                mrsl_runtime::Mode::ALL.to_vec()
+            } else {
+                b.modes
+                    .split(',')
+                    .map(|m| m.trim().parse().map_err(|e: mrsl_runtime::Error| e.to_string()))
+                    .collect::<Result<_, _>>()?
+            };
+            if !(b.target_fraction > 0.0 && b.target_fraction <= 1.0) {
+                return Err(format!("--target-fraction must be in (0, 1], not {}", b.target_fraction));
+            }
+            let args = bench::BenchArgs {
+                program: b.program.clone(),
+                scenes: b.scenes.clone(),
+                size: b.size,
+                modes,
+                knob: b.knob.clone(),
+                values: b.values.clone(),
+                similarities: b.similarities.clone(),
+                runs: b.runs,
+                out_dir: b.out_dir.clone(),
+                path_frames: b.path_frames,
+                target_fraction: b.target_fraction,
+            };
+            match bench::bench(&args) {
                 Ok(paths) => {
                     for p in paths {
                         eprintln!("wrote {}", p.display());

@@ -3,6 +3,7 @@
 
 use mrsl::{KernelKind, Options};
 use mrsl_runtime::gpu::Gpu;
+use mrsl_runtime::mesh_scene::MeshScene;
 use mrsl_runtime::scene::Scene;
 use mrsl_runtime::scene_file::SceneFile;
 use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader, Stats};
@@ -65,63 +66,20 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
     progress(&format!("device: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend), start);
     let start = Instant::now();
-    let scene = bind_scene(&gpu, &args.scene, args.size)?;
+    let mut scene = bind_scene(&gpu, &args.scene, args.size)?;
     let size = scene.size;
     progress(&format!("built the {} G-buffer at {}x{}", args.scene, size.0, size.1), start);
-    let channels = scene.channels;
     let mut shader = Shader::new(&gpu.device, &program).map_err(|e| e.to_string())?;
     shader.set_timestamp_period(&gpu.queue);
-    // A scene with a free camera tells programs where it is (the demo
-    // program's specular term reads `camera_pos`).
-    if let Some(camera) = scene.camera {
-        let has_camera_pos = program
-            .layout
-            .uniforms
-            .as_ref()
-            .is_some_and(|u| u.fields.iter().any(|f| f.name == "camera_pos" && f.ty == "float3"));
-        if has_camera_pos {
-            let eye: Vec<f64> = camera.eye.iter().map(|&v| v as f64).collect();
-            shader.set_uniform("camera_pos", &eye).map_err(|e| e.to_string())?;
-        }
-    }
-    // The scene file's uniforms, then the command line's.
-    for (name, values) in &scene.uniforms {
-        shader.set_uniform(name, values).map_err(|e| format!("{}: `uniforms.{name}`: {e}", args.scene))?;
-    }
+    // The scene's uniforms, then the command line's.
+    let shadow_map = scene.prepare(&gpu, &mut shader).map_err(|e| format!("{}: {e}", args.scene))?;
+    let channels = scene.channels;
     for (name, values) in &args.sets {
         shader.set_uniform(name, values).map_err(|e| e.to_string())?;
     }
-    // Programs that sample textures get a procedural checker texture and a
-    // linear, repeating sampler (scenes carry no textures of their own yet).
-    let checker = checker_texture(&gpu);
-    let checker_view = checker.create_view(&Default::default());
-    let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
-        address_mode_u: wgpu::AddressMode::Repeat,
-        address_mode_v: wgpu::AddressMode::Repeat,
-        mag_filter: wgpu::FilterMode::Linear,
-        min_filter: wgpu::FilterMode::Linear,
-        mipmap_filter: wgpu::MipmapFilterMode::Linear,
-        ..Default::default()
-    });
-    let outputs: Vec<(String, wgpu::Texture)> = program
-        .layout
-        .outputs
-        .iter()
-        .map(|o| (o.name.clone(), gpu.output_texture(&o.name, size, output_format(&o.format))))
-        .collect();
-    let mut bindings = Bindings { size, ..Default::default() };
-    for (name, texture) in &channels {
-        bindings.channels.insert(name.clone(), texture);
-    }
-    for t in &program.layout.textures {
-        bindings.textures.insert(t.name.clone(), &checker_view);
-    }
-    for s in &program.layout.samplers {
-        bindings.samplers.insert(s.name.clone(), &sampler);
-    }
-    for (name, texture) in &outputs {
-        bindings.outputs.insert(name.clone(), texture);
-    }
+    let resources = Resources::new(&gpu, &program, size, shadow_map);
+    let outputs = &resources.outputs;
+    let bindings = resources.bindings(&program, &channels);
 
     let mut written = vec![];
     let mut all_stats: Vec<Run> = vec![];
@@ -232,31 +190,120 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
 }
 
 /// A scene ready to bind: its G-buffer textures, the image size, the
-/// camera (for scenes that have a free one) and a scene file's uniforms.
-struct BoundScene {
-    channels: Vec<(String, wgpu::Texture)>,
-    size: (u32, u32),
-    camera: Option<mrsl_runtime::raster::Camera>,
-    uniforms: Vec<(String, Vec<f64>)>,
+/// mesh scene (camera, light rig, shadow map) for scenes made of a mesh, and
+/// a scene file's uniforms.
+pub struct BoundScene {
+    pub channels: Vec<(String, wgpu::Texture)>,
+    pub size: (u32, u32),
+    pub mesh: Option<MeshScene>,
+    pub uniforms: Vec<(String, Vec<f64>)>,
+}
+
+impl BoundScene {
+    /// Sets the uniforms the scene provides (the mesh scene's rig and
+    /// camera, then the scene file's), and renders the shadow map if the
+    /// program samples `shadow_map`; returns it.
+    pub fn prepare(&mut self, gpu: &Gpu, shader: &mut Shader) -> Result<Option<wgpu::Texture>, String> {
+        let mut shadow_map = None;
+        if let Some(mesh) = &mut self.mesh {
+            mesh.set_uniforms(shader, &mesh.camera.clone()).map_err(|e| e.to_string())?;
+            if shader.layout().textures.iter().any(|t| t.name == "shadow_map") {
+                shadow_map = Some(mesh.shadow_map(gpu).map_err(|e| e.to_string())?.clone());
+            }
+        }
+        for (name, values) in &self.uniforms {
+            shader.set_uniform(name, values).map_err(|e| format!("`uniforms.{name}`: {e}"))?;
+        }
+        Ok(shadow_map)
+    }
 }
 
 /// `--scene`: a built-in scene's name, or a `.toml` scene file (see
 /// docs/scenes.md). A scene file's `size` applies unless `--size` was given.
-fn bind_scene(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> Result<BoundScene, String> {
+pub fn bind_scene(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> Result<BoundScene, String> {
     if let Some(builtin) = Scene::parse(scene) {
         let size = size.unwrap_or(DEFAULT_SIZE);
-        let channels = builtin.textures_on(gpu, size.0, size.1).map_err(|e| e.to_string())?;
-        return Ok(BoundScene { channels, size, camera: builtin.camera(), uniforms: vec![] });
+        let mesh = builtin.mesh_scene(gpu).map_err(|e| e.to_string())?;
+        let channels = match &mesh {
+            Some(m) => m.gbuffer(gpu, &m.camera, size).map_err(|e| e.to_string())?,
+            None => builtin.textures_on(gpu, size.0, size.1).map_err(|e| e.to_string())?,
+        };
+        return Ok(BoundScene { channels, size, mesh, uniforms: vec![] });
     }
     let path = Path::new(scene);
     if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
         let file = SceneFile::load(path).map_err(|e| e.to_string())?;
         // The command line's --size wins over the file's.
         let size = size.or(file.size).unwrap_or(DEFAULT_SIZE);
-        let (channels, camera) = file.textures_on(gpu, size).map_err(|e| e.to_string())?;
-        return Ok(BoundScene { channels, size, camera: Some(camera), uniforms: file.uniforms.clone() });
+        let mesh = file.mesh_scene(gpu, size).map_err(|e| e.to_string())?;
+        let channels = mesh.gbuffer(gpu, &mesh.camera, size).map_err(|e| format!("{scene}: {e}"))?;
+        return Ok(BoundScene { channels, size, mesh: Some(mesh), uniforms: file.uniforms.clone() });
     }
     Err(format!("unknown scene `{scene}` (expected {}, or a .toml scene file)", Scene::NAMES.join(", ")))
+}
+
+/// What a program binds besides the G-buffer: its outputs, and for its
+/// textures the scene's shadow map as `shadow_map` and a procedural checker
+/// for any other, with a linear, repeating sampler (scenes carry no
+/// material textures yet).
+pub struct Resources {
+    pub size: (u32, u32),
+    pub outputs: Vec<(String, wgpu::Texture)>,
+    checker_view: wgpu::TextureView,
+    shadow_view: Option<wgpu::TextureView>,
+    sampler: wgpu::Sampler,
+}
+
+impl Resources {
+    pub fn new(gpu: &Gpu, program: &mrsl::Program, size: (u32, u32), shadow_map: Option<wgpu::Texture>) -> Resources {
+        let outputs = program
+            .layout
+            .outputs
+            .iter()
+            .map(|o| (o.name.clone(), gpu.output_texture(&o.name, size, output_format(&o.format))))
+            .collect();
+        Resources {
+            size,
+            outputs,
+            checker_view: checker_texture(gpu).create_view(&Default::default()),
+            shadow_view: shadow_map.map(|t| t.create_view(&Default::default())),
+            sampler: linear_sampler(gpu),
+        }
+    }
+
+    /// The bindings of `program` over the G-buffer `channels`.
+    pub fn bindings<'a>(&'a self, program: &mrsl::Program, channels: &'a [(String, wgpu::Texture)]) -> Bindings<'a> {
+        let mut bindings = Bindings { size: self.size, ..Default::default() };
+        for (name, texture) in channels {
+            bindings.channels.insert(name.clone(), texture);
+        }
+        for t in &program.layout.textures {
+            let view = match &self.shadow_view {
+                Some(shadow) if t.name == "shadow_map" => shadow,
+                _ => &self.checker_view,
+            };
+            bindings.textures.insert(t.name.clone(), view);
+        }
+        for s in &program.layout.samplers {
+            bindings.samplers.insert(s.name.clone(), &self.sampler);
+        }
+        for (name, texture) in &self.outputs {
+            bindings.outputs.insert(name.clone(), texture);
+        }
+        bindings
+    }
+}
+
+/// A linear, repeating sampler (what programs' `sampler` uniforms get).
+pub fn linear_sampler(gpu: &Gpu) -> wgpu::Sampler {
+    gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+        address_mode_u: wgpu::AddressMode::Repeat,
+        address_mode_v: wgpu::AddressMode::Repeat,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Linear,
+        ..Default::default()
+    })
 }
 
 fn with_suffix(path: &Path, suffix: &str) -> PathBuf {

@@ -39,6 +39,8 @@ pub enum Error {
     UnknownMode(String),
     #[error("the device rejected a pipeline: {0}")]
     Pipeline(String),
+    #[error("the light rig cannot be used: {0}")]
+    Rig(String),
     #[error("reading results back failed: {0}")]
     Readback(String),
 }

@@ -32,7 +32,8 @@ impl Gpu {
         Ok(Gpu { adapter_info: adapter.get_info(), device, queue })
     }
 
-    /// Creates a 2D texture and fills it with `data` (tightly packed rows).
+    /// Creates a 2D texture and fills it with `data` (tightly packed rows);
+    /// it can be sampled, and read back with [`Gpu::read_texture`].
     pub fn texture_with_data(
         &self,
         label: &str,
@@ -40,8 +41,9 @@ impl Gpu {
         format: wgpu::TextureFormat,
         data: &[u8],
     ) -> wgpu::Texture {
-        let texture =
-            self.texture_2d(label, size, format, wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST);
+        let usage =
+            wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC;
+        let texture = self.texture_2d(label, size, format, usage);
         let bytes_per_pixel = format.block_copy_size(None).unwrap_or(4);
         self.queue.write_texture(
             texture.as_image_copy(),

@@ -21,11 +21,14 @@
 //! # Ok(()) }
 //! ```
 
+pub mod controller;
 mod error;
 pub mod gpu;
 pub mod mesh;
+pub mod mesh_scene;
 pub mod metrics;
 pub mod raster;
+pub mod rig;
 pub mod scene;
 pub mod scene_file;
 mod shader;

@@ -12,6 +12,7 @@
 
 use crate::gpu::Gpu;
 use crate::mesh::MeshError;
+use crate::mesh_scene::MeshScene;
 use crate::raster::{Camera, RasterError};
 
 /// Material id of background pixels.
@@ -119,16 +120,26 @@ impl Scene {
         }
     }
 
+    /// The mesh scenes' mesh on `gpu`, with camera and light rig; `None` for
+    /// the scenes made on the CPU.
+    pub fn mesh_scene(self, gpu: &Gpu) -> Result<Option<MeshScene>, SceneError> {
+        match self {
+            Scene::Sponza => {
+                let mesh = crate::mesh::sponza_shared()?;
+                Ok(Some(MeshScene::new(gpu, &mesh, Scene::sponza_camera())?))
+            }
+            _ => Ok(None),
+        }
+    }
+
     /// The G-buffer as textures on `gpu` (the formats of [`GBuffer::upload`]):
     /// Sponza's straight from the rasteriser, without a round trip through
     /// the CPU; the CPU scenes' uploaded.
     pub fn textures_on(self, gpu: &Gpu, width: u32, height: u32) -> Result<Vec<(String, wgpu::Texture)>, SceneError> {
         match self {
             Scene::Sponza => {
-                let mesh = crate::mesh::sponza_shared()?;
-                let rasterizer = crate::raster::Rasterizer::new(gpu)?;
-                let uploaded = rasterizer.upload(gpu, &mesh)?;
-                Ok(rasterizer.render(gpu, &uploaded, &Scene::sponza_camera(), (width, height))?)
+                let scene = self.mesh_scene(gpu)?.expect("Sponza is a mesh scene");
+                Ok(scene.gbuffer(gpu, &scene.camera, (width, height))?)
             }
             _ => Ok(self.render(width, height).upload(gpu)),
         }

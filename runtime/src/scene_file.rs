@@ -19,7 +19,8 @@
 
 use crate::gpu::Gpu;
 use crate::mesh::{DEFAULT_CREASE_ANGLE, Mesh, MeshError};
-use crate::raster::{Camera, RasterError, Rasterizer};
+use crate::mesh_scene::MeshScene;
+use crate::raster::{Camera, RasterError};
 use crate::scene::{GBuffer, Scene};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -240,13 +241,18 @@ impl SceneFile {
         gpu: &Gpu,
         size: (u32, u32),
     ) -> Result<(Vec<(String, wgpu::Texture)>, Camera), SceneFileError> {
+        let scene = self.mesh_scene(gpu, size)?;
+        let textures = scene
+            .gbuffer(gpu, &scene.camera, size)
+            .map_err(|source| SceneFileError::Raster { path: self.path.clone(), source })?;
+        Ok((textures, scene.camera))
+    }
+
+    /// The mesh uploaded, with its camera for an image of `size` and its light rig.
+    pub fn mesh_scene(&self, gpu: &Gpu, size: (u32, u32)) -> Result<MeshScene, SceneFileError> {
         let mesh = self.load_mesh()?;
         let camera = self.camera_for(&mesh, size.0 as f32 / size.1.max(1) as f32);
-        let raster = |source| SceneFileError::Raster { path: self.path.clone(), source };
-        let rasterizer = Rasterizer::new(gpu).map_err(raster)?;
-        let uploaded = rasterizer.upload(gpu, &mesh).map_err(raster)?;
-        let textures = rasterizer.render(gpu, &uploaded, &camera, size).map_err(raster)?;
-        Ok((textures, camera))
+        MeshScene::new(gpu, &mesh, camera).map_err(|source| SceneFileError::Raster { path: self.path.clone(), source })
     }
 
     /// Rasterises the scene and reads the G-buffer back.

@@ -889,13 +889,19 @@ impl Shader {
                     let (a, b) = (ticks[2 * stage], ticks[2 * stage + 1]);
                     (b.saturating_sub(a)) as f64 * t.period_ns as f64 / 1e6
                 };
-                Some(match options.mode {
-                    Mode::Reference => crate::Timings { coarse_ms: 0.0, coarse2_ms: 0.0, fine_ms: ms(0) },
-                    Mode::Hierarchical => crate::Timings { coarse_ms: ms(1), coarse2_ms: 0.0, fine_ms: ms(2) },
-                    Mode::Checkerboard => crate::Timings { coarse_ms: 0.0, coarse2_ms: 0.0, fine_ms: ms(1) },
-                    Mode::Dynamic => crate::Timings { coarse_ms: ms(1), coarse2_ms: ms(3), fine_ms: ms(2) },
-                    _ => crate::Timings { coarse_ms: ms(1), coarse2_ms: 0.0, fine_ms: ms(2) },
-                })
+                // Stages written by each mode (see `encode`): 0 reference; 1 coarse
+                // or hierarchical levels or checkerboard; 2 fine or final; 3 the
+                // dynamic mode's 2x2 coarse pass, which runs between 1 and 2.
+                let span = |first: usize, last: usize| {
+                    (ticks[2 * last + 1].saturating_sub(ticks[2 * first])) as f64 * t.period_ns as f64 / 1e6
+                };
+                let (coarse_ms, coarse2_ms, fine_ms, total_ms) = match options.mode {
+                    Mode::Reference => (0.0, 0.0, ms(0), ms(0)),
+                    Mode::Checkerboard => (0.0, 0.0, ms(1), ms(1)),
+                    Mode::Dynamic => (ms(1), ms(3), ms(2), span(1, 2)),
+                    _ => (ms(1), 0.0, ms(2), span(1, 2)),
+                };
+                Some(crate::Timings { coarse_ms, coarse2_ms, fine_ms, total_ms })
             }
             None => None,
         };

@@ -6,12 +6,20 @@ use mrsl::layout::Layout;
 use mrsl::syntax::ast::Rate;
 
 /// GPU time of the passes, from timestamp queries.
+///
+/// `total_ms` spans from the first pass's beginning to the last pass's end:
+/// the number to compare between modes. The split between passes is only as
+/// good as the device's timestamps: lavapipe writes a timestamp when its
+/// queue thread reaches it, while a dispatch may still run on its worker
+/// threads, so there a pass's time can show up in the next pass's (see
+/// docs/evaluation.md).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Timings {
     pub coarse_ms: f64,
     /// The dynamic mode's 2x2 coarse pass (0 in other modes).
     pub coarse2_ms: f64,
     pub fine_ms: f64,
+    pub total_ms: f64,
 }
 
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -139,8 +147,8 @@ impl Stats {
         }
         if let Some(t) = self.timings {
             out.push_str(&format!(
-                "  GPU time: coarse {:.3} ms, coarse 2x2 {:.3} ms, fine {:.3} ms\n",
-                t.coarse_ms, t.coarse2_ms, t.fine_ms
+                "  GPU time: {:.3} ms (coarse {:.3} ms, coarse 2x2 {:.3} ms, fine {:.3} ms)\n",
+                t.total_ms, t.coarse_ms, t.coarse2_ms, t.fine_ms
             ));
         }
         out

@@ -1,0 +1,384 @@
+//! `mrslc bench`: sweeps scenes x modes x refinement thresholds, measures
+//! shaded fraction, wall and GPU time (medians) and quality against the
+//! reference, runs the dynamic-threshold controller along a camera path,
+//! and writes the markdown report, the CSV files and the plots.
+
+use crate::render::{BoundScene, Resources, bind_scene};
+use crate::report::{self, ControllerFrame, Point};
+use indicatif::{ProgressBar, ProgressStyle};
+use mrsl_runtime::controller::{Target, ThresholdController};
+use mrsl_runtime::gpu::Gpu;
+use mrsl_runtime::raster::Camera;
+use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader, Stats};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The default workload (examples/sponza_lights.mrsl).
+pub const WORKLOAD_PROGRAM: &str = include_str!("../../examples/sponza_lights.mrsl");
+
+pub struct BenchArgs {
+    pub program: Option<PathBuf>,
+    pub scenes: Vec<String>,
+    pub size: (u32, u32),
+    pub modes: Vec<Mode>,
+    /// The block and dynamic modes' knob: a program uniform and its values.
+    pub knob: String,
+    pub values: Vec<f64>,
+    /// The hierarchical mode's knob: its similarity thresholds.
+    pub similarities: Vec<f64>,
+    pub runs: usize,
+    pub out_dir: PathBuf,
+    /// Frames of the controller's camera path (0: skip it).
+    pub path_frames: usize,
+    pub target_fraction: f64,
+}
+
+/// A value of the program's knob so large that its predicate never fires:
+/// the hierarchical sweep turns the program's tolerance off so that DACS's
+/// own similarity test is the knob (as in the paper).
+const KNOB_OFF: f64 = 1e30;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
+/// A program, a shader and a scene bound together.
+struct Bench<'a> {
+    gpu: &'a Gpu,
+    program: &'a mrsl::Program,
+    shader: Shader,
+    runs: usize,
+}
+
+/// One configuration's measurements.
+struct Measured {
+    stats: Stats,
+    wall_ms: f64,
+    gpu_ms: Option<f64>,
+}
+
+impl Bench<'_> {
+    /// Runs `options` once to warm up, then `runs` times; medians.
+    fn measure(&mut self, bindings: &Bindings, options: DispatchOptions) -> Result<Measured, String> {
+        let device = &self.gpu.device;
+        let mut walls = vec![];
+        let mut gpus = vec![];
+        let mut last = None;
+        for run in 0..=self.runs {
+            let start = Instant::now();
+            let mut encoder = device.create_command_encoder(&Default::default());
+            self.shader.encode(device, &self.gpu.queue, &mut encoder, bindings, options).map_err(|e| e.to_string())?;
+            self.gpu.queue.submit([encoder.finish()]);
+            device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| e.to_string())?;
+            let wall = start.elapsed().as_secs_f64() * 1e3;
+            let stats = self.shader.read_stats(device).map_err(|e| e.to_string())?;
+            if run > 0 {
+                walls.push(wall);
+                if let Some(t) = stats.timings {
+                    gpus.push(t.total_ms);
+                }
+            }
+            last = Some(stats);
+        }
+        let stats = last.ok_or("no run")?;
+        Ok(Measured { stats, wall_ms: median(walls), gpu_ms: (!gpus.is_empty()).then(|| median(gpus)) })
+    }
+
+    fn set(&mut self, name: &str, value: f64) -> Result<(), String> {
+        self.shader.set_uniform(name, &[value]).map_err(|e| e.to_string())
+    }
+
+    fn declares(&self, name: &str) -> bool {
+        self.program.layout.uniforms.as_ref().is_some_and(|u| u.fields.iter().any(|f| f.name == name))
+    }
+}
+
+/// The configurations of one scene, in order.
+fn plan(args: &BenchArgs, has_knob: bool) -> Vec<(Mode, Option<f64>, bool)> {
+    let mut plan = vec![(Mode::Reference, None, false)];
+    for &mode in &args.modes {
+        match mode {
+            Mode::Reference => {}
+            Mode::Checkerboard => plan.push((mode, None, false)),
+            Mode::Hierarchical => plan.extend(args.similarities.iter().map(|&s| (mode, Some(s), false))),
+            _ if has_knob => plan.extend(args.values.iter().map(|&v| (mode, Some(v), false))),
+            _ => plan.push((mode, None, false)),
+        }
+    }
+    // The worst case: every predicate forced true.
+    plan.extend(args.modes.iter().filter(|m| **m != Mode::Reference).map(|&m| (m, None, true)));
+    plan
+}
+
+/// Runs the benchmark; returns the files written.
+pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
+    let (name, source) = match &args.program {
+        Some(path) => (
+            path.display().to_string(),
+            std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?,
+        ),
+        None => ("sponza_lights.mrsl (built in)".to_string(), WORKLOAD_PROGRAM.to_string()),
+    };
+    let options = mrsl::Options { file_name: name.clone(), ..mrsl::Options::default() };
+    let program = mrsl::compile(&source, &options).map_err(|d| mrsl::render_all(&d, &name, &source))?;
+    let gpu = Gpu::new().map_err(|e| e.to_string())?;
+    let device_name = format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
+    eprintln!("bench: {name} on {device_name}, {}x{}, {} runs per point (median)", args.size.0, args.size.1, args.runs);
+    std::fs::create_dir_all(&args.out_dir).map_err(|e| format!("cannot create {}: {e}", args.out_dir.display()))?;
+
+    let mut points: Vec<Point> = vec![];
+    let mut frames: Vec<ControllerFrame> = vec![];
+    for scene_name in &args.scenes {
+        let mut scene = bind_scene(&gpu, scene_name, Some(args.size))?;
+        let mut shader = Shader::new(&gpu.device, &program).map_err(|e| e.to_string())?;
+        shader.set_timestamp_period(&gpu.queue);
+        let shadow_map = scene.prepare(&gpu, &mut shader).map_err(|e| format!("{scene_name}: {e}"))?;
+        let resources = Resources::new(&gpu, &program, scene.size, shadow_map);
+        let mut bench = Bench { gpu: &gpu, program: &program, shader, runs: args.runs.max(1) };
+        let has_knob = bench.declares(&args.knob);
+        if !has_knob
+            && args.modes.iter().any(|m| !matches!(m, Mode::Reference | Mode::Checkerboard | Mode::Hierarchical))
+        {
+            eprintln!(
+                "bench: {name} has no uniform `{}`: the block modes run once at the program's defaults",
+                args.knob
+            );
+        }
+        let knob_default = program
+            .layout
+            .uniforms
+            .as_ref()
+            .and_then(|u| u.fields.iter().find(|f| f.name == args.knob))
+            .and_then(|f| f.default.as_ref().and_then(|d| d.first().copied()));
+        let plan = plan(args, has_knob);
+        let bar = ProgressBar::new(plan.len() as u64).with_style(
+            ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} {msg} ({elapsed})")
+                .map_err(|e| e.to_string())?
+                .progress_chars("=> "),
+        );
+        bar.set_prefix(scene_name.clone());
+        let bindings = resources.bindings(&program, &scene.channels);
+        let first_output = &resources.outputs.first().ok_or("the program has no output")?.1;
+        if first_output.format() != wgpu::TextureFormat::Rgba32Float {
+            return Err("bench compares images: the program's first output must be rgba32float".into());
+        }
+        let mut reference: Option<Vec<[f32; 4]>> = None;
+        for (mode, value, forced) in plan {
+            let knob = match (mode, value) {
+                (Mode::Hierarchical, Some(_)) => "similarity".to_string(),
+                (_, Some(_)) => args.knob.clone(),
+                _ => "-".to_string(),
+            };
+            bar.set_message(format!(
+                "{mode}{}{}",
+                value.map(|v| format!(" {knob}={v:e}")).unwrap_or_default(),
+                if forced { " (forced)" } else { "" }
+            ));
+            let mut options = DispatchOptions { force_refine: forced, ..DispatchOptions::new(mode) };
+            if has_knob {
+                let v = match (mode, value) {
+                    (Mode::Hierarchical, _) => KNOB_OFF,
+                    (_, Some(v)) => v,
+                    _ => knob_default.unwrap_or(KNOB_OFF),
+                };
+                bench.set(&args.knob, v)?;
+            }
+            if let (Mode::Hierarchical, Some(s)) = (mode, value) {
+                options.similarity = s as f32;
+            }
+            let m = bench.measure(&bindings, options)?;
+            let pixels = gpu.read_rgba32f(first_output).map_err(|e| e.to_string())?;
+            let metrics = match &reference {
+                None => {
+                    reference = Some(pixels);
+                    mrsl_runtime::metrics::Metrics { rmse: 0.0, psnr: f64::INFINITY, mssim: 1.0, flip: 0.0 }
+                }
+                Some(r) => {
+                    mrsl_runtime::metrics::compare(&pixels, r, scene.size.0, scene.size.1).map_err(|e| e.to_string())?
+                }
+            };
+            points.push(Point {
+                scene: scene_name.clone(),
+                mode: mode.to_string(),
+                knob,
+                value: value.unwrap_or(f64::NAN),
+                forced,
+                shaded_fraction: m.stats.shaded_fraction,
+                wall_ms: m.wall_ms,
+                gpu_ms: m.gpu_ms,
+                rmse: metrics.rmse,
+                psnr: metrics.psnr,
+                mssim: metrics.mssim,
+                flip: metrics.flip,
+            });
+            bar.inc(1);
+        }
+        bar.finish_with_message("done");
+        if args.path_frames > 0 && scene.mesh.is_some() && args.modes.contains(&Mode::Hierarchical) {
+            frames = controller_run(&gpu, &program, &mut scene, args)?;
+        }
+    }
+
+    let setup = format!(
+        "Program `{name}`; scenes {}; {}x{}; device {device_name}; {} timed runs per point after one warm-up, medians. \
+         Block and dynamic modes sweep the uniform `{}` over {:?}; the hierarchical mode sweeps `similarity` over {:?} \
+         with `{}` off. Quality against the reference image of the same program: RMSE, PSNR, MSSIM (Wang 2004), FLIP.",
+        args.scenes.join(", "),
+        args.size.0,
+        args.size.1,
+        args.runs,
+        args.knob,
+        args.values,
+        args.similarities,
+        args.knob
+    );
+    let mut written = vec![];
+    let mut write = |file: &str, bytes: &[u8]| -> Result<(), String> {
+        let path = args.out_dir.join(file);
+        std::fs::write(&path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        written.push(path);
+        Ok(())
+    };
+    let markdown = report::markdown(&setup, &points, &frames);
+    write("bench.md", markdown.as_bytes())?;
+    write("bench.csv", report::csv(&points)?.as_bytes())?;
+    if !frames.is_empty() {
+        write("controller.csv", report::controller_csv(&frames)?.as_bytes())?;
+    }
+    let plot_size = (900, 600);
+    for scene in &args.scenes {
+        let rgb = report::plot_quality_vs_time(&points, scene, plot_size)?;
+        let path = args.out_dir.join(format!("quality_vs_time.{}.png", file_safe(scene)));
+        save_rgb(&rgb, plot_size, &path)?;
+        written.push(path);
+    }
+    if !frames.is_empty() {
+        let rgb = report::plot_controller(&frames, plot_size)?;
+        let path = args.out_dir.join("controller.png");
+        save_rgb(&rgb, plot_size, &path)?;
+        written.push(path);
+    }
+    println!("{markdown}");
+    Ok(written)
+}
+
+fn file_safe(name: &str) -> String {
+    Path::new(name).file_stem().and_then(|s| s.to_str()).unwrap_or(name).replace(|c: char| !c.is_alphanumeric(), "_")
+}
+
+fn save_rgb(rgb: &[u8], size: (u32, u32), path: &Path) -> Result<(), String> {
+    image::RgbImage::from_raw(size.0, size.1, rgb.to_vec())
+        .ok_or("plot buffer has the wrong size")?
+        .save(path)
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+/// The camera of frame `i` of `n` along the path: the eye walks half-way
+/// towards the target while the view swings 25 degrees left and right.
+pub fn path_camera(start: &Camera, i: usize, n: usize) -> Camera {
+    let t = if n > 1 { i as f32 / (n - 1) as f32 } else { 0.0 };
+    let d: [f32; 3] = std::array::from_fn(|k| start.target[k] - start.eye[k]);
+    let eye: [f32; 3] = std::array::from_fn(|k| start.eye[k] + 0.5 * t * d[k]);
+    let yaw = 25f32.to_radians() * (std::f32::consts::TAU * t).sin();
+    let (s, c) = yaw.sin_cos();
+    let turned = [c * d[0] + s * d[2], d[1], -s * d[0] + c * d[2]];
+    Camera { eye, target: std::array::from_fn(|k| eye[k] + turned[k]), ..*start }
+}
+
+/// The dynamic threshold: the hierarchical mode's similarity steered to a
+/// target shaded fraction, frame by frame along a camera path.
+fn controller_run(
+    gpu: &Gpu,
+    program: &mrsl::Program,
+    scene: &mut BoundScene,
+    args: &BenchArgs,
+) -> Result<Vec<ControllerFrame>, String> {
+    let mut shader = Shader::new(&gpu.device, program).map_err(|e| e.to_string())?;
+    shader.set_timestamp_period(&gpu.queue);
+    let shadow_map = scene.prepare(gpu, &mut shader)?;
+    let mesh = scene.mesh.as_ref().ok_or("the controller needs a mesh scene")?;
+    let resources = Resources::new(gpu, program, args.size, shadow_map);
+    let has_knob = program.layout.uniforms.as_ref().is_some_and(|u| u.fields.iter().any(|f| f.name == args.knob));
+    if has_knob {
+        shader.set_uniform(&args.knob, &[KNOB_OFF]).map_err(|e| e.to_string())?;
+    }
+    let start = args.similarities.iter().copied().fold(f64::NAN, f64::min);
+    let start = if start.is_finite() { start } else { DispatchOptions::DEFAULT_SIMILARITY as f64 };
+    let mut controller = ThresholdController::new(Target::ShadedFraction(args.target_fraction), start, (1e-9, 1e3));
+    let bar = ProgressBar::new(args.path_frames as u64).with_style(
+        ProgressStyle::with_template("controller [{bar:30}] {pos}/{len} {msg} ({elapsed})")
+            .map_err(|e| e.to_string())?
+            .progress_chars("=> "),
+    );
+    let mut frames = vec![];
+    let mut bench = Bench { gpu, program, shader, runs: 1 };
+    for i in 0..args.path_frames {
+        let camera = path_camera(&mesh.camera, i, args.path_frames);
+        let channels = mesh.gbuffer(gpu, &camera, args.size).map_err(|e| e.to_string())?;
+        mesh.set_uniforms(&mut bench.shader, &camera).map_err(|e| e.to_string())?;
+        let bindings = resources.bindings(program, &channels);
+        let threshold = controller.threshold();
+        let options = DispatchOptions { similarity: threshold as f32, ..DispatchOptions::new(Mode::Hierarchical) };
+        let m = bench.measure(&bindings, options)?;
+        frames.push(ControllerFrame {
+            frame: i,
+            mode: Mode::Hierarchical.to_string(),
+            knob: "similarity".into(),
+            threshold,
+            shaded_fraction: m.stats.shaded_fraction,
+            time_ms: m.gpu_ms.unwrap_or(m.wall_ms),
+            target: args.target_fraction,
+        });
+        controller.update(m.stats.shaded_fraction);
+        bar.set_message(format!("shaded {:.1}%", 100.0 * m.stats.shaded_fraction));
+        bar.inc(1);
+    }
+    bar.finish();
+    Ok(frames)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_path_starts_at_the_scene_camera_and_walks_forward() {
+        let start = Camera::look_at([0.0, 1.0, 0.0], [10.0, 1.0, 0.0], 60.0);
+        let first = path_camera(&start, 0, 10);
+        assert_eq!(first.eye, start.eye);
+        assert!((first.target[0] - 10.0).abs() < 1e-5 && first.target[2].abs() < 1e-5);
+        let last = path_camera(&start, 9, 10);
+        assert!((last.eye[0] - 5.0).abs() < 1e-5);
+        // Mid-way the view has turned.
+        let mid = path_camera(&start, 2, 10);
+        assert!(mid.target[2].abs() > 1.0);
+    }
+
+    #[test]
+    fn the_plan_sweeps_each_mode_and_forces_each_once() {
+        let args = BenchArgs {
+            program: None,
+            scenes: vec!["demo".into()],
+            size: (64, 64),
+            modes: vec![Mode::Coarse4x4, Mode::Hierarchical, Mode::Checkerboard],
+            knob: "k".into(),
+            values: vec![1.0, 2.0],
+            similarities: vec![0.1, 0.2, 0.3],
+            runs: 1,
+            out_dir: ".".into(),
+            path_frames: 0,
+            target_fraction: 0.5,
+        };
+        let plan = plan(&args, true);
+        assert_eq!(plan[0], (Mode::Reference, None, false));
+        assert_eq!(plan.iter().filter(|p| p.0 == Mode::Coarse4x4 && !p.2).count(), 2);
+        assert_eq!(plan.iter().filter(|p| p.0 == Mode::Hierarchical && !p.2).count(), 3);
+        assert_eq!(plan.iter().filter(|p| p.2).count(), 3);
+        assert_eq!(plan.len(), 1 + 2 + 3 + 1 + 3);
+    }
+}

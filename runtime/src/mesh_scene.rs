@@ -1,0 +1,65 @@
+//! A mesh on the GPU with its camera and light rig: G-buffers from any
+//! camera (one per frame of a camera path), the rig's shadow map (rendered
+//! once, on first use) and the uniforms a program takes from the scene.
+
+use crate::gpu::Gpu;
+use crate::mesh::Mesh;
+use crate::raster::{Camera, GpuMesh, RasterError, Rasterizer};
+use crate::rig::{DEFAULT_LIGHTS, DEFAULT_SHADOW_MAP_SIZE, LightRig};
+use crate::{Error, Shader};
+
+/// A mesh scene ready to render.
+pub struct MeshScene {
+    rasterizer: Rasterizer,
+    mesh: GpuMesh,
+    /// The scene's own camera.
+    pub camera: Camera,
+    pub rig: LightRig,
+    shadow_map: Option<wgpu::Texture>,
+}
+
+impl MeshScene {
+    /// Uploads `mesh`; the rig has [`DEFAULT_LIGHTS`] lights over its bounds.
+    pub fn new(gpu: &Gpu, mesh: &Mesh, camera: Camera) -> Result<MeshScene, RasterError> {
+        let rasterizer = Rasterizer::new(gpu)?;
+        let uploaded = rasterizer.upload(gpu, mesh)?;
+        let bounds = uploaded.bounds().unwrap_or(crate::mesh::Bounds { min: [-1.0, -1.0, -1.0], max: [1.0, 1.0, 1.0] });
+        let rig = LightRig::for_bounds(&bounds, DEFAULT_LIGHTS);
+        Ok(MeshScene { rasterizer, mesh: uploaded, camera, rig, shadow_map: None })
+    }
+
+    /// The G-buffer seen from `camera` (see [`Rasterizer::render`]).
+    pub fn gbuffer(
+        &self,
+        gpu: &Gpu,
+        camera: &Camera,
+        size: (u32, u32),
+    ) -> Result<Vec<(String, wgpu::Texture)>, RasterError> {
+        self.rasterizer.render(gpu, &self.mesh, camera, size)
+    }
+
+    /// The rig's shadow map ([`DEFAULT_SHADOW_MAP_SIZE`] square), rendered on first use.
+    pub fn shadow_map(&mut self, gpu: &Gpu) -> Result<&wgpu::Texture, RasterError> {
+        if self.shadow_map.is_none() {
+            self.shadow_map = Some(self.rig.shadow_map(gpu, &self.rasterizer, &self.mesh, DEFAULT_SHADOW_MAP_SIZE)?);
+        }
+        Ok(self.shadow_map.as_ref().expect("set just above"))
+    }
+
+    /// Sets what the scene provides among the uniforms the program declares:
+    /// the rig's (see [`crate::rig`]) and `camera_pos` (a `float3`: the eye of
+    /// `camera`). Returns the names set.
+    pub fn set_uniforms(&self, shader: &mut Shader, camera: &Camera) -> Result<Vec<String>, Error> {
+        let mut set = self.rig.apply(shader)?;
+        let has_camera_pos = shader
+            .layout()
+            .uniforms
+            .as_ref()
+            .is_some_and(|u| u.fields.iter().any(|f| f.name == "camera_pos" && f.ty == "float3"));
+        if has_camera_pos {
+            shader.set_uniform("camera_pos", &camera.eye.map(f64::from))?;
+            set.push("camera_pos".into());
+        }
+        Ok(set)
+    }
+}

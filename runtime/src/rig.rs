@@ -1,0 +1,272 @@
+//! The light rig of the mesh scenes: dozens of point lights and a sun with a
+//! shadow map, handed to programs as uniforms and a texture they declare by
+//! name (see docs/scenes.md, "Lights and shadows").
+//!
+//! | name            | mrsl type      | content                                                    |
+//! | --------------- | -------------- | ---------------------------------------------------------- |
+//! | `light_pos`     | `float4[N]`    | xyz world position, w range (attenuation reaches 0 there)  |
+//! | `light_color`   | `float4[N]`    | rgb colour, a intensity                                    |
+//! | `light_count`   | `int`          | lights in use: min(rig's lights, N)                        |
+//! | `sun_pos`       | `float3`       | the sun camera's eye                                       |
+//! | `sun_view_proj` | `float4x4`     | world → sun clip space; `clip.xy / clip.w` is in [-1, 1]   |
+//! | `sun_focal`     | `float`        | shadow-map uv per world unit at distance 1 (1 / 2tan(fov/2)) |
+//! | `sun_color`     | `float3`       | the sun's radiance                                         |
+//! | `sun_size`      | `float`        | the sun's width in world units (PCSS light size)           |
+//! | `shadow_map`    | `texture2d`    | distance from `sun_pos` as `r + g` (see below)             |
+//!
+//! The shadow map is the `depth` channel of a G-buffer rasterised from the
+//! sun (a pinhole camera: the same rasteriser and pixel convention as the
+//! view), so texel `(x, y)` holds the distance from `sun_pos` to the nearest
+//! surface along the ray through its centre. mrsl textures are filterable
+//! floats and `R32Float` is not filterable in WebGPU without an optional
+//! feature, so the distance is stored in `Rg16Float` as a sum of two halves:
+//! `r = f16(d)`, `g = f16(d - r)` — about 22 bits of precision instead of
+//! half's 11, which keeps the shadow bias at millimetres on Sponza.
+
+use crate::Shader;
+use crate::gpu::Gpu;
+use crate::mesh::{Bounds, length, normalize, sub};
+use crate::raster::{Camera, GpuMesh, RasterError, Rasterizer};
+
+/// A point light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointLight {
+    pub position: [f32; 3],
+    /// Distance at which the light's attenuation reaches zero.
+    pub range: f32,
+    pub color: [f32; 3],
+    pub intensity: f32,
+}
+
+/// A sun: a distant, bright area light seen through a pinhole shadow camera.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sun {
+    /// The shadow camera: its eye is the light's position, its view covers the scene.
+    pub camera: Camera,
+    pub color: [f32; 3],
+    /// Width of the light in world units (PCSS's light size).
+    pub size: f32,
+}
+
+/// Point lights and a sun for a mesh scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LightRig {
+    pub lights: Vec<PointLight>,
+    pub sun: Sun,
+}
+
+/// Default number of point lights of [`LightRig::for_bounds`].
+pub const DEFAULT_LIGHTS: usize = 32;
+
+/// Default shadow-map resolution (square).
+pub const DEFAULT_SHADOW_MAP_SIZE: u32 = 1024;
+
+/// A small deterministic hash in [0, 1) (the rig must be the same on every
+/// run and machine; pulling in a random-number crate for 100 numbers is not
+/// worth a dependency).
+fn hash01(k: u32) -> f32 {
+    let mut x = k.wrapping_mul(0x9E37_79B9) ^ 0x85EB_CA6B;
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7FEB_352D);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846C_A68B);
+    x ^= x >> 16;
+    (x >> 8) as f32 / (1u32 << 24) as f32
+}
+
+impl LightRig {
+    /// `count` point lights spread over `bounds` and a sun above it.
+    ///
+    /// The lights stand in two rows along the longest horizontal axis, a
+    /// fifth of the height above the floor (lanterns along an atrium's
+    /// colonnades), with a deterministic jitter and warm-to-cool colours;
+    /// each reaches a quarter of the scene's length. The sun is up and to
+    /// the side, far enough (three diagonals) that its rays are almost
+    /// parallel, with a field of view just covering the bounding sphere.
+    pub fn for_bounds(bounds: &Bounds, count: usize) -> LightRig {
+        let (min, extent) = (bounds.min, bounds.extent());
+        // Long axis: x or z, whichever is longer; rows are offset along the other.
+        let (long, short) = if extent[0] >= extent[2] { (0, 2) } else { (2, 0) };
+        let lights = (0..count)
+            .map(|i| {
+                let row = (i % 2) as f32;
+                let along = ((i / 2) as f32 + 0.5) / count.div_ceil(2) as f32;
+                let jitter = |k: u32| hash01(i as u32 * 4 + k) - 0.5;
+                let mut p = [0.0; 3];
+                p[long] = min[long] + extent[long] * (0.05 + 0.9 * along + 0.02 * jitter(0));
+                p[short] = min[short] + extent[short] * (0.3 + 0.4 * row + 0.05 * jitter(1));
+                p[1] = min[1] + extent[1] * (0.2 + 0.1 * jitter(2));
+                let warm = hash01(i as u32 * 4 + 3);
+                PointLight {
+                    position: p,
+                    range: 0.25 * extent[long].max(extent[short]),
+                    color: [1.0, 0.55 + 0.35 * warm, 0.25 + 0.6 * (1.0 - warm)],
+                    intensity: 2.0,
+                }
+            })
+            .collect();
+        let center = bounds.center();
+        let radius = (0.5 * bounds.diagonal()).max(1e-3);
+        let distance = 3.0 * bounds.diagonal().max(1e-3);
+        let dir = normalize([0.3, 1.0, 0.2]);
+        let eye = [0, 1, 2].map(|k| center[k] + distance * dir[k]);
+        let fov = 2.0 * (radius / distance).asin().to_degrees() * 1.02;
+        let sun = Sun { camera: Camera::look_at(eye, center, fov), color: [3.0, 2.85, 2.6], size: 0.03 * distance };
+        LightRig { lights, sun }
+    }
+
+    /// The sun's world → clip matrix, column-major (16 values): `clip.xy /
+    /// clip.w` is the pixel convention of [`Camera::ray`] on a square image,
+    /// `clip.w` the depth along the view direction.
+    pub fn sun_view_proj(&self) -> Result<[f32; 16], RasterError> {
+        let camera = &self.sun.camera;
+        let (forward, right, up) = camera.basis()?;
+        let tan_half = (camera.fov_y_degrees.to_radians() / 2.0).tan();
+        let row = |axis: [f32; 3], scale: f32| {
+            let d = crate::mesh::dot(axis, camera.eye);
+            [axis[0] * scale, axis[1] * scale, axis[2] * scale, -d * scale]
+        };
+        let rows = [row(right, 1.0 / tan_half), row(up, 1.0 / tan_half), [0.0; 4], row(forward, 1.0)];
+        Ok(std::array::from_fn(|k| rows[k % 4][k / 4]))
+    }
+
+    /// Sets the rig's uniforms that the shader's program declares (names
+    /// above); arrays take as many lights as they hold. Returns the names set.
+    pub fn apply(&self, shader: &mut Shader) -> Result<Vec<String>, crate::Error> {
+        let declared: Vec<(String, String)> = shader
+            .layout()
+            .uniforms
+            .as_ref()
+            .map(|u| u.fields.iter().map(|f| (f.name.clone(), f.ty.clone())).collect())
+            .unwrap_or_default();
+        let focal = 0.5 / (self.sun.camera.fov_y_degrees.to_radians() / 2.0).tan();
+        let view_proj = self.sun_view_proj().map_err(|e| crate::Error::Rig(e.to_string()))?;
+        let light_capacity = declared_capacity(shader, "light_pos").unwrap_or(self.lights.len());
+        let mut set = vec![];
+        for (name, ty) in declared {
+            let capacity = crate::components(&ty) / 4;
+            let lights = || self.lights.iter().take(capacity);
+            let values: Vec<f64> = match name.as_str() {
+                "light_pos" => lights().flat_map(|l| [l.position[0], l.position[1], l.position[2], l.range]).collect(),
+                "light_color" => lights().flat_map(|l| [l.color[0], l.color[1], l.color[2], l.intensity]).collect(),
+                "light_count" => vec![self.lights.len().min(light_capacity) as f32],
+                "sun_pos" => self.sun.camera.eye.to_vec(),
+                "sun_view_proj" => view_proj.to_vec(),
+                "sun_focal" => vec![focal],
+                "sun_color" => self.sun.color.to_vec(),
+                "sun_size" => vec![self.sun.size],
+                _ => continue,
+            }
+            .into_iter()
+            .map(f64::from)
+            .collect();
+            // Arrays larger than the rig: the rest stays zero (lights past light_count).
+            let mut values = values;
+            if name == "light_pos" || name == "light_color" {
+                values.resize(crate::components(&ty), 0.0);
+            }
+            shader.set_uniform(&name, &values)?;
+            set.push(name);
+        }
+        Ok(set)
+    }
+
+    /// Renders the sun's shadow map (`size` x `size`, `Rg16Float`, distance
+    /// as `r + g`; see the module documentation).
+    pub fn shadow_map(
+        &self,
+        gpu: &Gpu,
+        rasterizer: &Rasterizer,
+        mesh: &GpuMesh,
+        size: u32,
+    ) -> Result<wgpu::Texture, RasterError> {
+        let channels = rasterizer.render(gpu, mesh, &self.sun.camera, (size, size))?;
+        let depth = channels
+            .iter()
+            .find(|(name, _)| name == "depth")
+            .map(|(_, t)| t)
+            .ok_or_else(|| RasterError::Render("the rasteriser made no depth channel".into()))?;
+        let distances: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(depth)?);
+        let texels: Vec<half::f16> = distances
+            .iter()
+            .flat_map(|&d| {
+                let hi = half::f16::from_f32(d);
+                [hi, half::f16::from_f32(d - hi.to_f32())]
+            })
+            .collect();
+        Ok(gpu.texture_with_data(
+            "mrsl shadow map",
+            (size, size),
+            wgpu::TextureFormat::Rg16Float,
+            bytemuck::cast_slice(&texels),
+        ))
+    }
+
+    /// Distance from `p` to the sun (what the shadow map stores for the nearest surface).
+    pub fn sun_distance(&self, p: [f32; 3]) -> f32 {
+        length(sub(p, self.sun.camera.eye))
+    }
+}
+
+/// How many float4 elements the program's array uniform `name` holds.
+fn declared_capacity(shader: &Shader, name: &str) -> Option<usize> {
+    let field = shader.layout().uniforms.as_ref()?.fields.iter().find(|f| f.name == name)?;
+    Some(crate::components(&field.ty) / 4)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bounds() -> Bounds {
+        Bounds { min: [-17.0, -1.0, -8.0], max: [16.0, 15.0, 7.0] }
+    }
+
+    #[test]
+    fn lights_lie_inside_the_bounds_and_are_deterministic() {
+        let rig = LightRig::for_bounds(&bounds(), 32);
+        assert_eq!(rig.lights.len(), 32);
+        let b = bounds();
+        for l in &rig.lights {
+            for k in 0..3 {
+                assert!(l.position[k] > b.min[k] && l.position[k] < b.max[k], "{l:?}");
+            }
+            assert!(l.range > 0.0 && l.intensity > 0.0);
+        }
+        assert_eq!(rig, LightRig::for_bounds(&bounds(), 32));
+    }
+
+    #[test]
+    fn the_sun_projects_the_scene_inside_its_view() {
+        let rig = LightRig::for_bounds(&bounds(), 4);
+        let m = rig.sun_view_proj().unwrap();
+        let apply = |p: [f32; 3]| {
+            let c: [f32; 4] = std::array::from_fn(|r| m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r]);
+            [c[0] / c[3], c[1] / c[3], c[3]]
+        };
+        for corner in bounds().corners() {
+            let [x, y, w] = apply(corner);
+            assert!(x.abs() < 1.0 && y.abs() < 1.0 && w > 0.0, "corner {corner:?} -> {x} {y} {w}");
+        }
+        // The centre of the scene is the centre of the image, at the eye distance.
+        let [x, y, w] = apply(bounds().center());
+        assert!(x.abs() < 1e-5 && y.abs() < 1e-5, "{x} {y}");
+        assert!((w - rig.sun_distance(bounds().center())).abs() < 1e-3);
+        // Image right is clip +x, image up is clip +y (as Camera::ray).
+        let (_, right, up) = rig.sun.camera.basis().unwrap();
+        let c = bounds().center();
+        let [x, _, _] = apply([0, 1, 2].map(|k| c[k] + right[k]));
+        let [_, y, _] = apply([0, 1, 2].map(|k| c[k] + up[k]));
+        assert!(x > 0.0 && y > 0.0);
+    }
+
+    #[test]
+    fn two_halves_keep_22_bits_of_distance() {
+        for d in [0.5f32, 12.345, 99.87654, 170.001] {
+            let hi = half::f16::from_f32(d);
+            let lo = half::f16::from_f32(d - hi.to_f32());
+            let back = hi.to_f32() + lo.to_f32();
+            assert!(((back - d) / d).abs() < 2.0f32.powi(-21), "{d} -> {back}");
+        }
+    }
+}
