@@ -174,11 +174,16 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
                 (_, Some(_)) => args.knob.clone(),
                 _ => "-".to_string(),
             };
-            bar.set_message(format!(
+            let what = format!(
                 "{mode}{}{}",
                 value.map(|v| format!(" {knob}={v:e}")).unwrap_or_default(),
                 if forced { " (forced)" } else { "" }
-            ));
+            );
+            // The bar draws only on a terminal; logs get a line per point.
+            if bar.is_hidden() {
+                eprintln!("{scene_name} [{}/{}] {what}", bar.position() + 1, bar.length().unwrap_or(0));
+            }
+            bar.set_message(what);
             let mut options = DispatchOptions { force_refine: forced, ..DispatchOptions::new(mode) };
             if has_knob {
                 let v = match (mode, value) {
@@ -209,6 +214,7 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
                 value: value.unwrap_or(f64::NAN),
                 forced,
                 shaded_fraction: m.stats.shaded_fraction,
+                coarse_fraction: m.stats.coarse_shaded_fraction,
                 wall_ms: m.wall_ms,
                 gpu_ms: m.gpu_ms,
                 rmse: metrics.rmse,
@@ -335,7 +341,11 @@ fn controller_run(
             target: args.target_fraction,
         });
         controller.update(m.stats.shaded_fraction);
-        bar.set_message(format!("shaded {:.1}%", 100.0 * m.stats.shaded_fraction));
+        let what = format!("similarity {threshold:.3e}: shaded {:.1}%", 100.0 * m.stats.shaded_fraction);
+        if bar.is_hidden() {
+            eprintln!("controller [{}/{}] {what}", i + 1, args.path_frames);
+        }
+        bar.set_message(what);
         bar.inc(1);
     }
     bar.finish();

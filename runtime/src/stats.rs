@@ -46,6 +46,10 @@ pub struct Stats {
     pub effects: Vec<EffectStats>,
     /// Effect evaluations relative to the reference's (pixels x live effects).
     pub shaded_fraction: f64,
+    /// The same over the coarse effects only: the part of the shading that
+    /// adapts (fine effects run once per pixel in every mode). The analogue
+    /// of DACS's "shading rate"; 1 in a program without coarse effects.
+    pub coarse_shaded_fraction: f64,
     pub timings: Option<Timings>,
     /// Hierarchical mode: pixels queued for shading at levels 1 to 4.
     pub work_lists: Vec<u64>,
@@ -93,6 +97,12 @@ impl Stats {
         let total: u64 = effects.iter().map(|e| e.coarse_evaluations + e.pixel_evaluations).sum();
         let shaded_fraction =
             if effects.is_empty() { 1.0 } else { total as f64 / (pixels * effects.len() as u64) as f64 };
+        let coarse: Vec<&EffectStats> = effects.iter().filter(|e| e.rate == Rate::Coarse).collect();
+        let coarse_shaded_fraction = if coarse.is_empty() {
+            1.0
+        } else {
+            coarse.iter().map(|e| e.shaded_fraction).sum::<f64>() / coarse.len() as f64
+        };
         Stats {
             mode: options.mode.name().into(),
             force_refine: options.force_refine,
@@ -101,6 +111,7 @@ impl Stats {
             coarse_samples: samples,
             effects,
             shaded_fraction,
+            coarse_shaded_fraction,
             timings,
             work_lists: vec![],
             lane_utilisation: None,
@@ -110,13 +121,14 @@ impl Stats {
     /// A human-readable table.
     pub fn table(&self) -> String {
         let mut out = format!(
-            "{} {}x{}{}: {} coarse samples, shaded fraction {:.1}% of the reference\n",
+            "{} {}x{}{}: {} coarse samples, shaded fraction {:.1}% of the reference ({:.1}% of its coarse effects)\n",
             self.mode,
             self.width,
             self.height,
             if self.force_refine { " (forced refine)" } else { "" },
             self.coarse_samples,
-            100.0 * self.shaded_fraction
+            100.0 * self.shaded_fraction,
+            100.0 * self.coarse_shaded_fraction
         );
         out.push_str(&format!(
             "  {:<20} {:>6} {:>12} {:>12} {:>12} {:>8}\n",
