@@ -59,7 +59,10 @@ struct Bench<'a> {
 struct Measured {
     stats: Stats,
     wall_ms: f64,
+    /// Medians of the timestamp span, the coarse passes and the fine pass.
     gpu_ms: Option<f64>,
+    coarse_pass_ms: Option<f64>,
+    fine_pass_ms: Option<f64>,
 }
 
 impl Bench<'_> {
@@ -68,6 +71,8 @@ impl Bench<'_> {
         let device = &self.gpu.device;
         let mut walls = vec![];
         let mut gpus = vec![];
+        let mut coarse = vec![];
+        let mut fine = vec![];
         let mut last = None;
         for run in 0..=self.runs {
             let start = Instant::now();
@@ -81,12 +86,21 @@ impl Bench<'_> {
                 walls.push(wall);
                 if let Some(t) = stats.timings {
                     gpus.push(t.total_ms);
+                    coarse.push(t.coarse_ms + t.coarse2_ms);
+                    fine.push(t.fine_ms);
                 }
             }
             last = Some(stats);
         }
         let stats = last.ok_or("no run")?;
-        Ok(Measured { stats, wall_ms: median(walls), gpu_ms: (!gpus.is_empty()).then(|| median(gpus)) })
+        let timed = !gpus.is_empty();
+        Ok(Measured {
+            stats,
+            wall_ms: median(walls),
+            gpu_ms: timed.then(|| median(gpus)),
+            coarse_pass_ms: timed.then(|| median(coarse)),
+            fine_pass_ms: timed.then(|| median(fine)),
+        })
     }
 
     fn set(&mut self, name: &str, value: f64) -> Result<(), String> {
@@ -217,6 +231,8 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
                 coarse_fraction: m.stats.coarse_shaded_fraction,
                 wall_ms: m.wall_ms,
                 gpu_ms: m.gpu_ms,
+                coarse_pass_ms: m.coarse_pass_ms,
+                fine_pass_ms: m.fine_pass_ms,
                 rmse: metrics.rmse,
                 psnr: metrics.psnr,
                 mssim: metrics.mssim,

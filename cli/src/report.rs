@@ -25,6 +25,12 @@ pub struct Point {
     pub wall_ms: f64,
     /// Median GPU time of the shading passes (timestamp span), if the device has timestamps.
     pub gpu_ms: Option<f64>,
+    /// Medians of the per-pass timestamps ([`mrsl_runtime::Timings`]): the
+    /// coarse passes (4x4 and the dynamic mode's 2x2, or the hierarchical
+    /// levels) and the fine or final pass. On lavapipe the split is not
+    /// reliable (see docs/evaluation.md); `gpu_ms` is.
+    pub coarse_pass_ms: Option<f64>,
+    pub fine_pass_ms: Option<f64>,
     pub rmse: f64,
     pub psnr: f64,
     pub mssim: f64,
@@ -511,6 +517,8 @@ mod tests {
             coarse_fraction: fraction,
             wall_ms: time,
             gpu_ms: None,
+            coarse_pass_ms: None,
+            fine_pass_ms: None,
             rmse: 1.0 - mssim,
             psnr: 10.0 + 100.0 * mssim,
             mssim,
@@ -573,7 +581,7 @@ mod tests {
         let text = csv(&pts).unwrap();
         assert_eq!(text.lines().count(), 4);
         assert!(text.starts_with(
-            "scene,mode,knob,value,forced,shaded_fraction,coarse_fraction,wall_ms,gpu_ms,rmse,psnr,mssim,flip"
+            "scene,mode,knob,value,forced,shaded_fraction,coarse_fraction,wall_ms,gpu_ms,coarse_pass_ms,fine_pass_ms,rmse,psnr,mssim,flip"
         ));
         let md = markdown("setup", &pts, &[]);
         // MSSIM 0.99 at 46.7 ms: 100 / 46.7.
