@@ -3,7 +3,7 @@
 //! reference, runs the dynamic-threshold controller along a camera path,
 //! and writes the markdown report, the CSV files and the plots.
 
-use crate::render::{BoundScene, Resources, bind_scene};
+use crate::render::{BoundScene, Resources, bind_scene, compile_program};
 use crate::report::{self, ControllerFrame, Point};
 use indicatif::{ProgressBar, ProgressStyle};
 use mrsl_runtime::controller::{Target, ThresholdController};
@@ -47,10 +47,9 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-/// A program, a shader and a scene bound together.
+/// A shader on a device, measured `runs` times per configuration.
 struct Bench<'a> {
     gpu: &'a Gpu,
-    program: &'a mrsl::Program,
     shader: Shader,
     runs: usize,
 }
@@ -106,10 +105,11 @@ impl Bench<'_> {
     fn set(&mut self, name: &str, value: f64) -> Result<(), String> {
         self.shader.set_uniform(name, &[value]).map_err(|e| e.to_string())
     }
+}
 
-    fn declares(&self, name: &str) -> bool {
-        self.program.layout.uniforms.as_ref().is_some_and(|u| u.fields.iter().any(|f| f.name == name))
-    }
+/// The program's uniform `name`, if it declares one.
+fn uniform<'p>(program: &'p mrsl::Program, name: &str) -> Option<&'p mrsl::layout::Field> {
+    program.layout.uniforms.as_ref()?.fields.iter().find(|f| f.name == name)
 }
 
 /// The configurations of one scene, in order.
@@ -131,20 +131,18 @@ fn plan(args: &BenchArgs, has_knob: bool) -> Vec<(Mode, Option<f64>, bool)> {
 
 /// Runs the benchmark; returns the files written.
 pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
-    let (name, source) = match &args.program {
-        Some(path) => (
-            path.display().to_string(),
-            std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?,
-        ),
-        None => ("sponza_lights.mrsl (built in)".to_string(), WORKLOAD_PROGRAM.to_string()),
-    };
-    let options = mrsl::Options { file_name: name.clone(), ..mrsl::Options::default() };
-    let program = mrsl::compile(&source, &options).map_err(|d| mrsl::render_all(&d, &name, &source))?;
+    let (name, program) = compile_program(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM))?;
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
     let device_name = format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
     eprintln!("bench: {name} on {device_name}, {}x{}, {} runs per point (median)", args.size.0, args.size.1, args.runs);
     std::fs::create_dir_all(&args.out_dir).map_err(|e| format!("cannot create {}: {e}", args.out_dir.display()))?;
 
+    let knob = uniform(&program, &args.knob);
+    let has_knob = knob.is_some();
+    let knob_default = knob.and_then(|f| f.default.as_ref()).and_then(|d| d.first().copied());
+    if !has_knob && args.modes.iter().any(|m| !matches!(m, Mode::Reference | Mode::Checkerboard | Mode::Hierarchical)) {
+        eprintln!("bench: {name} has no uniform `{}`: the block modes run once at the program's defaults", args.knob);
+    }
     let mut points: Vec<Point> = vec![];
     let mut frames: Vec<ControllerFrame> = vec![];
     for scene_name in &args.scenes {
@@ -153,22 +151,7 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
         shader.set_timestamp_period(&gpu.queue);
         let shadow_map = scene.prepare(&gpu, &mut shader).map_err(|e| format!("{scene_name}: {e}"))?;
         let resources = Resources::new(&gpu, &program, scene.size, shadow_map);
-        let mut bench = Bench { gpu: &gpu, program: &program, shader, runs: args.runs.max(1) };
-        let has_knob = bench.declares(&args.knob);
-        if !has_knob
-            && args.modes.iter().any(|m| !matches!(m, Mode::Reference | Mode::Checkerboard | Mode::Hierarchical))
-        {
-            eprintln!(
-                "bench: {name} has no uniform `{}`: the block modes run once at the program's defaults",
-                args.knob
-            );
-        }
-        let knob_default = program
-            .layout
-            .uniforms
-            .as_ref()
-            .and_then(|u| u.fields.iter().find(|f| f.name == args.knob))
-            .and_then(|f| f.default.as_ref().and_then(|d| d.first().copied()));
+        let mut bench = Bench { gpu: &gpu, shader, runs: args.runs.max(1) };
         let plan = plan(args, has_knob);
         let bar = ProgressBar::new(plan.len() as u64).with_style(
             ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} {msg} ({elapsed})")
@@ -270,7 +253,7 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
     write("bench.md", markdown.as_bytes())?;
     write("bench.csv", report::csv(&points)?.as_bytes())?;
     if !frames.is_empty() {
-        write("controller.csv", report::controller_csv(&frames)?.as_bytes())?;
+        write("controller.csv", report::csv(&frames)?.as_bytes())?;
     }
     let plot_size = (900, 600);
     for scene in &args.scenes {
@@ -325,8 +308,7 @@ fn controller_run(
     let shadow_map = scene.prepare(gpu, &mut shader)?;
     let mesh = scene.mesh.as_ref().ok_or("the controller needs a mesh scene")?;
     let resources = Resources::new(gpu, program, args.size, shadow_map);
-    let has_knob = program.layout.uniforms.as_ref().is_some_and(|u| u.fields.iter().any(|f| f.name == args.knob));
-    if has_knob {
+    if uniform(program, &args.knob).is_some() {
         shader.set_uniform(&args.knob, &[KNOB_OFF]).map_err(|e| e.to_string())?;
     }
     let start = args.similarities.iter().copied().fold(f64::NAN, f64::min);
@@ -338,7 +320,7 @@ fn controller_run(
             .progress_chars("=> "),
     );
     let mut frames = vec![];
-    let mut bench = Bench { gpu, program, shader, runs: 1 };
+    let mut bench = Bench { gpu, shader, runs: 1 };
     for i in 0..args.path_frames {
         let camera = path_camera(&mesh.camera, i, args.path_frames);
         let channels = mesh.gbuffer(gpu, &camera, args.size).map_err(|e| e.to_string())?;

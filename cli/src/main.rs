@@ -198,18 +198,7 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
                 compare: r.compare,
                 similarity: r.similarity,
             };
-            match render::render(&args) {
-                Ok(paths) => {
-                    for p in paths {
-                        eprintln!("wrote {}", p.display());
-                    }
-                    Ok(ExitCode::SUCCESS)
-                }
-                Err(message) => {
-                    eprintln!("{message}");
-                    Ok(ExitCode::from(1))
-                }
-            }
+            Ok(written(render::render(&args)))
         }
         Command::Bench(b) => {
             let modes: Vec<mrsl_runtime::Mode> = if b.modes == "all" {
@@ -236,18 +225,7 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
                 path_frames: b.path_frames,
                 target_fraction: b.target_fraction,
             };
-            match bench::bench(&args) {
-                Ok(paths) => {
-                    for p in paths {
-                        eprintln!("wrote {}", p.display());
-                    }
-                    Ok(ExitCode::SUCCESS)
-                }
-                Err(message) => {
-                    eprintln!("{message}");
-                    Ok(ExitCode::from(1))
-                }
-            }
+            Ok(written(bench::bench(&args)))
         }
         Command::Compile { file, out_dir, emit, blocks } => {
             let (name, source) = read(file)?;
@@ -292,6 +270,23 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
                 eprintln!("wrote {}", path.display());
             }
             Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+/// The exit of a command that writes files: lists them (exit 0), or prints
+/// why it failed (exit 1).
+fn written(result: Result<Vec<PathBuf>, String>) -> ExitCode {
+    match result {
+        Ok(paths) => {
+            for p in paths {
+                eprintln!("wrote {}", p.display());
+            }
+            ExitCode::SUCCESS
+        }
+        Err(message) => {
+            eprintln!("{message}");
+            ExitCode::from(1)
         }
     }
 }

@@ -47,19 +47,27 @@ fn progress(what: &str, start: Instant) {
     eprintln!("{what} ({:.0} ms)", start.elapsed().as_secs_f64() * 1e3);
 }
 
-/// Runs the render; returns the paths written.
-pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
-    let (name, source) = match &args.program {
+/// Reads and compiles the program at `path` (default options), or the
+/// built-in `(name, source)`; returns its name for messages and the program,
+/// or the diagnostics rendered.
+pub fn compile_program(path: Option<&Path>, builtin: (&str, &str)) -> Result<(String, mrsl::Program), String> {
+    let (name, source) = match path {
         Some(path) => (
             path.display().to_string(),
             std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?,
         ),
-        None => ("demo.mrsl (built in)".to_string(), DEMO_PROGRAM.to_string()),
+        None => (format!("{} (built in)", builtin.0), builtin.1.to_string()),
     };
-    let stem = args.program.as_ref().and_then(|p| p.file_stem()).and_then(|s| s.to_str()).unwrap_or("demo").to_string();
-    let start = Instant::now();
     let options = Options { file_name: name.clone(), ..Options::default() };
     let program = mrsl::compile(&source, &options).map_err(|d| mrsl::render_all(&d, &name, &source))?;
+    Ok((name, program))
+}
+
+/// Runs the render; returns the paths written.
+pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
+    let stem = args.program.as_ref().and_then(|p| p.file_stem()).and_then(|s| s.to_str()).unwrap_or("demo").to_string();
+    let start = Instant::now();
+    let (name, program) = compile_program(args.program.as_deref(), ("demo.mrsl", DEMO_PROGRAM))?;
     progress(&format!("compiled {name}: {} kernels", program.kernels.len()), start);
 
     let start = Instant::now();

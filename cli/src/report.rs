@@ -237,19 +237,12 @@ pub struct ControllerFrame {
     pub target: f64,
 }
 
-/// The points as CSV (one row per point; empty cells for missing values).
-pub fn csv(points: &[Point]) -> Result<String, String> {
+/// Rows ([`Point`]s or [`ControllerFrame`]s) as CSV: a header from the
+/// field names, one row each, empty cells for missing values.
+pub fn csv<T: serde::Serialize>(rows: &[T]) -> Result<String, String> {
     let mut writer = csv::Writer::from_writer(vec![]);
-    for p in points {
-        writer.serialize(p).map_err(|e| e.to_string())?;
-    }
-    String::from_utf8(writer.into_inner().map_err(|e| e.to_string())?).map_err(|e| e.to_string())
-}
-
-pub fn controller_csv(frames: &[ControllerFrame]) -> Result<String, String> {
-    let mut writer = csv::Writer::from_writer(vec![]);
-    for f in frames {
-        writer.serialize(f).map_err(|e| e.to_string())?;
+    for row in rows {
+        writer.serialize(row).map_err(|e| e.to_string())?;
     }
     String::from_utf8(writer.into_inner().map_err(|e| e.to_string())?).map_err(|e| e.to_string())
 }
@@ -386,6 +379,25 @@ fn register_font() -> Result<(), String> {
     .clone()
 }
 
+/// Draws a chart with `draw` on a white `size` canvas; returns its RGB bytes.
+fn draw_rgb(
+    size: (u32, u32),
+    draw: impl FnOnce(
+        &plotters::drawing::DrawingArea<plotters::prelude::BitMapBackend, plotters::coord::Shift>,
+    ) -> Result<(), String>,
+) -> Result<Vec<u8>, String> {
+    use plotters::prelude::*;
+    register_font()?;
+    let mut buffer = vec![255u8; (size.0 * size.1 * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        draw(&root)?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(buffer)
+}
+
 const PALETTE: [plotters::style::RGBColor; 6] = [
     plotters::style::RGBColor(31, 119, 180),
     plotters::style::RGBColor(255, 127, 14),
@@ -399,16 +411,12 @@ const PALETTE: [plotters::style::RGBColor; 6] = [
 /// against time per mode, one PNG of `size` pixels per scene; returns RGB bytes.
 pub fn plot_quality_vs_time(points: &[Point], scene: &str, size: (u32, u32)) -> Result<Vec<u8>, String> {
     use plotters::prelude::*;
-    register_font()?;
-    let mut buffer = vec![255u8; (size.0 * size.1 * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, size).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
+    draw_rgb(size, |root| {
         let pts: Vec<&Point> = points.iter().filter(|p| p.scene == scene && !p.forced).collect();
         let nines = |m: f64| -(1.0 - m).max(1e-6).log10();
         let t_max = pts.iter().map(|p| p.time_ms()).fold(1.0, f64::max) * 1.1;
         let q_max = pts.iter().filter(|p| p.mode != "reference").map(|p| nines(p.mssim)).fold(2.5, f64::max) * 1.1;
-        let mut chart = ChartBuilder::on(&root)
+        let mut chart = ChartBuilder::on(root)
             .caption(format!("{scene}: quality vs time"), ("sans-serif", 22))
             .margin(12)
             .x_label_area_size(40)
@@ -449,21 +457,16 @@ pub fn plot_quality_vs_time(points: &[Point], scene: &str, size: (u32, u32)) -> 
             .position(SeriesLabelPosition::LowerRight)
             .draw()
             .map_err(|e| e.to_string())?;
-        root.present().map_err(|e| e.to_string())?;
-    }
-    Ok(buffer)
+        Ok(())
+    })
 }
 
 /// The controller run: shaded fraction per frame and the target; RGB bytes.
 pub fn plot_controller(frames: &[ControllerFrame], size: (u32, u32)) -> Result<Vec<u8>, String> {
     use plotters::prelude::*;
-    register_font()?;
-    let mut buffer = vec![255u8; (size.0 * size.1 * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, size).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
+    draw_rgb(size, |root| {
         let n = frames.len().max(2) as f64;
-        let mut chart = ChartBuilder::on(&root)
+        let mut chart = ChartBuilder::on(root)
             .caption("dynamic threshold: shaded fraction per frame", ("sans-serif", 22))
             .margin(12)
             .x_label_area_size(40)
@@ -497,9 +500,8 @@ pub fn plot_controller(frames: &[ControllerFrame], size: (u32, u32)) -> Result<V
             .border_style(BLACK)
             .draw()
             .map_err(|e| e.to_string())?;
-        root.present().map_err(|e| e.to_string())?;
-    }
-    Ok(buffer)
+        Ok(())
+    })
 }
 
 #[cfg(test)]

@@ -59,7 +59,7 @@ impl Gpu {
     }
 
     /// A single-level 2D texture.
-    fn texture_2d(
+    pub(crate) fn texture_2d(
         &self,
         label: &str,
         size: (u32, u32),

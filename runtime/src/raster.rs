@@ -463,19 +463,7 @@ impl Rasterizer {
             layout: &self.globals_layout,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: globals_buffer.as_entire_binding() }],
         });
-        let extent = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
-        let texture = |label: &str, format, usage| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: extent,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
+        let texture = |label: &str, format, usage| gpu.texture_2d(label, size, format, usage);
         let channels: Vec<(String, wgpu::Texture)> = CHANNELS
             .iter()
             .map(|&(name, format)| {

@@ -136,12 +136,9 @@ impl Scene {
     /// Sponza's straight from the rasteriser, without a round trip through
     /// the CPU; the CPU scenes' uploaded.
     pub fn textures_on(self, gpu: &Gpu, width: u32, height: u32) -> Result<Vec<(String, wgpu::Texture)>, SceneError> {
-        match self {
-            Scene::Sponza => {
-                let scene = self.mesh_scene(gpu)?.expect("Sponza is a mesh scene");
-                Ok(scene.gbuffer(gpu, &scene.camera, (width, height))?)
-            }
-            _ => Ok(self.render(width, height).upload(gpu)),
+        match self.mesh_scene(gpu)? {
+            Some(scene) => Ok(scene.gbuffer(gpu, &scene.camera, (width, height))?),
+            None => Ok(self.render(width, height).upload(gpu)),
         }
     }
 

@@ -564,11 +564,9 @@ impl Shader {
         views: &HashMap<&str, wgpu::TextureView>,
     ) {
         let (w, h) = bindings.size;
-        self.ensure_rate_image(device, bindings.size);
-        self.ensure_hier_buffers(device, bindings.size);
-        let (buffers, _) = self.hier_buffers.as_ref().expect("created above");
+        let stage = self.record_stage(device, KernelKind::Hierarchical, bindings.size, views);
+        let (buffers, _) = self.hier_buffers.as_ref().expect("created by record_stage");
         encoder.clear_buffer(&buffers.queue, 0, None);
-        let stage = self.record_stage_group(device, KernelKind::Hierarchical, buffers, views);
         let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("mrsl hierarchical args"),
             layout: &self.args_group_layout,
@@ -583,18 +581,7 @@ impl Shader {
             groups(w, h),
         ];
         {
-            let timestamp_writes = self.timestamps.as_ref().map(|t| wgpu::ComputePassTimestampWrites {
-                query_set: &t.set,
-                beginning_of_pass_write_index: Some(2),
-                end_of_pass_write_index: Some(3),
-            });
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("mrsl hierarchical levels"),
-                timestamp_writes,
-            });
-            pass.set_bind_group(0, Some(resources), &[]);
-            pass.set_bind_group(1, Some(gbuffer), &[]);
-            pass.set_bind_group(2, Some(&stage), &[]);
+            let mut pass = self.begin_pass(encoder, "mrsl hierarchical levels", 1, &[resources, gbuffer, &stage]);
             let (gx, gy) = groups(count(0, 4, w), count(0, 4, h));
             pass.set_pipeline(&self.hierarchical[&0]);
             pass.dispatch_workgroups(gx, gy, 1);
@@ -610,18 +597,7 @@ impl Shader {
             }
         }
         {
-            let timestamp_writes = self.timestamps.as_ref().map(|t| wgpu::ComputePassTimestampWrites {
-                query_set: &t.set,
-                beginning_of_pass_write_index: Some(4),
-                end_of_pass_write_index: Some(5),
-            });
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("mrsl hierarchical final"),
-                timestamp_writes,
-            });
-            pass.set_bind_group(0, Some(resources), &[]);
-            pass.set_bind_group(1, Some(gbuffer), &[]);
-            pass.set_bind_group(2, Some(&stage), &[]);
+            let mut pass = self.begin_pass(encoder, "mrsl hierarchical final", 2, &[resources, gbuffer, &stage]);
             pass.set_pipeline(&self.hierarchical[&13]);
             pass.dispatch_workgroups(w.div_ceil(mrsl::layout::TILE), h.div_ceil(mrsl::layout::TILE), 1);
         }
@@ -640,20 +616,8 @@ impl Shader {
         views: &HashMap<&str, wgpu::TextureView>,
     ) {
         let (w, h) = bindings.size;
-        self.ensure_rate_image(device, bindings.size);
-        self.ensure_hier_buffers(device, bindings.size);
-        let (buffers, _) = self.hier_buffers.as_ref().expect("created above");
-        let stage = self.record_stage_group(device, KernelKind::Checkerboard, buffers, views);
-        let timestamp_writes = self.timestamps.as_ref().map(|t| wgpu::ComputePassTimestampWrites {
-            query_set: &t.set,
-            beginning_of_pass_write_index: Some(2),
-            end_of_pass_write_index: Some(3),
-        });
-        let mut pass = encoder
-            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("mrsl checkerboard"), timestamp_writes });
-        pass.set_bind_group(0, Some(resources), &[]);
-        pass.set_bind_group(1, Some(gbuffer), &[]);
-        pass.set_bind_group(2, Some(&stage), &[]);
+        let stage = self.record_stage(device, KernelKind::Checkerboard, bindings.size, views);
+        let mut pass = self.begin_pass(encoder, "mrsl checkerboard", 1, &[resources, gbuffer, &stage]);
         // cb_shade: 16 shaded quads per workgroup along a row of quads.
         let (quads_x, quads_y) = (w.div_ceil(2), h.div_ceil(2));
         pass.set_pipeline(&self.checkerboard[0]);
@@ -665,14 +629,18 @@ impl Shader {
 
     /// Group 2 of the modes that keep a record per pixel (hierarchical, checkerboard):
     /// the records (and for the hierarchical mode its work lists and queues), the
-    /// outputs, the statistics and the rate image.
-    fn record_stage_group(
-        &self,
+    /// outputs, the statistics and the rate image; (re)creates the record
+    /// buffers and the rate image for `size` first.
+    fn record_stage(
+        &mut self,
         device: &wgpu::Device,
         kind: KernelKind,
-        buffers: &HierBuffers,
+        size: (u32, u32),
         views: &HashMap<&str, wgpu::TextureView>,
     ) -> wgpu::BindGroup {
+        self.ensure_rate_image(device, size);
+        self.ensure_hier_buffers(device, size);
+        let (buffers, _) = self.hier_buffers.as_ref().expect("created just above");
         let l = &self.layout;
         let hl = &l.hierarchical;
         let mut entries =
@@ -720,6 +688,20 @@ impl Shader {
         groups: &[&wgpu::BindGroup],
         workgroups: (u32, u32),
     ) {
+        let mut pass = self.begin_pass(encoder, label, stage, groups);
+        pass.set_pipeline(&self.pipelines[&pipeline]);
+        pass.dispatch_workgroups(workgroups.0, workgroups.1, 1);
+    }
+
+    /// Begins a compute pass that writes stage slot `stage`'s timestamps
+    /// (see `read_stats`) and binds `groups` as groups 0, 1, 2, ...
+    fn begin_pass<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        label: &str,
+        stage: u32,
+        groups: &[&wgpu::BindGroup],
+    ) -> wgpu::ComputePass<'e> {
         let timestamp_writes = self.timestamps.as_ref().map(|t| wgpu::ComputePassTimestampWrites {
             query_set: &t.set,
             beginning_of_pass_write_index: Some(2 * stage),
@@ -727,11 +709,10 @@ impl Shader {
         });
         let mut pass =
             encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes });
-        pass.set_pipeline(&self.pipelines[&pipeline]);
         for (i, g) in groups.iter().enumerate() {
             pass.set_bind_group(i as u32, Some(*g), &[]);
         }
-        pass.dispatch_workgroups(workgroups.0, workgroups.1, 1);
+        pass
     }
 
     /// The interface buffer for `block`, (re)created when the size changes.
