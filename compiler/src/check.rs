@@ -8,6 +8,7 @@
 use crate::diagnostic::{Diagnostic, Label};
 use crate::syntax::ast::*;
 use crate::types::{self, Scalar, Type};
+use mrsl_abi::TextureFormat;
 use std::collections::{HashMap, HashSet};
 
 macro_rules! typed_id {
@@ -48,15 +49,8 @@ pub enum Callee {
     Construct(Type),
 }
 
-/// How a discontinuity-key channel is compared between samples.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-#[serde(tag = "kind", rename_all = "lowercase")]
-pub enum KeyCompare {
-    /// Any difference is a discontinuity.
-    Exact,
-    /// `distance(a, b) > threshold` is a discontinuity.
-    Threshold { threshold: f64 },
-}
+/// How a discontinuity-key channel is compared (part of the layout contract).
+pub use mrsl_abi::KeyCompare;
 
 #[derive(Debug, Clone)]
 pub struct InputInfo {
@@ -116,7 +110,7 @@ pub struct EffectInfo {
     /// The local variable holding the result inside a block body.
     pub result: Option<LocalId>,
     /// Output storage format (outputs only).
-    pub format: Option<String>,
+    pub format: Option<TextureFormat>,
 }
 
 #[derive(Debug, Clone)]
@@ -657,7 +651,9 @@ impl<'a> Checker<'a> {
                         _ => None,
                     };
                     match format {
-                        Some(f) if output_format_fits(&f, &ty) => self.out.effects[id.index()].format = Some(f),
+                        Some(f) if let Some(fits) = output_format_fits(&f, &ty) => {
+                            self.out.effects[id.index()].format = Some(fits)
+                        }
                         Some(f) => self.error(
                             err(
                                 "E0116",
@@ -665,7 +661,10 @@ impl<'a> Checker<'a> {
                                 attr.span,
                                 "unsupported format",
                             )
-                            .with_note(format!("formats for `{ty}`: {}", formats_for(&ty).join(", "))),
+                            .with_note(format!(
+                                "formats for `{ty}`: {}",
+                                formats_for(&ty).iter().map(|f| f.name()).collect::<Vec<_>>().join(", ")
+                            )),
                         ),
                         None => self.error(err(
                             "E0116",
@@ -681,7 +680,7 @@ impl<'a> Checker<'a> {
             }
         }
         if d.rate == Rate::Out && self.out.effects[id.index()].format.is_none() && ok {
-            self.out.effects[id.index()].format = Some(default_output_format(&ty).to_string());
+            self.out.effects[id.index()].format = Some(default_output_format(&ty));
         }
     }
 
@@ -2436,45 +2435,36 @@ fn texture_args(name: &str, args: &[Type], rest: &[Type]) -> Result<(), BuiltinE
 }
 
 /// Storage-texture formats an output of type `ty` may be written to.
-pub fn formats_for(ty: &Type) -> Vec<&'static str> {
+pub fn formats_for(ty: &Type) -> Vec<TextureFormat> {
+    use TextureFormat as F;
     // A format must hold every component: single-channel formats only for
     // scalars, two-channel ones for at most two components.
     let n = ty.components();
-    formats_any(ty)
-        .into_iter()
-        .filter(|f| match *f {
-            "r32float" | "r32uint" | "r32sint" => n == 1,
-            "rg32float" => n <= 2,
-            _ => true,
-        })
-        .collect()
-}
-
-fn formats_any(ty: &Type) -> Vec<&'static str> {
-    match ty {
-        Type::Scalar(Scalar::Float) => vec!["r32float", "rgba16float", "rgba32float", "rgba8unorm"],
-        Type::Vector(Scalar::Float, _) => {
-            vec!["rgba32float", "rgba16float", "rgba8unorm", "rg32float"]
-        }
-        Type::Scalar(Scalar::Uint) | Type::Vector(Scalar::Uint, _) => vec!["r32uint", "rgba32uint"],
-        Type::Scalar(Scalar::Int) | Type::Vector(Scalar::Int, _) => vec!["r32sint", "rgba32sint"],
+    let any = match ty {
+        Type::Scalar(Scalar::Float) => vec![F::R32Float, F::Rgba16Float, F::Rgba32Float, F::Rgba8Unorm],
+        Type::Vector(Scalar::Float, _) => vec![F::Rgba32Float, F::Rgba16Float, F::Rgba8Unorm, F::Rg32Float],
+        Type::Scalar(Scalar::Uint) | Type::Vector(Scalar::Uint, _) => vec![F::R32Uint, F::Rgba32Uint],
+        Type::Scalar(Scalar::Int) | Type::Vector(Scalar::Int, _) => vec![F::R32Sint, F::Rgba32Sint],
         _ => vec![],
-    }
+    };
+    any.into_iter().filter(|f| f.components() >= n.min(4) || f.components() == 4).collect()
 }
 
-fn output_format_fits(format: &str, ty: &Type) -> bool {
-    formats_for(ty).contains(&format)
+/// The format called `format`, if an output of type `ty` may be written to it.
+fn output_format_fits(format: &str, ty: &Type) -> Option<TextureFormat> {
+    formats_for(ty).into_iter().find(|f| f.name() == format)
 }
 
 /// The default storage format of an output: exact 32-bit storage, so that
 /// outputs can be compared bit for bit with the reference.
-pub fn default_output_format(ty: &Type) -> &'static str {
+pub fn default_output_format(ty: &Type) -> TextureFormat {
+    use TextureFormat as F;
     match ty {
-        Type::Scalar(Scalar::Float) => "r32float",
-        Type::Vector(Scalar::Float, _) => "rgba32float",
-        Type::Scalar(Scalar::Uint) => "r32uint",
-        Type::Vector(Scalar::Uint, _) => "rgba32uint",
-        Type::Scalar(Scalar::Int) => "r32sint",
-        _ => "rgba32sint",
+        Type::Scalar(Scalar::Float) => F::R32Float,
+        Type::Vector(Scalar::Float, _) => F::Rgba32Float,
+        Type::Scalar(Scalar::Uint) => F::R32Uint,
+        Type::Vector(Scalar::Uint, _) => F::Rgba32Uint,
+        Type::Scalar(Scalar::Int) => F::R32Sint,
+        _ => F::Rgba32Sint,
     }
 }

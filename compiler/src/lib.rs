@@ -2,9 +2,12 @@
 //!
 //! A program declares G-buffer inputs, uniforms, functions and *effects* at
 //! coarse or fine rate; coarse effects may `refine` themselves where they are
-//! not smooth. [`compile`] turns the source into three WGSL compute kernels
-//! (coarse, fine, reference), validated by naga, and a [`Layout`] describing
-//! every binding and the coarse-to-fine interface.
+//! not smooth. [`compile`] turns the source into WGSL compute kernels (coarse
+//! and fine per block size, a per-pixel reference, and the kernels of the
+//! dynamic, hierarchical and checkerboard modes), validated by naga, and a
+//! [`Layout`] describing every binding and the coarse-to-fine interface. The
+//! result is a [`Program`]: a [`CompiledProgram`] (the `mrsl-abi` contract
+//! type the runtime consumes) plus warnings.
 //!
 //! ```
 //! let source = "
@@ -34,8 +37,7 @@ pub mod types;
 pub mod wgsl;
 
 pub use diagnostic::{Diagnostic, Label, Severity, render_all};
-pub use layout::Layout;
-pub use wgsl::KernelKind;
+pub use mrsl_abi::{CompiledProgram, Kernel, KernelKind, Layout};
 
 /// Which kernels to generate, and for which block sizes.
 #[derive(Debug, Clone, PartialEq)]
@@ -73,41 +75,20 @@ impl Default for Options {
 /// Block sizes the generated kernels support.
 pub const BLOCK_SIZES: [u32; 2] = [2, 4];
 
-/// One generated WGSL compute kernel.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct Kernel {
-    pub kind: KernelKind,
-    /// Coarse block size; `None` for the reference kernel.
-    pub block_size: Option<u32>,
-    /// The main entry point.
-    pub entry_point: &'static str,
-    /// Every entry point, in dispatch order (one for all but the hierarchical kernel).
-    pub entry_points: Vec<&'static str>,
-    pub workgroup_size: [u32; 3],
-    pub wgsl: String,
-}
-
-/// A compiled program.
+/// A compiled program: kernels and layout (dereferences to the
+/// [`CompiledProgram`] the runtime takes), and the warnings found on the way.
 #[derive(Debug, Clone)]
 pub struct Program {
-    pub kernels: Vec<Kernel>,
-    pub layout: Layout,
+    pub compiled: CompiledProgram,
     /// Warnings (the program compiled regardless).
     pub warnings: Vec<Diagnostic>,
 }
 
-impl Program {
-    /// The kernel of `kind` for block size `block` (ignored for the reference kernel).
-    pub fn kernel(&self, kind: KernelKind, block: u32) -> Option<&Kernel> {
-        let any_block = matches!(
-            kind,
-            KernelKind::Reference
-                | KernelKind::DynamicCoarse
-                | KernelKind::DynamicFine
-                | KernelKind::Hierarchical
-                | KernelKind::Checkerboard
-        );
-        self.kernels.iter().find(|k| k.kind == kind && (any_block || k.block_size == Some(block)))
+impl std::ops::Deref for Program {
+    type Target = CompiledProgram;
+
+    fn deref(&self) -> &CompiledProgram {
+        &self.compiled
     }
 }
 
@@ -202,20 +183,9 @@ fn generate(
                     .with_note(message),
             ]);
         }
-        kernels.push(Kernel {
-            kind,
-            block_size: block,
-            entry_point: kind.entry_point(),
-            entry_points: match kind {
-                KernelKind::Hierarchical => wgsl::HIERARCHICAL_ENTRY_POINTS.to_vec(),
-                KernelKind::Checkerboard => vec!["cb_shade", "cb_final"],
-                _ => vec![kind.entry_point()],
-            },
-            workgroup_size: kind.workgroup_size(),
-            wgsl,
-        });
+        kernels.push(Kernel { kind, block_size: block, wgsl });
     }
-    Ok(Program { kernels, layout, warnings: diagnostics })
+    Ok(Program { compiled: CompiledProgram::new(kernels, layout), warnings: diagnostics })
 }
 
 /// Parses and checks `source` (all stages that report diagnostics), then

@@ -1,34 +1,6 @@
 //! The types of mrsl values, their WGSL spelling and host layout rules.
 
-use serde::Serialize;
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Scalar {
-    Bool,
-    Int,
-    Uint,
-    Float,
-}
-
-impl Scalar {
-    pub fn name(self) -> &'static str {
-        match self {
-            Scalar::Bool => "bool",
-            Scalar::Int => "int",
-            Scalar::Uint => "uint",
-            Scalar::Float => "float",
-        }
-    }
-    pub fn wgsl(self) -> &'static str {
-        match self {
-            Scalar::Bool => "bool",
-            Scalar::Int => "i32",
-            Scalar::Uint => "u32",
-            Scalar::Float => "f32",
-        }
-    }
-}
+pub use mrsl_abi::Scalar;
 
 /// A type. `AbstractInt`/`AbstractFloat` are the types of unsuffixed literals
 /// (and constant expressions of them); they convert to a concrete type where
@@ -203,6 +175,19 @@ impl Type {
             }
             _ => (4, 4),
         }
+    }
+
+    /// The layout's spelling of a value type (scalars, vectors, matrices and
+    /// arrays of them); `None` for textures, samplers and literal types.
+    pub fn value_type(&self) -> Option<mrsl_abi::ValueType> {
+        use mrsl_abi::ValueType;
+        Some(match self {
+            Type::Scalar(s) => ValueType::Scalar(*s),
+            Type::Vector(s, n) => ValueType::Vector(*s, *n),
+            Type::Matrix(n) => ValueType::Matrix(*n),
+            Type::Array(t, n) => ValueType::Array(Box::new(t.value_type()?), *n),
+            _ => return None,
+        })
     }
 
     /// The type as stored in a host-shareable buffer (bool becomes u32).

@@ -10,52 +10,14 @@ use crate::check::{Callee, Checked, EffectId, KeyCompare, LocalId, Symbol, Unifo
 use crate::deriv::{DerivInfo, visit_expr, visit_stmt_exprs};
 use crate::graph::EffectGraph;
 use crate::interface::Interface;
-use crate::layout::{self, Layout};
+use crate::layout;
+use mrsl_abi::geometry::TILE;
+use mrsl_abi::{CONTROL_FIELDS, Layout, entry};
 use crate::syntax::ast::*;
 use crate::types::{Scalar, Type};
 use std::collections::{BTreeSet, HashMap};
 
-/// Which kernel to write.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum KernelKind {
-    /// One invocation per coarse sample: coarse effects, refine flags, interface writes.
-    Coarse,
-    /// One invocation per pixel: resample or re-evaluate coarse effects, then fine effects and outputs.
-    Fine,
-    /// One invocation per pixel: every effect evaluated per pixel.
-    Reference,
-    /// Dynamic mode, second level: one invocation per 2x2 coarse sample, shading
-    /// only samples that a 4x4 block refined by the (4x4) coarse kernel needs.
-    DynamicCoarse,
-    /// Dynamic mode, per pixel: 4x4 value, else 2x2 value, else evaluated.
-    DynamicFine,
-    /// Hierarchical (DACS) mode: one module with the entry points of every
-    /// level (see [`HIERARCHICAL_ENTRY_POINTS`]).
-    Hierarchical,
-    /// Checkerboard baseline: coarse effects shaded in half the 2x2 quads,
-    /// reconstructed in the others (entry points `cb_shade`, then `cb_final`).
-    Checkerboard,
-}
-
-/// Entry points of the hierarchical kernel, in dispatch order: level 0, then
-/// for each level 1 to 4 classify, args and (indirect) shade, then final.
-pub const HIERARCHICAL_ENTRY_POINTS: [&str; 14] = [
-    "hier_level0",
-    "hier_classify_1",
-    "hier_args_1",
-    "hier_shade_1",
-    "hier_classify_2",
-    "hier_args_2",
-    "hier_shade_2",
-    "hier_classify_3",
-    "hier_args_3",
-    "hier_shade_3",
-    "hier_classify_4",
-    "hier_args_4",
-    "hier_shade_4",
-    "hier_final",
-];
+pub use mrsl_abi::KernelKind;
 
 /// One level of coarse samples as the fine stage reads it.
 struct Level {
@@ -70,45 +32,6 @@ struct Level {
 impl Level {
     const DYNAMIC_OUTER: Level = Level { suffix: "", block: 4, buffer: "mrsl_interface", parent: false };
     const DYNAMIC_INNER: Level = Level { suffix: "2", block: 2, buffer: "mrsl_interface2", parent: true };
-}
-
-impl KernelKind {
-    pub fn name(self) -> &'static str {
-        match self {
-            KernelKind::Coarse => "coarse",
-            KernelKind::Fine => "fine",
-            KernelKind::Reference => "reference",
-            KernelKind::DynamicCoarse => "dynamic_coarse",
-            KernelKind::DynamicFine => "dynamic_fine",
-            KernelKind::Hierarchical => "hierarchical",
-            KernelKind::Checkerboard => "checkerboard",
-        }
-    }
-    pub fn entry_point(self) -> &'static str {
-        match self {
-            KernelKind::Coarse => "coarse_main",
-            KernelKind::Fine => "fine_main",
-            KernelKind::Reference => "reference_main",
-            KernelKind::DynamicCoarse => "dynamic_coarse_main",
-            KernelKind::DynamicFine => "dynamic_fine_main",
-            KernelKind::Hierarchical => "hier_final",
-            KernelKind::Checkerboard => "cb_final",
-        }
-    }
-    /// Whether the kernel runs per coarse sample (else per pixel).
-    pub fn is_coarse(self) -> bool {
-        matches!(self, KernelKind::Coarse | KernelKind::DynamicCoarse)
-    }
-    /// Whether the kernel resolves coarse values per pixel.
-    pub fn is_fine(self) -> bool {
-        matches!(self, KernelKind::Fine | KernelKind::DynamicFine)
-    }
-    pub fn workgroup_size(self) -> [u32; 3] {
-        match self {
-            KernelKind::Coarse | KernelKind::DynamicCoarse => [8, 8, 1],
-            _ => [layout::TILE * layout::TILE, 1, 1],
-        }
-    }
 }
 
 /// Everything the writer reads.
@@ -129,9 +52,6 @@ pub fn write_string(inputs: &Inputs, kind: KernelKind, block: u32) -> String {
     w.out
 }
 
-/// Entry point names of the generated kernels (user names are kept clear of them).
-const ENTRY_POINT_NAMES: [&str; 6] =
-    ["coarse_main", "fine_main", "reference_main", "dynamic_coarse_main", "dynamic_fine_main", "cb_final"];
 
 /// Renames user identifiers that collide with WGSL keywords, WGSL builtins or
 /// the generated `mrsl_` namespace, so source names survive everywhere else.
@@ -139,9 +59,8 @@ fn wgsl_ident(name: &str) -> String {
     let reserved = naga::keywords::wgsl::RESERVED.contains(&name)
         || naga::keywords::wgsl::BUILTIN_IDENTIFIERS.contains(&name)
         || name.to_ascii_lowercase().starts_with("mrsl")
-        || ENTRY_POINT_NAMES.contains(&name)
-        || name.starts_with("hier_")
-        || name.starts_with("cb_")
+        || KernelKind::ALL.iter().any(|k| k.entry_points().contains(&name))
+        || entry::RESERVED_PREFIXES.iter().any(|p| name.starts_with(p))
         || name.starts_with("__")
         || matches!(name, "u" | "pos");
     if reserved { format!("{name}_") } else { name.to_string() }
@@ -276,10 +195,12 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
     fn bindings(&mut self) {
         let l = self.i.layout;
         self.line(0, "struct MrslControl {");
-        self.line(1, "size: vec2<u32>,");
-        self.line(1, "force_refine: u32,");
-        self.line(1, "frame: u32,");
-        self.line(1, "similarity: f32, // hierarchical mode: largest neighbour variance still interpolated");
+        for f in &CONTROL_FIELDS {
+            match f.comment {
+                Some(comment) => self.line(1, format!("{}: {}, // {comment}", f.name, f.wgsl_type)),
+                None => self.line(1, format!("{}: {},", f.name, f.wgsl_type)),
+            }
+        }
         self.line(0, "}");
         self.line(
             0,
@@ -306,11 +227,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         self.line(0, "");
         self.line(0, "// G-buffer channels.");
         for ch in &l.channels {
-            let sample = match ch.sample_type {
-                "uint" => "u32",
-                "sint" => "i32",
-                _ => "f32",
-            };
+            let sample = ch.format.scalar().wgsl();
             self.line(
                 0,
                 format!(
@@ -1065,7 +982,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         let iface = self.i.interface;
         let [wx, wy, wz] = self.kind.workgroup_size();
         self.line(0, format!("@compute @workgroup_size({wx}, {wy}, {wz})"));
-        self.line(0, format!("fn {}(@builtin(global_invocation_id) mrsl_gid: vec3<u32>) {{", self.kind.entry_point()));
+        self.line(0, format!("fn {}(@builtin(global_invocation_id) mrsl_gid: vec3<u32>) {{", self.kind.main_entry_point()));
         self.line(1, "let mrsl_n = mrsl_grid();");
         self.line(1, "if (mrsl_gid.x >= u32(mrsl_n.x) || mrsl_gid.y >= u32(mrsl_n.y)) { return; }");
         self.line(1, "let mrsl_pos = vec2<i32>(mrsl_gid.xy);");
@@ -1357,7 +1274,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
 
     /// Entry point of the fine and reference kernels.
     fn pixel_entry(&mut self) {
-        let tile = layout::TILE;
+        let tile = TILE;
         let b = if self.kind.is_fine() { self.block } else { 2 };
         self.line(0, format!("// Pixel of a {tile}x{tile} tile for lane `li`: {b}x{b} blocks are laid out so that"));
         self.line(0, "// consecutive lanes (a SIMD group) cover whole blocks and share their refine decisions.");
@@ -1377,7 +1294,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             0,
             format!(
                 "fn {}(@builtin(workgroup_id) mrsl_wg: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {{",
-                self.kind.entry_point()
+                self.kind.main_entry_point()
             ),
         );
         self.line(1, "let mrsl_pos = mrsl_tile_pixel(mrsl_wg.xy, mrsl_li);");
@@ -1413,7 +1330,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         self.output_stores(&order, 2);
         self.line(1, "}");
         self.line(1, "workgroupBarrier();");
-        self.line(1, format!("for (var k = mrsl_li; k < {nc}u; k += {}u) {{", layout::TILE * layout::TILE));
+        self.line(1, format!("for (var k = mrsl_li; k < {nc}u; k += {}u) {{", TILE * TILE));
         self.line(2, "atomicAdd(&mrsl_stats[k], atomicLoad(&mrsl_wg_stats[k]));");
         self.line(1, "}");
         self.line(0, "}");
@@ -1690,7 +1607,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             self.line(0, "");
         }
         // Final pass: coarse values from the records, fine effects and outputs per pixel.
-        self.record_final_entry("hier_final");
+        self.record_final_entry(entry::HIER_FINAL);
         let order = self.i.graph.order.clone();
         let nc = coarse.len();
         self.line(1, "if (all(mrsl_pos < mrsl_grid())) {");
@@ -1840,7 +1757,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             self.line(0, "}");
         }
         self.line(0, "");
-        self.record_final_entry("cb_final");
+        self.record_final_entry(entry::CB_FINAL);
         let order = self.i.graph.order.clone();
         let nc = coarse.len();
         self.line(1, "if (all(mrsl_pos < mrsl_grid())) {");

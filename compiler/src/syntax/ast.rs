@@ -139,16 +139,8 @@ pub struct FunctionDecl {
     pub span: Span,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Rate {
-    /// `coarse effect`: once per coarse sample, resampled or refined.
-    Coarse,
-    /// `fine effect`: once per pixel.
-    Fine,
-    /// `fine out`: once per pixel, written to an output target.
-    Out,
-}
+/// The rate of an effect (part of the layout contract).
+pub use mrsl_abi::Rate;
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum EffectBody {

@@ -1,0 +1,152 @@
+//! Dispatch geometry both sides must agree on: where coarse samples lie,
+//! how many workgroups each kernel is dispatched with, and how the
+//! hierarchical mode's levels, work lists and queues are laid out. The code
+//! generator writes these numbers into the kernels and the runtime sizes its
+//! buffers and dispatches from them.
+
+/// Pixels per side of the square tile one fine, reference or final workgroup shades.
+pub const TILE: u32 = 8;
+
+/// Invocations of a per-pixel workgroup (one tile, one pixel each).
+pub const PIXEL_WORKGROUP: u32 = TILE * TILE;
+
+/// Invocations per side of a coarse-sample workgroup (coarse kernels and the
+/// hierarchical level-0 and classify entry points).
+pub const COARSE_WORKGROUP: u32 = 8;
+
+/// Invocations of a workgroup that shades a compacted work list (hierarchical `hier_shade_*`).
+pub const WORK_LIST_WORKGROUP: u32 = 64;
+
+/// Checkerboard `cb_shade`: shaded 2x2 quads per workgroup, along a row of quads.
+pub const CHECKERBOARD_QUADS_PER_WORKGROUP: u32 = 16;
+
+/// Words per level in the hierarchical queue and indirect-argument buffers:
+/// the queue's first word counts queued pixels; the arguments are x, y, z, unused.
+pub const QUEUE_WORDS_PER_LEVEL: u32 = 4;
+
+/// Levels of the hierarchical mode: level 0 (always shaded) and the four classified levels.
+pub const HIERARCHICAL_LEVEL_COUNT: u32 = 5;
+
+/// Bytes of the hierarchical queue buffer and of its indirect-argument buffer.
+pub const HIERARCHICAL_QUEUE_BYTES: u64 = (HIERARCHICAL_LEVEL_COUNT * QUEUE_WORDS_PER_LEVEL * 4) as u64;
+
+/// The largest storage binding the runtime relies on (WebGPU's default limit).
+pub const MAX_STORAGE_BINDING_BYTES: u64 = 128 << 20;
+
+/// The largest image side the runtime accepts.
+pub const MAX_SIDE: u32 = 16384;
+
+/// The number of coarse samples along each axis for a `size` image and
+/// block size `block`: sample `(i, j)` shades pixel `(min(i*B, W-1), min(j*B, H-1))`,
+/// so the last row and column of pixels always have samples.
+pub fn sample_grid(size: (u32, u32), block: u32) -> (u32, u32) {
+    ((size.0 + block - 2) / block + 1, (size.1 + block - 2) / block + 1)
+}
+
+/// The rule of [`sample_grid`] as the layout JSON states it for engines.
+pub const SAMPLE_GRID_RULE: &str = "nx * ny, nx = (W + B - 2) / B + 1, ny = (H + B - 2) / B + 1 (integer division); sample (i, j) shades pixel (min(i*B, W-1), min(j*B, H-1))";
+
+/// Workgroups of a coarse kernel over the samples of block size `block`.
+pub fn coarse_workgroups(size: (u32, u32), block: u32) -> (u32, u32) {
+    let (nx, ny) = sample_grid(size, block);
+    (nx.div_ceil(COARSE_WORKGROUP), ny.div_ceil(COARSE_WORKGROUP))
+}
+
+/// Workgroups of a per-pixel kernel: one per tile.
+pub fn pixel_workgroups(size: (u32, u32)) -> (u32, u32) {
+    (size.0.div_ceil(TILE), size.1.div_ceil(TILE))
+}
+
+/// Pixels `start, start + step, start + 2 step, ...` along each axis: the
+/// grid one hierarchical entry point is dispatched over (one invocation each).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Lattice {
+    pub start: u32,
+    pub step: u32,
+}
+
+impl Lattice {
+    /// Lattice points along an axis of `n` pixels.
+    pub fn count(self, n: u32) -> u32 {
+        if n > self.start { (n - self.start - 1) / self.step + 1 } else { 0 }
+    }
+
+    /// Lattice points of a `size` image.
+    pub fn points(self, size: (u32, u32)) -> u64 {
+        u64::from(self.count(size.0)) * u64::from(self.count(size.1))
+    }
+
+    /// Workgroups of [`COARSE_WORKGROUP`]² invocations covering the lattice (at least one).
+    pub fn workgroups(self, size: (u32, u32)) -> (u32, u32) {
+        let groups = |n: u32| self.count(n).div_ceil(COARSE_WORKGROUP).max(1);
+        (groups(size.0), groups(size.1))
+    }
+}
+
+/// Level 0 of the hierarchical mode: every 4th pixel in both directions, always shaded.
+pub const HIERARCHICAL_LEVEL0: Lattice = Lattice { start: 0, step: 4 };
+
+/// The dispatch lattices of hierarchical levels 1 to 4. Levels 2 and 4 use
+/// only the lattice points with an odd coordinate sum; the work lists still
+/// reserve a word per point, so each list's capacity is its lattice's size.
+pub const HIERARCHICAL_LEVELS: [Lattice; 4] = [
+    Lattice { start: 2, step: 4 },
+    Lattice { start: 0, step: 2 },
+    Lattice { start: 1, step: 2 },
+    Lattice { start: 0, step: 1 },
+];
+
+/// Words of the hierarchical work lists (levels 1 to 4 one after another).
+pub fn work_list_words(size: (u32, u32)) -> u64 {
+    HIERARCHICAL_LEVELS.iter().map(|l| l.points(size)).sum()
+}
+
+/// Byte offset of level `level`'s (1 to 4) indirect dispatch arguments.
+pub fn indirect_args_offset(level: u32) -> u64 {
+    u64::from(level * QUEUE_WORDS_PER_LEVEL * 4)
+}
+
+/// Checkerboard `cb_shade` workgroups: rows of quads, [`CHECKERBOARD_QUADS_PER_WORKGROUP`]
+/// shaded quads per workgroup (half the quads of a row; all when `forced`).
+pub fn checkerboard_workgroups(size: (u32, u32), forced: bool) -> (u32, u32) {
+    let (quads_x, quads_y) = (size.0.div_ceil(2), size.1.div_ceil(2));
+    let shaded_per_row = if forced { quads_x } else { quads_x.div_ceil(2) };
+    (shaded_per_row.div_ceil(CHECKERBOARD_QUADS_PER_WORKGROUP).max(1), quads_y)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_hierarchical_levels_cover_every_pixel_once() {
+        for size in [(1, 1), (2, 3), (7, 5), (16, 9), (33, 17)] {
+            let mut shaded = vec![0u32; (size.0 * size.1) as usize];
+            let mut mark = |x: u32, y: u32| shaded[(y * size.0 + x) as usize] += 1;
+            for y in 0..HIERARCHICAL_LEVEL0.count(size.1) {
+                for x in 0..HIERARCHICAL_LEVEL0.count(size.0) {
+                    mark(x * 4, y * 4);
+                }
+            }
+            for (index, level) in HIERARCHICAL_LEVELS.iter().enumerate() {
+                let odd_only = index % 2 == 1;
+                for j in 0..level.count(size.1) {
+                    for i in 0..level.count(size.0) {
+                        if !odd_only || (i + j) % 2 == 1 {
+                            mark(level.start + i * level.step, level.start + j * level.step);
+                        }
+                    }
+                }
+            }
+            assert!(shaded.iter().all(|&n| n == 1), "{size:?}: {shaded:?}");
+        }
+    }
+
+    #[test]
+    fn samples_reach_the_last_pixel() {
+        for (w, b) in [(1, 2), (2, 2), (3, 2), (8, 4), (9, 4), (10, 4)] {
+            let (nx, _) = sample_grid((w, 1), b);
+            assert!(((nx - 1) * b).min(w - 1) == w - 1 && (nx < 2 || (nx - 2) * b < w - 1), "{w} {b}");
+        }
+    }
+}

@@ -1,0 +1,157 @@
+//! The kernels a program compiles to: their names, entry points in dispatch
+//! order and workgroup sizes, stated once in [`KernelKind`] and [`entry`].
+
+use crate::geometry::{COARSE_WORKGROUP, PIXEL_WORKGROUP};
+use serde::{Deserialize, Serialize};
+
+/// Entry-point names of the generated kernels. The runtime looks pipelines
+/// up by these names; the compiler writes them and keeps user names clear of them.
+pub mod entry {
+    pub const COARSE: &str = "coarse_main";
+    pub const FINE: &str = "fine_main";
+    pub const REFERENCE: &str = "reference_main";
+    pub const DYNAMIC_COARSE: &str = "dynamic_coarse_main";
+    pub const DYNAMIC_FINE: &str = "dynamic_fine_main";
+    /// Hierarchical level 0: every 4th pixel, always shaded.
+    pub const HIER_LEVEL0: &str = "hier_level0";
+    /// Hierarchical levels 1 to 4: classify the level's pixels into its work list.
+    pub const HIER_CLASSIFY: [&str; 4] = ["hier_classify_1", "hier_classify_2", "hier_classify_3", "hier_classify_4"];
+    /// Hierarchical levels 1 to 4: turn the work-list count into indirect dispatch
+    /// arguments (these alone bind [`crate::GROUP_ARGS`]).
+    pub const HIER_ARGS: [&str; 4] = ["hier_args_1", "hier_args_2", "hier_args_3", "hier_args_4"];
+    /// Hierarchical levels 1 to 4: shade the compacted work list (indirect dispatch).
+    pub const HIER_SHADE: [&str; 4] = ["hier_shade_1", "hier_shade_2", "hier_shade_3", "hier_shade_4"];
+    /// Hierarchical final pass: fine effects and outputs per pixel.
+    pub const HIER_FINAL: &str = "hier_final";
+    /// Checkerboard: shade the coarse effects in half the 2x2 quads.
+    pub const CB_SHADE: &str = "cb_shade";
+    /// Checkerboard final pass: reconstruct, then fine effects and outputs per pixel.
+    pub const CB_FINAL: &str = "cb_final";
+
+    /// Prefixes of generated entry points; user identifiers with them are renamed.
+    pub const RESERVED_PREFIXES: [&str; 2] = ["hier_", "cb_"];
+
+    /// Whether `name` is an entry point that binds the indirect-argument group.
+    pub fn binds_args_group(name: &str) -> bool {
+        HIER_ARGS.contains(&name)
+    }
+}
+
+/// The hierarchical kernel's entry points in dispatch order: level 0, then per
+/// level 1 to 4 classify, args and (indirect) shade, then final.
+const HIERARCHICAL_ENTRY_POINTS: [&str; 14] = [
+    entry::HIER_LEVEL0,
+    entry::HIER_CLASSIFY[0],
+    entry::HIER_ARGS[0],
+    entry::HIER_SHADE[0],
+    entry::HIER_CLASSIFY[1],
+    entry::HIER_ARGS[1],
+    entry::HIER_SHADE[1],
+    entry::HIER_CLASSIFY[2],
+    entry::HIER_ARGS[2],
+    entry::HIER_SHADE[2],
+    entry::HIER_CLASSIFY[3],
+    entry::HIER_ARGS[3],
+    entry::HIER_SHADE[3],
+    entry::HIER_FINAL,
+];
+
+/// Which kernel: each is one WGSL module with the entry points [`KernelKind::entry_points`] lists.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum KernelKind {
+    /// One invocation per coarse sample: coarse effects, refine flags, interface writes.
+    Coarse,
+    /// One invocation per pixel: resample or re-evaluate coarse effects, then fine effects and outputs.
+    Fine,
+    /// One invocation per pixel: every effect evaluated per pixel.
+    Reference,
+    /// Dynamic mode, second level: one invocation per 2x2 coarse sample, shading
+    /// only samples that a 4x4 block refined by the (4x4) coarse kernel needs.
+    DynamicCoarse,
+    /// Dynamic mode, per pixel: 4x4 value, else 2x2 value, else evaluated.
+    DynamicFine,
+    /// Hierarchical (DACS) mode: level 0, four classified levels shading
+    /// compacted work lists, and a final per-pixel pass.
+    Hierarchical,
+    /// Checkerboard baseline: coarse effects shaded in half the 2x2 quads,
+    /// reconstructed in the others.
+    Checkerboard,
+}
+
+impl KernelKind {
+    /// Every kind, in the order the compiler writes them.
+    pub const ALL: [KernelKind; 7] = [
+        KernelKind::Coarse,
+        KernelKind::Fine,
+        KernelKind::Reference,
+        KernelKind::DynamicCoarse,
+        KernelKind::DynamicFine,
+        KernelKind::Hierarchical,
+        KernelKind::Checkerboard,
+    ];
+
+    /// The name used in file names and messages (`dynamic_coarse`).
+    pub fn name(self) -> &'static str {
+        match self {
+            KernelKind::Coarse => "coarse",
+            KernelKind::Fine => "fine",
+            KernelKind::Reference => "reference",
+            KernelKind::DynamicCoarse => "dynamic_coarse",
+            KernelKind::DynamicFine => "dynamic_fine",
+            KernelKind::Hierarchical => "hierarchical",
+            KernelKind::Checkerboard => "checkerboard",
+        }
+    }
+
+    /// The kind called `name` (see [`KernelKind::name`]).
+    pub fn from_name(name: &str) -> Option<KernelKind> {
+        KernelKind::ALL.into_iter().find(|k| k.name() == name)
+    }
+
+    /// Every entry point of the kernel, in dispatch order.
+    pub fn entry_points(self) -> &'static [&'static str] {
+        match self {
+            KernelKind::Coarse => &[entry::COARSE],
+            KernelKind::Fine => &[entry::FINE],
+            KernelKind::Reference => &[entry::REFERENCE],
+            KernelKind::DynamicCoarse => &[entry::DYNAMIC_COARSE],
+            KernelKind::DynamicFine => &[entry::DYNAMIC_FINE],
+            KernelKind::Hierarchical => &HIERARCHICAL_ENTRY_POINTS,
+            KernelKind::Checkerboard => &[entry::CB_SHADE, entry::CB_FINAL],
+        }
+    }
+
+    /// The entry point that writes the outputs (the last one dispatched).
+    pub fn main_entry_point(self) -> &'static str {
+        let all = self.entry_points();
+        all[all.len() - 1]
+    }
+
+    /// Whether the kernel runs per coarse sample (else per pixel).
+    pub fn is_coarse(self) -> bool {
+        matches!(self, KernelKind::Coarse | KernelKind::DynamicCoarse)
+    }
+
+    /// Whether the kernel resolves coarse values per pixel from an interface buffer.
+    pub fn is_fine(self) -> bool {
+        matches!(self, KernelKind::Fine | KernelKind::DynamicFine)
+    }
+
+    /// Whether the kernel exists once per block size (coarse and fine); the
+    /// other kinds exist once per program.
+    pub fn per_block_size(self) -> bool {
+        matches!(self, KernelKind::Coarse | KernelKind::Fine)
+    }
+
+    /// Workgroup size of the main entry point.
+    pub fn workgroup_size(self) -> [u32; 3] {
+        if self.is_coarse() { [COARSE_WORKGROUP, COARSE_WORKGROUP, 1] } else { [PIXEL_WORKGROUP, 1, 1] }
+    }
+}
+
+impl std::fmt::Display for KernelKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}

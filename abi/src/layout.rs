@@ -1,0 +1,253 @@
+//! The binding layout and interface description of a compiled program.
+//!
+//! Engines and the runtime build their bind group layouts, buffers and
+//! dispatches from this description; nothing about the generated code has
+//! to be guessed. It is written as JSON (`STEM.layout.json`) and read back
+//! into the same value ([`Layout::from_json`]).
+
+use crate::types::{SampleType, TextureFormat, ValueType};
+use serde::{Deserialize, Serialize};
+
+/// The layout format this crate reads and writes (the `format` field).
+pub const LAYOUT_FORMAT: &str = "mrsl-layout/1";
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Layout {
+    /// The format version, [`LAYOUT_FORMAT`].
+    pub format: String,
+    pub control: ControlBlock,
+    pub uniforms: Option<UniformBlock>,
+    pub textures: Vec<ResourceBinding>,
+    pub samplers: Vec<ResourceBinding>,
+    pub channels: Vec<Channel>,
+    pub interface: InterfaceLayout,
+    pub outputs: Vec<Output>,
+    pub stats: StatsLayout,
+    /// The fine kernels' per-pixel refine mask (`rg32uint`: x bit k = coarse effect k
+    /// (stats counter k) evaluated per pixel; y bit k = taken from the dynamic mode's 2x2 level).
+    pub rate_image: ResourceBinding,
+    /// The dynamic mode's second (2x2) level of coarse samples: records of
+    /// `interface.stride_words + 1` words, the last being a validity tag.
+    pub interface2: ResourceBinding,
+    /// The hierarchical (DACS) and checkerboard modes' buffers.
+    pub hierarchical: HierarchicalLayout,
+    pub effects: Vec<EffectLayout>,
+}
+
+impl Layout {
+    /// Parses a layout written by [`Layout::to_json`] (or `mrslc compile`),
+    /// rejecting another format version.
+    pub fn from_json(text: &str) -> Result<Layout, String> {
+        #[derive(Deserialize)]
+        struct Version {
+            format: Option<String>,
+        }
+        let version: Version = serde_json::from_str(text).map_err(|e| e.to_string())?;
+        match version.format.as_deref() {
+            Some(LAYOUT_FORMAT) => serde_json::from_str(text).map_err(|e| e.to_string()),
+            Some(other) => Err(format!("layout format `{other}` is not supported (expected `{LAYOUT_FORMAT}`)")),
+            None => Err(format!("no `format` field (expected `{LAYOUT_FORMAT}`)")),
+        }
+    }
+
+    /// The layout as pretty-printed JSON, as `mrslc compile` writes it.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a layout always serialises")
+    }
+
+    /// Number of statistics counters: one per coarse effect, plus the dynamic
+    /// mode's count of shaded 2x2 samples.
+    pub fn stats_counters(&self) -> usize {
+        self.stats.counters.len() + 1
+    }
+}
+
+/// Buffers of the hierarchical and checkerboard modes (group 2): a record per
+/// pixel, and (hierarchical only) the work lists of pixels to shade per level
+/// and per-level counters that double as indirect dispatch arguments.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HierarchicalLayout {
+    /// Per pixel: `flag_words` refine flags, `mask_words` "evaluated here" bits
+    /// (bit k = coarse effect k), then every live coarse effect's value.
+    pub values_binding: u32,
+    pub record_words: u32,
+    pub flag_words: u32,
+    pub mask_words: u32,
+    /// Word offset of each live coarse effect's value in a record, in stats-counter order.
+    pub value_offsets: Vec<u32>,
+    /// `array<u32>`: pixel indices to shade, level 1 to 4 one after another.
+    pub work_binding: u32,
+    /// `array<atomic<u32>>` of 4 words per level (index 0..4): the first counts queued pixels.
+    pub queue_binding: u32,
+    /// Indirect dispatch arguments (x, y, z, unused) per level (index 0..4), written by
+    /// the `hier_args_*` entry points only: bind group `args_group`, binding 0. It is
+    /// a separate group because a buffer cannot be indirect and writable in one dispatch.
+    pub args_group: u32,
+}
+
+/// Counters the fine kernels accumulate (when the program has live coarse effects).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StatsLayout {
+    pub group: u32,
+    pub binding: u32,
+    /// Counter `k` counts the pixels that re-evaluated this coarse effect;
+    /// one more counter after them counts the 2x2 samples the dynamic mode shaded.
+    pub counters: Vec<String>,
+}
+
+/// The runtime-owned uniform block every kernel reads (see [`crate::Control`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ControlBlock {
+    pub group: u32,
+    pub binding: u32,
+    pub size: u32,
+    pub fields: Vec<Field>,
+}
+
+/// A field of a uniform block.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Field {
+    pub name: String,
+    /// mrsl type (`float3`); `bool` fields are stored as `uint`.
+    #[serde(rename = "type")]
+    pub ty: ValueType,
+    /// The WGSL type of the stored value (`vec3<f32>`; `u32` for `bool`).
+    pub wgsl_type: String,
+    pub offset: u32,
+    pub size: u32,
+    /// Default value, components in order (columns for matrices), if any.
+    pub default: Option<Vec<f64>>,
+}
+
+/// The user uniform block.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct UniformBlock {
+    pub group: u32,
+    pub binding: u32,
+    /// Size in bytes (a multiple of 16).
+    pub size: u32,
+    pub fields: Vec<Field>,
+}
+
+/// What a [`ResourceBinding`] binds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ResourceKind {
+    /// A filterable float `texture_2d<f32>`.
+    #[serde(rename = "float")]
+    Texture,
+    /// A filtering sampler.
+    #[serde(rename = "filtering")]
+    Sampler,
+    /// An `rg32uint` write-only storage texture (the rate image).
+    #[serde(rename = "rg32uint")]
+    RateImage,
+    /// A read-write storage buffer.
+    #[serde(rename = "storage")]
+    Storage,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ResourceBinding {
+    pub name: String,
+    pub group: u32,
+    pub binding: u32,
+    pub kind: ResourceKind,
+}
+
+/// A G-buffer channel (`in` declaration).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Channel {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub ty: ValueType,
+    pub group: u32,
+    pub binding: u32,
+    /// The texture format the tools create for it; any format of the same
+    /// sample type with enough components is accepted.
+    pub format: TextureFormat,
+    /// The sample type of the binding.
+    pub sample_type: SampleType,
+    /// Discontinuity key comparison, if this channel is a key.
+    pub key: Option<KeyCompare>,
+}
+
+/// How a discontinuity-key channel is compared between samples.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum KeyCompare {
+    /// Any difference is a discontinuity.
+    Exact,
+    /// `distance(a, b) > threshold` is a discontinuity.
+    Threshold { threshold: f64 },
+}
+
+/// The coarse-to-fine interface buffer of the block modes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct InterfaceLayout {
+    pub group: u32,
+    pub binding: u32,
+    /// 32-bit words per coarse sample record.
+    pub stride_words: u32,
+    /// Leading words of refine flags in each record.
+    pub flag_words: u32,
+    pub slots: Vec<SlotLayout>,
+    /// Whether the slot allocation is proven minimal.
+    pub minimal: bool,
+    /// How many coarse samples there are for a `W`x`H` image and block size `B`
+    /// ([`crate::geometry::SAMPLE_GRID_RULE`]).
+    pub samples: String,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SlotLayout {
+    pub offset: u32,
+    pub size: u32,
+    pub effects: Vec<String>,
+}
+
+/// An output (`fine out` declaration): a storage texture.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Output {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub ty: ValueType,
+    pub format: TextureFormat,
+    pub group: u32,
+    pub binding: u32,
+}
+
+/// The rate of an effect.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Rate {
+    /// `coarse effect`: once per coarse sample, resampled or refined.
+    Coarse,
+    /// `fine effect`: once per pixel.
+    Fine,
+    /// `fine out`: once per pixel, written to an output target.
+    Out,
+}
+
+/// How a coarse effect's value is reconstructed at a pixel from coarse samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Resample {
+    Nearest,
+    Bilinear,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EffectLayout {
+    pub name: String,
+    pub rate: Rate,
+    #[serde(rename = "type")]
+    pub ty: ValueType,
+    /// Computed at all (reaches an output).
+    pub live: bool,
+    pub refine_bit: Option<u32>,
+    pub slot: Option<usize>,
+    pub resample: Option<Resample>,
+    pub depends_on: Vec<String>,
+    /// When the effect is passed, as a formula over refine flags `r_X`.
+    pub pass_condition: Option<String>,
+}
