@@ -1,57 +1,51 @@
 //! An engine using mrsl the way a real renderer would: it owns the wgpu
-//! device, fills its own G-buffer textures, and lets the mrsl runtime record
-//! its passes into the engine's command encoder, between the engine's own
-//! work. Run it with:
+//! device, fills its own G-buffer textures, loads kernels that `mrslc
+//! compile` wrote ahead of time, and lets the mrsl runtime record its passes
+//! into the engine's command encoder. The compiler is not linked:
 //!
 //! ```sh
-//! cargo run -p mrsl-runtime --example engine            # writes engine.png and engine-reference.png
+//! cargo run --release -p mrslc -- compile examples/demo.mrsl -o kernels
+//! cargo run --release -p mrsl-runtime --example engine -- kernels
 //! ```
 //!
+//! writes `engine.dynamic.png` and `engine.reference.png` into the current
+//! directory. Built with the runtime's `compile` feature (`--features
+//! compile`) and no argument, it compiles the built-in demo program at load
+//! time instead.
+//!
 //! The G-buffer here is filled from the CPU (a sphere over a ground plane,
-//! analytically); an engine would rasterise it in its own geometry pass.
+//! analytically); an engine would rasterise it in its own geometry pass. It
+//! has `position`, `normal` (rgba32float), `uv` (rg32float) and `material`
+//! (r32uint); a program reading another channel gets a typed error naming it.
 
-use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader};
-
-const PROGRAM: &str = r#"
-in float3 position;
-in float3 normal;
-@key in uint material;
-
-uniform float3 light_dir = float3(0.4, 0.8, 0.45);
-uniform float3 eye = float3(0.0, 1.2, 4.0);
-uniform float threshold = 0.04;
-
-coarse effect float diffuse {
-    diffuse = saturate(dot(normal, normalize(light_dir)));
-    if (fwidth(diffuse) > threshold) refine;
-}
-coarse effect float specular {
-    float3 h = normalize(normalize(light_dir) + normalize(eye - position));
-    specular = pow(saturate(dot(normal, h)), 48.0);
-    if (specular > 0.05) refine;
-}
-fine effect float3 base = material == 1u ? float3(0.8, 0.3, 0.2) : float3(0.7, 0.7, 0.65);
-fine out float4 color = float4(base * (0.08 + diffuse) + float3(specular), 1.0);
-"#;
+use mrsl_runtime::{Bindings, CompiledProgram, DispatchOptions, Mode, Shader};
+use std::collections::HashMap;
 
 const WIDTH: u32 = 480;
 const HEIGHT: u32 = 270;
+const EYE: [f32; 3] = [0.0, 1.2, 4.0];
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    // 1. The engine's own device.
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{e}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
+    let program = load_program()?;
+
+    // 1. The engine's own device (here: whatever adapter wgpu finds first).
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-        power_preference: wgpu::PowerPreference::HighPerformance,
-        force_fallback_adapter: false,
-        compatible_surface: None,
-        apply_limit_buckets: false,
-    }))?;
+    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default()))?;
     let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default()))?;
     println!("adapter: {}", adapter.get_info().name);
 
-    // 2. The engine's own G-buffer: position, normal (rgba32float), material (r32uint).
-    let (position, normal, material) = gbuffer();
-    let texture = |label: &str, format: wgpu::TextureFormat, bytes: &[u8], bytes_per_pixel: u32| {
+    // 2. The engine's own G-buffer.
+    let texture = |label: &str, format: wgpu::TextureFormat, bytes: &[u8], usage: wgpu::TextureUsages| {
         let t = device.create_texture(&wgpu::TextureDescriptor {
             label: Some(label),
             size: wgpu::Extent3d { width: WIDTH, height: HEIGHT, depth_or_array_layers: 1 },
@@ -59,64 +53,95 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            usage: usage | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
-        queue.write_texture(
-            t.as_image_copy(),
-            bytes,
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(WIDTH * bytes_per_pixel),
-                rows_per_image: None,
-            },
-            t.size(),
-        );
+        if !bytes.is_empty() {
+            let bytes_per_row = Some(WIDTH * format.block_copy_size(None).unwrap_or(4));
+            let layout = wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row, rows_per_image: None };
+            queue.write_texture(t.as_image_copy(), bytes, layout, t.size());
+        }
         t
     };
-    let position = texture("position", wgpu::TextureFormat::Rgba32Float, bytemuck::cast_slice(&position), 16);
-    let normal = texture("normal", wgpu::TextureFormat::Rgba32Float, bytemuck::cast_slice(&normal), 16);
-    let material = texture("material", wgpu::TextureFormat::R32Uint, bytemuck::cast_slice(&material), 4);
-    let color = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("color"),
-        size: wgpu::Extent3d { width: WIDTH, height: HEIGHT, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba32Float,
-        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
+    let g = gbuffer();
+    let sampled = wgpu::TextureUsages::TEXTURE_BINDING;
+    let channels = HashMap::from([
+        ("position", texture("position", wgpu::TextureFormat::Rgba32Float, bytemuck::cast_slice(&g.position), sampled)),
+        ("normal", texture("normal", wgpu::TextureFormat::Rgba32Float, bytemuck::cast_slice(&g.normal), sampled)),
+        ("uv", texture("uv", wgpu::TextureFormat::Rg32Float, bytemuck::cast_slice(&g.uv), sampled)),
+        ("material", texture("material", wgpu::TextureFormat::R32Uint, bytemuck::cast_slice(&g.material), sampled)),
+    ]);
+    // Output targets in the formats the layout names.
+    let storage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
+    let outputs: Vec<(String, wgpu::Texture)> = program
+        .layout
+        .outputs
+        .iter()
+        .map(|o| (o.name.clone(), texture(&o.name, mrsl_runtime::wgpu_format(o.format), &[], storage)))
+        .collect();
 
-    // 3. Compile the program and instantiate it on the engine's device.
-    let program =
-        mrsl::compile(PROGRAM, &mrsl::Options::default()).map_err(|d| mrsl::render_all(&d, "engine.mrsl", PROGRAM))?;
+    // 3. The program on the engine's device.
     let mut shader = Shader::new(&device, &program)?;
-    shader.set_uniform("threshold", &[0.03])?;
+    if program.layout.uniforms.as_ref().is_some_and(|u| u.fields.iter().any(|f| f.name == "camera_pos")) {
+        shader.set_uniform("camera_pos", &EYE.map(f64::from))?;
+    }
     let mut bindings = Bindings { size: (WIDTH, HEIGHT), ..Default::default() };
-    bindings.channels.insert("position".into(), &position);
-    bindings.channels.insert("normal".into(), &normal);
-    bindings.channels.insert("material".into(), &material);
-    bindings.outputs.insert("color".into(), &color);
+    for (name, t) in &channels {
+        bindings.channels.insert(name.to_string(), t);
+    }
+    for (name, t) in &outputs {
+        bindings.outputs.insert(name.clone(), t);
+    }
 
-    for (mode, file) in [(Mode::Dynamic, "engine.png"), (Mode::Reference, "engine-reference.png")] {
+    for mode in [Mode::Dynamic, Mode::Reference] {
         // 4. The engine's frame: its own passes, then mrsl's, in one encoder.
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         shader.encode(&device, &queue, &mut encoder, &bindings, DispatchOptions::new(mode))?;
-        let readback = copy_out(&device, &mut encoder, &color);
+        let (name, color) = &outputs[0];
+        let readback = copy_out(&device, &mut encoder, color);
         queue.submit([encoder.finish()]);
         println!("{}", shader.read_stats(&device)?.table());
-        save_png(&device, &readback, file)?;
+        let file = format!("engine.{mode}.png");
+        save_png(&device, &readback, color.format(), &file).map_err(|e| format!("output `{name}`: {e}"))?;
         println!("wrote {file}");
     }
     Ok(())
 }
 
-/// A sphere on a ground plane seen from `eye`, as world-space position,
-/// normal and material per pixel (material 0 = ground, 1 = sphere, 2 = sky).
-fn gbuffer() -> (Vec<[f32; 4]>, Vec<[f32; 4]>, Vec<u32>) {
-    let eye = [0.0f32, 1.2, 4.0];
-    let (mut position, mut normal, mut material) = (vec![], vec![], vec![]);
+/// The kernels in the directory given as the first argument, or (with the
+/// `compile` feature and no argument) the demo program compiled now.
+fn load_program() -> Result<CompiledProgram, Box<dyn std::error::Error>> {
+    if let Some(dir) = std::env::args_os().nth(1) {
+        return Ok(CompiledProgram::read_dir(dir.as_ref(), None)?);
+    }
+    #[cfg(feature = "compile")]
+    {
+        println!("no kernel directory given: compiling the built-in demo program");
+        Ok(mrsl_runtime::compile(include_str!("demo.mrsl"), "examples/demo.mrsl")?)
+    }
+    #[cfg(not(feature = "compile"))]
+    Err("usage: engine KERNEL_DIR\n\
+         KERNEL_DIR holds the files `mrslc compile` writes, e.g.:\n  \
+         cargo run --release -p mrslc -- compile examples/demo.mrsl -o kernels\n  \
+         cargo run --release -p mrsl-runtime --example engine -- kernels\n\
+         (or build the example with `--features compile` to compile the demo at load time)"
+        .into())
+}
+
+/// The engine's G-buffer, per pixel.
+struct GBuffer {
+    position: Vec<[f32; 4]>,
+    normal: Vec<[f32; 4]>,
+    uv: Vec<[f32; 2]>,
+    material: Vec<u32>,
+}
+
+/// A sphere on a ground plane seen from `EYE`: world-space position, normal,
+/// uv (planar on the ground, spherical on the sphere) and material per pixel
+/// (0 = ground, 1 = sphere, 255 = sky).
+fn gbuffer() -> GBuffer {
+    let eye = EYE;
+    let mut g = GBuffer { position: vec![], normal: vec![], uv: vec![], material: vec![] };
     for y in 0..HEIGHT {
         for x in 0..WIDTH {
             let u = (x as f32 + 0.5) / WIDTH as f32 * 2.0 - 1.0;
@@ -133,14 +158,21 @@ fn gbuffer() -> (Vec<[f32; 4]>, Vec<[f32; 4]>, Vec<u32>) {
             } else if d[1] < 0.0 {
                 (-eye[1] / d[1], [0.0, 1.0, 0.0], 0)
             } else {
-                (100.0, [-d[0], -d[1], -d[2]], 2)
+                (100.0, [-d[0], -d[1], -d[2]], 255)
             };
-            position.push([eye[0] + t * d[0], eye[1] + t * d[1], eye[2] + t * d[2], 1.0]);
-            normal.push([n[0], n[1], n[2], 0.0]);
-            material.push(m);
+            let p = [eye[0] + t * d[0], eye[1] + t * d[1], eye[2] + t * d[2]];
+            let uv = match m {
+                1 => [0.5 + n[2].atan2(n[0]) / std::f32::consts::TAU, 0.5 - n[1].asin() / std::f32::consts::PI],
+                0 => [p[0] * 0.25, p[2] * 0.25],
+                _ => [0.0, 0.0],
+            };
+            g.position.push([p[0], p[1], p[2], 1.0]);
+            g.normal.push([n[0], n[1], n[2], 0.0]);
+            g.uv.push(uv);
+            g.material.push(m);
         }
     }
-    (position, normal, material)
+    g
 }
 
 fn normalize(v: [f32; 3]) -> [f32; 3] {
@@ -167,7 +199,15 @@ fn copy_out(device: &wgpu::Device, encoder: &mut wgpu::CommandEncoder, texture: 
     buffer
 }
 
-fn save_png(device: &wgpu::Device, buffer: &wgpu::Buffer, path: &str) -> Result<(), Box<dyn std::error::Error>> {
+fn save_png(
+    device: &wgpu::Device,
+    buffer: &wgpu::Buffer,
+    format: wgpu::TextureFormat,
+    path: &str,
+) -> Result<(), Box<dyn std::error::Error>> {
+    if format != wgpu::TextureFormat::Rgba32Float {
+        return Err(format!("this example writes rgba32float outputs only, not {format:?}").into());
+    }
     let slice = buffer.slice(..);
     slice.map_async(wgpu::MapMode::Read, |r| r.expect("readback buffer maps"));
     device.poll(wgpu::PollType::wait_indefinitely())?;

@@ -30,8 +30,8 @@ mod types;
 pub use control::{CONTROL_FIELDS, Control, ControlField};
 pub use kernel::{KernelKind, entry};
 pub use layout::{
-    Channel, ControlBlock, EffectLayout, Field, HierarchicalLayout, InterfaceLayout, KeyCompare, LAYOUT_FORMAT,
-    Layout, Output, Rate, Resample, ResourceBinding, ResourceKind, SlotLayout, StatsLayout, UniformBlock,
+    Channel, ControlBlock, EffectLayout, Field, HierarchicalLayout, InterfaceLayout, KeyCompare, LAYOUT_FORMAT, Layout,
+    Output, Rate, Resample, ResourceBinding, ResourceKind, SlotLayout, StatsLayout, UniformBlock,
 };
 pub use program::{CompiledProgram, Kernel, ReadError};
 pub use types::{SampleType, Scalar, TextureFormat, ValueType};

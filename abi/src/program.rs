@@ -104,7 +104,8 @@ impl CompiledProgram {
 
     /// The files of the program called `stem`: (file name, contents), kernels first.
     pub fn files(&self, stem: &str) -> Vec<(String, String)> {
-        let mut files: Vec<(String, String)> = self.kernels.iter().map(|k| (k.file_name(stem), k.wgsl.clone())).collect();
+        let mut files: Vec<(String, String)> =
+            self.kernels.iter().map(|k| (k.file_name(stem), k.wgsl.clone())).collect();
         files.push((format!("{stem}.layout.json"), self.layout.to_json()));
         files
     }

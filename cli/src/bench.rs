@@ -6,9 +6,9 @@
 use crate::render::{BoundScene, Resources, bind_scene, compile_program};
 use crate::report::{self, ControllerFrame, Point};
 use indicatif::{ProgressBar, ProgressStyle};
+use mrsl_lab::gpu::Gpu;
+use mrsl_lab::raster::Camera;
 use mrsl_runtime::controller::{Target, ThresholdController};
-use mrsl_runtime::gpu::Gpu;
-use mrsl_runtime::raster::Camera;
 use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader, Stats};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -108,7 +108,7 @@ impl Bench<'_> {
 }
 
 /// The program's uniform `name`, if it declares one.
-fn uniform<'p>(program: &'p mrsl::Program, name: &str) -> Option<&'p mrsl::layout::Field> {
+fn uniform<'p>(program: &'p mrsl::Program, name: &str) -> Option<&'p mrsl_abi::Field> {
     program.layout.uniforms.as_ref()?.fields.iter().find(|f| f.name == name)
 }
 
@@ -198,10 +198,10 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
             let metrics = match &reference {
                 None => {
                     reference = Some(pixels);
-                    mrsl_runtime::metrics::Metrics { rmse: 0.0, psnr: f64::INFINITY, mssim: 1.0, flip: 0.0 }
+                    mrsl_lab::metrics::Metrics { rmse: 0.0, psnr: f64::INFINITY, mssim: 1.0, flip: 0.0 }
                 }
                 Some(r) => {
-                    mrsl_runtime::metrics::compare(&pixels, r, scene.size.0, scene.size.1).map_err(|e| e.to_string())?
+                    mrsl_lab::metrics::compare(&pixels, r, scene.size.0, scene.size.1).map_err(|e| e.to_string())?
                 }
             };
             points.push(Point {

@@ -154,12 +154,28 @@ enum Emit {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    locate_sponza();
     match run(&cli) {
         Ok(code) => code,
         Err(message) => {
             eprintln!("error: {message}");
             ExitCode::from(2)
         }
+    }
+}
+
+/// Tells the evaluation kit where cargo unpacked the Dabrovic Sponza (the
+/// `obj-rs` 0.7.4 package in `$CARGO_HOME`, by default `~/.cargo`), unless
+/// `$MRSL_SPONZA` names the file; the kit does not search by itself.
+fn locate_sponza() {
+    if std::env::var_os("MRSL_SPONZA").is_some() {
+        return;
+    }
+    let cargo_home = std::env::var_os("CARGO_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|home| PathBuf::from(home).join(".cargo")));
+    if let Some(path) = cargo_home.and_then(|home| mrsl_lab::mesh::find_sponza_in_cargo_home(&home)) {
+        mrsl_lab::mesh::set_sponza_path(path);
     }
 }
 
@@ -239,7 +255,7 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
                 }
             };
             report(cli.color, &program.warnings, &name, &source);
-            let layout = serde_json::to_string_pretty(&program.layout).map_err(|e| e.to_string())?;
+            let layout = program.layout.to_json();
             if let Some(emit) = emit {
                 let block = *block_sizes.last().unwrap_or(&4);
                 let text = match emit {
@@ -257,15 +273,10 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
             }
             std::fs::create_dir_all(out_dir).map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
             let stem = file.file_stem().and_then(|s| s.to_str()).unwrap_or("program");
-            let mut written = vec![];
-            for k in &program.kernels {
-                let file_name = match k.block_size {
-                    Some(b) => format!("{stem}.{}.b{b}.wgsl", k.kind.name()),
-                    None => format!("{stem}.{}.wgsl", k.kind.name()),
-                };
-                written.push(write(out_dir, &file_name, &k.wgsl)?);
-            }
-            written.push(write(out_dir, &format!("{stem}.layout.json"), &layout)?);
+            let written = program
+                .compiled
+                .write_dir(out_dir, stem)
+                .map_err(|(path, e)| format!("cannot write {}: {e}", path.display()))?;
             for path in written {
                 eprintln!("wrote {}", path.display());
             }
@@ -294,12 +305,6 @@ fn written(result: Result<Vec<PathBuf>, String>) -> ExitCode {
 fn read(file: &Path) -> Result<(String, String), String> {
     let source = std::fs::read_to_string(file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
     Ok((file.display().to_string(), source))
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> Result<PathBuf, String> {
-    let path = dir.join(name);
-    std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    Ok(path)
 }
 
 fn plural(n: usize) -> &'static str {

@@ -2,10 +2,10 @@
 //! writes the image, a refinement heatmap and statistics.
 
 use mrsl::{KernelKind, Options};
-use mrsl_runtime::gpu::Gpu;
-use mrsl_runtime::mesh_scene::MeshScene;
-use mrsl_runtime::scene::Scene;
-use mrsl_runtime::scene_file::SceneFile;
+use mrsl_lab::gpu::Gpu;
+use mrsl_lab::mesh_scene::MeshScene;
+use mrsl_lab::scene::Scene;
+use mrsl_lab::scene_file::SceneFile;
 use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader, Stats};
 
 use std::path::{Path, PathBuf};
@@ -40,7 +40,7 @@ struct Run {
     #[serde(flatten)]
     stats: Stats,
     /// Against the reference image (with `--compare`).
-    metrics: Option<mrsl_runtime::metrics::Metrics>,
+    metrics: Option<mrsl_lab::metrics::Metrics>,
 }
 
 fn progress(what: &str, start: Instant) {
@@ -125,8 +125,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
                 reference = Some(pixels);
             } else if let Some(reference) = &reference {
                 let start = Instant::now();
-                let m =
-                    mrsl_runtime::metrics::compare(&pixels, reference, size.0, size.1).map_err(|e| e.to_string())?;
+                let m = mrsl_lab::metrics::compare(&pixels, reference, size.0, size.1).map_err(|e| e.to_string())?;
                 progress(
                     &format!(
                         "{mode} vs reference: RMSE {:.5}, PSNR {:.2} dB, MSSIM {:.5}, FLIP {:.5}",
@@ -134,12 +133,12 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
                     ),
                     start,
                 );
-                let error = mrsl_runtime::metrics::error_image(
+                let error = mrsl_lab::metrics::error_image(
                     &pixels,
                     reference,
                     size.0,
                     size.1,
-                    mrsl_runtime::metrics::DEFAULT_ERROR_SCALE,
+                    mrsl_lab::metrics::DEFAULT_ERROR_SCALE,
                 )
                 .map_err(|e| e.to_string())?;
                 let path = PathBuf::from(format!("{stem}.{mode}.error.png"));
@@ -268,7 +267,7 @@ impl Resources {
             .layout
             .outputs
             .iter()
-            .map(|o| (o.name.clone(), gpu.output_texture(&o.name, size, output_format(&o.format))))
+            .map(|o| (o.name.clone(), gpu.output_texture(&o.name, size, mrsl_runtime::wgpu_format(o.format))))
             .collect();
         Resources {
             size,
@@ -321,20 +320,6 @@ fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
     let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("out");
     let ext = path.extension().and_then(|s| s.to_str()).unwrap_or("png");
     path.with_file_name(format!("{stem}{suffix}.{ext}"))
-}
-
-fn output_format(name: &str) -> wgpu::TextureFormat {
-    match name {
-        "r32float" => wgpu::TextureFormat::R32Float,
-        "rg32float" => wgpu::TextureFormat::Rg32Float,
-        "rgba16float" => wgpu::TextureFormat::Rgba16Float,
-        "rgba8unorm" => wgpu::TextureFormat::Rgba8Unorm,
-        "r32uint" => wgpu::TextureFormat::R32Uint,
-        "rgba32uint" => wgpu::TextureFormat::Rgba32Uint,
-        "r32sint" => wgpu::TextureFormat::R32Sint,
-        "rgba32sint" => wgpu::TextureFormat::Rgba32Sint,
-        _ => wgpu::TextureFormat::Rgba32Float,
-    }
 }
 
 fn checker_texture(gpu: &Gpu) -> wgpu::Texture {

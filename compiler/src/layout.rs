@@ -8,10 +8,10 @@ use crate::interface::Interface;
 use crate::syntax::ast::Rate;
 use crate::types::{Scalar, Type, round_up};
 use mrsl_abi::{
-    BINDING_CONTROL, BINDING_UNIFORMS, CONTROL_FIELDS, Channel, Control, ControlBlock, EffectLayout, Field,
-    GROUP_ARGS, GROUP_GBUFFER, GROUP_RESOURCES, GROUP_STAGE, HierarchicalLayout, InterfaceLayout, LAYOUT_FORMAT,
-    Layout, Output, Resample, ResourceBinding, ResourceKind, SampleType, SlotLayout, StatsLayout, TextureFormat,
-    UniformBlock, ValueType,
+    BINDING_CONTROL, BINDING_UNIFORMS, CONTROL_FIELDS, Channel, Control, ControlBlock, EffectLayout, Field, GROUP_ARGS,
+    GROUP_GBUFFER, GROUP_RESOURCES, GROUP_STAGE, HierarchicalLayout, InterfaceLayout, LAYOUT_FORMAT, Layout, Output,
+    Resample, ResourceBinding, ResourceKind, SampleType, SlotLayout, StatsLayout, TextureFormat, UniformBlock,
+    ValueType,
 };
 
 /// The layout's type of a checked value type (checked programs only declare value types where the layout has them).

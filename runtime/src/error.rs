@@ -1,12 +1,9 @@
-//! The runtime's typed errors: every mismatch between a program's layout and what the engine binds.
+//! The runtime's typed errors: every mismatch between a program's layout and
+//! what the engine binds, and what the device or a readback refused.
 
 /// What went wrong, naming the binding at fault.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum Error {
-    #[error("no adapter: {0}")]
-    NoAdapter(String),
-    #[error("device request failed: {0}")]
-    Device(String),
     #[error("G-buffer channel `{0}` is not bound")]
     MissingChannel(String),
     #[error(
@@ -39,8 +36,10 @@ pub enum Error {
     UnknownMode(String),
     #[error("the device rejected a pipeline: {0}")]
     Pipeline(String),
-    #[error("the light rig cannot be used: {0}")]
-    Rig(String),
     #[error("reading results back failed: {0}")]
     Readback(String),
+    /// The program did not compile (the `compile` feature); the rendered diagnostics.
+    #[cfg(feature = "compile")]
+    #[error("the program does not compile:\n{0}")]
+    Compile(String),
 }

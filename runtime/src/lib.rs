@@ -3,13 +3,16 @@
 //! The engine owns the device, the G-buffer textures and the output
 //! textures; [`Shader`] owns the pipelines, the uniform and control blocks
 //! and the coarse-to-fine interface buffer, and records its passes into the
-//! engine's command encoder:
+//! engine's command encoder. Programs arrive as a [`CompiledProgram`]: read
+//! from the files `mrslc compile -o DIR` wrote, or (with the `compile`
+//! feature) compiled from source at load time.
 //!
 //! ```no_run
-//! # fn demo(device: &wgpu::Device, queue: &wgpu::Queue, program: &mrsl::Program,
-//! #         normal: &wgpu::Texture, color: &wgpu::Texture) -> Result<(), mrsl_runtime::Error> {
-//! use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader};
-//! let mut shader = Shader::new(device, program)?;
+//! # fn demo(device: &wgpu::Device, queue: &wgpu::Queue,
+//! #         normal: &wgpu::Texture, color: &wgpu::Texture) -> Result<(), Box<dyn std::error::Error>> {
+//! use mrsl_runtime::{Bindings, CompiledProgram, DispatchOptions, Mode, Shader};
+//! let program = CompiledProgram::read_dir("kernels".as_ref(), None)?;
+//! let mut shader = Shader::new(device, &program)?;
 //! let mut bindings = Bindings { size: (color.width(), color.height()), ..Default::default() };
 //! bindings.channels.insert("normal".into(), normal);
 //! bindings.outputs.insert("color".into(), color);
@@ -20,23 +23,30 @@
 //! println!("shaded {:.1}% of the reference's work", 100.0 * stats.shaded_fraction);
 //! # Ok(()) }
 //! ```
+//!
+//! The crate depends on `mrsl-abi` (the contract with the compiler), wgpu
+//! without any backend (the application enables the ones it ships),
+//! bytemuck, thiserror, serde and pollster.
 
 pub mod controller;
 mod error;
-pub mod gpu;
-pub mod mesh;
-pub mod mesh_scene;
-pub mod metrics;
-pub mod raster;
-pub mod rig;
-pub mod scene;
-pub mod scene_file;
 mod shader;
 mod stats;
 
 pub use error::Error;
-pub use shader::{Bindings, DispatchOptions, Shader, components};
+pub use mrsl_abi::{CompiledProgram, KernelKind, Layout, ReadError};
+pub use shader::{Bindings, DispatchOptions, Shader, wgpu_format};
 pub use stats::{EffectStats, Stats, Timings};
+
+/// Compiles mrsl source into the kernels and layout [`Shader::new`] takes;
+/// errors are the rendered diagnostics (`file_name` names the source in them).
+#[cfg(feature = "compile")]
+pub fn compile(source: &str, file_name: &str) -> Result<CompiledProgram, Error> {
+    let options = mrsl::Options { file_name: file_name.into(), ..mrsl::Options::default() };
+    mrsl::compile(source, &options)
+        .map(|program| program.compiled)
+        .map_err(|diagnostics| Error::Compile(mrsl::render_all(&diagnostics, file_name, source)))
+}
 
 /// How a program is dispatched.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -70,6 +80,23 @@ impl Mode {
             Mode::Dynamic => "dynamic",
             Mode::Hierarchical => "hierarchical",
             Mode::Checkerboard => "checkerboard",
+        }
+    }
+
+    /// The kernels the mode dispatches, with their block sizes.
+    pub fn kernels(self) -> &'static [(KernelKind, Option<u32>)] {
+        match self {
+            Mode::Reference => &[(KernelKind::Reference, None)],
+            Mode::Coarse2x2 => &[(KernelKind::Coarse, Some(2)), (KernelKind::Fine, Some(2))],
+            Mode::Coarse4x4 => &[(KernelKind::Coarse, Some(4)), (KernelKind::Fine, Some(4))],
+            // The 4x4 level is the ordinary 4x4 coarse kernel; the dynamic mode has its own fine kernel.
+            Mode::Dynamic => &[
+                (KernelKind::Coarse, Some(4)),
+                (KernelKind::DynamicCoarse, Some(2)),
+                (KernelKind::DynamicFine, Some(4)),
+            ],
+            Mode::Hierarchical => &[(KernelKind::Hierarchical, None)],
+            Mode::Checkerboard => &[(KernelKind::Checkerboard, None)],
         }
     }
 

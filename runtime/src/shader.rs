@@ -3,8 +3,10 @@
 
 use crate::error::Error;
 use crate::{Mode, Stats};
-use mrsl::layout::Layout;
-use mrsl::{KernelKind, Program};
+use mrsl_abi::geometry::{self, HIERARCHICAL_LEVEL0, HIERARCHICAL_LEVELS, MAX_SIDE, MAX_STORAGE_BINDING_BYTES};
+use mrsl_abi::{
+    CompiledProgram, Control, GROUP_ARGS, KernelKind, Layout, SampleType, Scalar, TextureFormat, ValueType, entry,
+};
 use std::collections::HashMap;
 
 /// Resources an engine binds for one dispatch. Every name is a declaration of
@@ -62,19 +64,19 @@ struct Timestamps {
     period_ns: f32,
 }
 
+/// A pipeline: kernel kind, block size (as in [`mrsl_abi::Kernel::block_size`]) and entry point.
+type PipelineKey = (KernelKind, Option<u32>, &'static str);
+
 /// A program on a device.
 pub struct Shader {
     layout: Layout,
     resources_layout: wgpu::BindGroupLayout,
     gbuffer_layout: wgpu::BindGroupLayout,
     stage_layouts: HashMap<KernelKind, wgpu::BindGroupLayout>,
-    pipelines: HashMap<(KernelKind, u32), wgpu::ComputePipeline>,
-    /// The hierarchical kernel's pipelines, by index in `HIERARCHICAL_ENTRY_POINTS`.
-    hierarchical: HashMap<usize, wgpu::ComputePipeline>,
+    /// Every entry point of every kernel, by name (see [`mrsl_abi::KernelKind::entry_points`]).
+    pipelines: HashMap<PipelineKey, wgpu::ComputePipeline>,
     /// Hierarchical mode buffers (values, work lists, queues) and the size they were made for.
     hier_buffers: Option<(HierBuffers, (u32, u32))>,
-    /// The checkerboard kernel's pipelines: `cb_shade`, `cb_final`.
-    checkerboard: Vec<wgpu::ComputePipeline>,
     /// Whether the dispatch being encoded forces refinement.
     forced: bool,
     args_group_layout: wgpu::BindGroupLayout,
@@ -94,32 +96,18 @@ pub struct Shader {
     last: Option<(DispatchOptions, (u32, u32))>,
 }
 
-fn sample_grid(size: (u32, u32), block: u32) -> (u32, u32) {
-    ((size.0 + block - 2) / block + 1, (size.1 + block - 2) / block + 1)
-}
-
 impl Shader {
-    /// Creates the pipelines of every kernel in `program`.
-    pub fn new(device: &wgpu::Device, program: &Program) -> Result<Shader, Error> {
+    /// Creates the pipelines of every kernel in `program`: compiled just now
+    /// (`&mrsl::compile(..)?` dereferences to one) or read from the files
+    /// `mrslc compile` wrote ([`CompiledProgram::read_dir`]).
+    pub fn new(device: &wgpu::Device, program: &CompiledProgram) -> Result<Shader, Error> {
         let layout = program.layout.clone();
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let resources_layout = resources_layout(device, &layout);
         let gbuffer_layout = gbuffer_layout(device, &layout);
-        let mut stage_layouts = HashMap::new();
-        for kind in [
-            KernelKind::Coarse,
-            KernelKind::Fine,
-            KernelKind::Reference,
-            KernelKind::DynamicCoarse,
-            KernelKind::DynamicFine,
-            KernelKind::Hierarchical,
-            KernelKind::Checkerboard,
-        ] {
-            stage_layouts.insert(kind, stage_layout(device, &layout, kind));
-        }
+        let stage_layouts: HashMap<KernelKind, wgpu::BindGroupLayout> =
+            KernelKind::ALL.into_iter().map(|kind| (kind, stage_layout(device, &layout, kind))).collect();
         let mut pipelines = HashMap::new();
-        let mut hierarchical = HashMap::new();
-        let mut checkerboard = vec![];
         let args_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("mrsl hierarchical args"),
             entries: &[wgpu::BindGroupLayoutEntry {
@@ -135,11 +123,11 @@ impl Shader {
         });
         for kernel in &program.kernels {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(kernel.entry_point),
+                label: Some(kernel.kind.name()),
                 source: wgpu::ShaderSource::Wgsl(kernel.wgsl.as_str().into()),
             });
             let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(kernel.entry_point),
+                label: Some(kernel.kind.name()),
                 bind_group_layouts: &[
                     Some(&resources_layout),
                     Some(&gbuffer_layout),
@@ -147,7 +135,7 @@ impl Shader {
                 ],
                 immediate_size: 0,
             });
-            // The hierarchical `args` entry points also see the indirect arguments (group 3).
+            // The hierarchical `args` entry points also see the indirect arguments (`GROUP_ARGS`).
             let args_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("mrsl hierarchical args"),
                 bind_group_layouts: &[
@@ -158,8 +146,8 @@ impl Shader {
                 ],
                 immediate_size: 0,
             });
-            for (k, entry) in kernel.entry_points.iter().enumerate() {
-                let layout = if entry.starts_with("hier_args") { &args_layout } else { &pipeline_layout };
+            for &entry in kernel.entry_points() {
+                let layout = if entry::binds_args_group(entry) { &args_layout } else { &pipeline_layout };
                 let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                     label: Some(entry),
                     layout: Some(layout),
@@ -168,13 +156,7 @@ impl Shader {
                     compilation_options: Default::default(),
                     cache: None,
                 });
-                if kernel.kind == KernelKind::Hierarchical {
-                    hierarchical.insert(k, pipeline);
-                } else if kernel.kind == KernelKind::Checkerboard {
-                    checkerboard.push(pipeline);
-                } else {
-                    pipelines.insert((kernel.kind, kernel.block_size.unwrap_or(1)), pipeline);
-                }
+                pipelines.insert((kernel.kind, kernel.block_size, entry), pipeline);
             }
         }
         let control = device.create_buffer(&wgpu::BufferDescriptor {
@@ -191,8 +173,7 @@ impl Shader {
                 mapped_at_creation: false,
             })
         });
-        // One counter per coarse effect, plus the dynamic mode's 2x2 sample count.
-        let counters = (layout.stats.counters.len() + 1) as u64 * 4;
+        let counters = layout.stats_counters() as u64 * 4;
         let stats = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("mrsl stats"),
             size: counters,
@@ -234,14 +215,12 @@ impl Shader {
             gbuffer_layout,
             stage_layouts,
             pipelines,
-            hierarchical,
             hier_buffers: None,
-            checkerboard,
             forced: false,
             args_group_layout,
             queue_readback: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("mrsl hierarchical queue readback"),
-                size: 80,
+                size: geometry::HIERARCHICAL_QUEUE_BYTES,
                 usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
@@ -278,11 +257,11 @@ impl Shader {
             .as_ref()
             .and_then(|u| u.fields.iter().find(|f| f.name == name))
             .ok_or_else(|| Error::UnknownUniform(name.to_string()))?;
-        let expected = components(&field.ty);
+        let expected = field.ty.components() as usize;
         if values.len() != expected {
             return Err(Error::UniformComponents {
                 name: name.into(),
-                ty: field.ty.clone(),
+                ty: field.ty.to_string(),
                 expected,
                 found: values.len(),
             });
@@ -301,7 +280,7 @@ impl Shader {
                 .get(&field.name)
                 .or(field.default.as_ref())
                 .ok_or_else(|| Error::MissingUniform(field.name.clone()))?;
-            write_field(&mut bytes[field.offset as usize..], &field.wgsl_type, &field.ty, values);
+            write_field(&mut bytes[field.offset as usize..], &field.ty, values);
         }
         Ok(bytes)
     }
@@ -312,40 +291,22 @@ impl Shader {
         let missing = |what: &str| {
             Err(Error::UnsupportedMode(mode.name().into(), format!("the program was compiled without {what}")))
         };
-        match mode {
-            Mode::Reference if !self.pipelines.contains_key(&(KernelKind::Reference, 1)) => {
-                return missing("its reference kernel");
-            }
-            Mode::Coarse2x2 | Mode::Coarse4x4 | Mode::Dynamic => {
-                let block = mode.block_size().unwrap_or(4);
-                // The dynamic mode runs the 4x4 coarse kernel but its own fine kernel.
-                let fine_needed = mode != Mode::Dynamic;
-                if !self.pipelines.contains_key(&(KernelKind::Coarse, block))
-                    || (fine_needed && !self.pipelines.contains_key(&(KernelKind::Fine, block)))
-                {
-                    return missing(&format!("{block}x{block} coarse and fine kernels"));
-                }
-                if mode == Mode::Dynamic
-                    && (!self.pipelines.contains_key(&(KernelKind::DynamicCoarse, 2))
-                        || !self.pipelines.contains_key(&(KernelKind::DynamicFine, 4)))
-                {
-                    return missing("the dynamic-mode kernels");
-                }
-            }
-            Mode::Hierarchical if self.hierarchical.is_empty() => return missing("the hierarchical kernel"),
-            Mode::Checkerboard if self.checkerboard.is_empty() => return missing("the checkerboard kernel"),
-            _ => {}
+        if let Some(what) = mode.kernels().iter().find(|(kind, block)| !self.has_kernel(*kind, *block)) {
+            return missing(&match what {
+                (kind, Some(b)) if kind.per_block_size() => format!("its {b}x{b} {kind} kernel"),
+                (kind, _) => format!("its {kind} kernel"),
+            });
         }
         if width == 0 || height == 0 {
             return Err(Error::BadSize { width, height, reason: "it is empty".into() });
         }
-        if width > 16384 || height > 16384 {
-            return Err(Error::BadSize { width, height, reason: "the largest supported side is 16384".into() });
+        if width > MAX_SIDE || height > MAX_SIDE {
+            return Err(Error::BadSize { width, height, reason: format!("the largest supported side is {MAX_SIDE}") });
         }
         if mode == Mode::Dynamic {
-            let (nx, ny) = sample_grid(bindings.size, 2);
+            let (nx, ny) = geometry::sample_grid(bindings.size, 2);
             let bytes = nx as u64 * ny as u64 * (self.layout.interface.stride_words as u64 + 1) * 4;
-            if bytes > 128 << 20 {
+            if bytes > MAX_STORAGE_BINDING_BYTES {
                 return Err(Error::BadSize {
                     width,
                     height,
@@ -360,13 +321,15 @@ impl Shader {
             // Work lists hold about 1.56 words per pixel; a level's shading
             // dispatch covers at most 65535 workgroups of 64 lanes.
             let pixels = width as u64 * height as u64;
-            if pixels * 2 * 4 > 128 << 20 || pixels / 2 > 65535 * 64 {
+            if pixels * 2 * 4 > MAX_STORAGE_BINDING_BYTES
+                || pixels / 2 > 65535 * u64::from(geometry::WORK_LIST_WORKGROUP)
+            {
                 return Err(Error::BadSize { width, height, reason: "the hierarchical work lists would exceed the storage or dispatch limits (about 4 million pixels per level)".into() });
             }
         }
         if matches!(mode, Mode::Hierarchical | Mode::Checkerboard) {
             let bytes = width as u64 * height as u64 * self.layout.hierarchical.record_words as u64 * 4;
-            if bytes > 128 << 20 {
+            if bytes > MAX_STORAGE_BINDING_BYTES {
                 return Err(Error::BadSize {
                     width,
                     height,
@@ -378,9 +341,9 @@ impl Shader {
             }
         }
         if let Some(block) = mode.block_size() {
-            let (nx, ny) = sample_grid(bindings.size, block);
+            let (nx, ny) = geometry::sample_grid(bindings.size, block);
             let bytes = nx as u64 * ny as u64 * self.layout.interface.stride_words as u64 * 4;
-            if bytes > 128 << 20 {
+            if bytes > MAX_STORAGE_BINDING_BYTES {
                 return Err(Error::BadSize {
                     width,
                     height,
@@ -406,19 +369,19 @@ impl Shader {
         };
         for ch in &self.layout.channels {
             let t = bindings.channels.get(&ch.name).ok_or_else(|| Error::MissingChannel(ch.name.clone()))?;
-            let need = components(&ch.ty) as u32;
+            let need = ch.ty.components();
             let fits = match (ch.sample_type, t.format().sample_type(None, None)) {
-                ("uint", Some(wgpu::TextureSampleType::Uint)) => true,
-                ("sint", Some(wgpu::TextureSampleType::Sint)) => true,
-                ("unfilterable-float", Some(wgpu::TextureSampleType::Float { .. })) => true,
+                (SampleType::Uint, Some(wgpu::TextureSampleType::Uint)) => true,
+                (SampleType::Sint, Some(wgpu::TextureSampleType::Sint)) => true,
+                (SampleType::UnfilterableFloat, Some(wgpu::TextureSampleType::Float { .. })) => true,
                 _ => false,
             } && t.format().components() as u32 >= need.min(4)
                 && (need != 3 || t.format().components() == 4);
             if !fits {
                 return Err(Error::ChannelFormat {
                     channel: ch.name.clone(),
-                    ty: ch.ty.clone(),
-                    expected: ch.format.into(),
+                    ty: ch.ty.to_string(),
+                    expected: ch.format.to_string(),
                     components: need,
                     found: t.format(),
                 });
@@ -437,7 +400,7 @@ impl Shader {
         }
         for o in &self.layout.outputs {
             let t = bindings.outputs.get(&o.name).ok_or_else(|| Error::MissingOutput(o.name.clone()))?;
-            let expected = storage_format(&o.format);
+            let expected = wgpu_format(o.format);
             if t.format() != expected {
                 return Err(Error::OutputFormat { name: o.name.clone(), expected, found: t.format() });
             }
@@ -463,15 +426,16 @@ impl Shader {
         let mode = options.mode;
         self.validate(bindings, mode)?;
         let (width, height) = bindings.size;
-        let mut control = [0u32; 8];
-        control[0] = width;
-        control[1] = height;
-        control[2] = u32::from(options.force_refine);
         self.frame = self.frame.wrapping_add(1).max(1);
         self.forced = options.force_refine;
-        control[3] = self.frame;
-        control[4] = options.similarity.to_bits();
-        queue.write_buffer(&self.control, 0, bytemuck::cast_slice(&control));
+        let control = Control {
+            size: [width, height],
+            force_refine: u32::from(options.force_refine),
+            frame: self.frame,
+            similarity: options.similarity,
+            reserved: [0; 3],
+        };
+        queue.write_buffer(&self.control, 0, bytemuck::bytes_of(&control));
         if let Some(buffer) = &self.uniforms {
             queue.write_buffer(buffer, 0, &self.uniform_bytes()?);
         }
@@ -481,7 +445,7 @@ impl Shader {
         let views: HashMap<&str, wgpu::TextureView> =
             bindings.outputs.iter().map(|(k, t)| (k.as_str(), t.create_view(&Default::default()))).collect();
         encoder.clear_buffer(&self.stats, 0, None);
-        let tiles = (width.div_ceil(mrsl::layout::TILE), height.div_ceil(mrsl::layout::TILE));
+        let tiles = geometry::pixel_workgroups(bindings.size);
         if mode == Mode::Hierarchical {
             self.encode_hierarchical(device, encoder, bindings, &resources, &gbuffer, &views);
         } else if mode == Mode::Checkerboard {
@@ -494,7 +458,7 @@ impl Shader {
                         encoder,
                         "mrsl reference",
                         0,
-                        (KernelKind::Reference, 1),
+                        (KernelKind::Reference, None, entry::REFERENCE),
                         &[&resources, &gbuffer, &stage],
                         tiles,
                     );
@@ -508,15 +472,13 @@ impl Shader {
                     let coarse_stage = self.stage_group(device, KernelKind::Coarse, Some(&interface), None, &views);
                     let fine_kind = if dynamic { KernelKind::DynamicFine } else { KernelKind::Fine };
                     let fine_stage = self.stage_group(device, fine_kind, Some(&interface), inner.as_ref(), &views);
-                    let (nx, ny) = sample_grid(bindings.size, block);
-                    let coarse_groups = (nx.div_ceil(8), ny.div_ceil(8));
                     self.pass(
                         encoder,
                         "mrsl coarse",
                         1,
-                        (KernelKind::Coarse, block),
+                        (KernelKind::Coarse, Some(block), entry::COARSE),
                         &[&resources, &gbuffer, &coarse_stage],
-                        coarse_groups,
+                        geometry::coarse_workgroups(bindings.size, block),
                     );
                     if dynamic {
                         let stage = self.stage_group(
@@ -526,17 +488,24 @@ impl Shader {
                             inner.as_ref(),
                             &views,
                         );
-                        let (nx, ny) = sample_grid(bindings.size, 2);
                         self.pass(
                             encoder,
                             "mrsl dynamic coarse 2x2",
                             3,
-                            (KernelKind::DynamicCoarse, 2),
+                            (KernelKind::DynamicCoarse, Some(2), entry::DYNAMIC_COARSE),
                             &[&resources, &gbuffer, &stage],
-                            (nx.div_ceil(8), ny.div_ceil(8)),
+                            geometry::coarse_workgroups(bindings.size, 2),
                         );
                     }
-                    self.pass(encoder, "mrsl fine", 2, (fine_kind, block), &[&resources, &gbuffer, &fine_stage], tiles);
+                    let fine_entry = if dynamic { entry::DYNAMIC_FINE } else { entry::FINE };
+                    self.pass(
+                        encoder,
+                        "mrsl fine",
+                        2,
+                        (fine_kind, Some(block), fine_entry),
+                        &[&resources, &gbuffer, &fine_stage],
+                        tiles,
+                    );
                 }
             }
         }
@@ -563,7 +532,6 @@ impl Shader {
         gbuffer: &wgpu::BindGroup,
         views: &HashMap<&str, wgpu::TextureView>,
     ) {
-        let (w, h) = bindings.size;
         let stage = self.record_stage(device, KernelKind::Hierarchical, bindings.size, views);
         let (buffers, _) = self.hier_buffers.as_ref().expect("created by record_stage");
         encoder.clear_buffer(&buffers.queue, 0, None);
@@ -572,34 +540,29 @@ impl Shader {
             layout: &self.args_group_layout,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffers.args.as_entire_binding() }],
         });
-        let count = |start: u32, step: u32, n: u32| if n > start { (n - start - 1) / step + 1 } else { 0 };
-        let groups = |x: u32, y: u32| (x.div_ceil(8).max(1), y.div_ceil(8).max(1));
-        let lattices = [
-            groups(count(2, 4, w), count(2, 4, h)),
-            groups(count(0, 2, w), count(0, 2, h)),
-            groups(count(1, 2, w), count(1, 2, h)),
-            groups(w, h),
-        ];
+        let size = bindings.size;
+        let pipeline = |name: &'static str| &self.pipelines[&(KernelKind::Hierarchical, None, name)];
         {
             let mut pass = self.begin_pass(encoder, "mrsl hierarchical levels", 1, &[resources, gbuffer, &stage]);
-            let (gx, gy) = groups(count(0, 4, w), count(0, 4, h));
-            pass.set_pipeline(&self.hierarchical[&0]);
+            let (gx, gy) = HIERARCHICAL_LEVEL0.workgroups(size);
+            pass.set_pipeline(pipeline(entry::HIER_LEVEL0));
             pass.dispatch_workgroups(gx, gy, 1);
-            for (level, (gx, gy)) in lattices.iter().enumerate() {
-                let base = 1 + 3 * level;
-                pass.set_pipeline(&self.hierarchical[&base]);
-                pass.dispatch_workgroups(*gx, *gy, 1);
-                pass.set_pipeline(&self.hierarchical[&(base + 1)]);
-                pass.set_bind_group(3, Some(&args), &[]);
+            for (index, lattice) in HIERARCHICAL_LEVELS.iter().enumerate() {
+                let (gx, gy) = lattice.workgroups(size);
+                pass.set_pipeline(pipeline(entry::HIER_CLASSIFY[index]));
+                pass.dispatch_workgroups(gx, gy, 1);
+                pass.set_pipeline(pipeline(entry::HIER_ARGS[index]));
+                pass.set_bind_group(GROUP_ARGS, Some(&args), &[]);
                 pass.dispatch_workgroups(1, 1, 1);
-                pass.set_pipeline(&self.hierarchical[&(base + 2)]);
-                pass.dispatch_workgroups_indirect(&buffers.args, 4 * (level as u64 + 1) * 4);
+                pass.set_pipeline(pipeline(entry::HIER_SHADE[index]));
+                pass.dispatch_workgroups_indirect(&buffers.args, geometry::indirect_args_offset(index as u32 + 1));
             }
         }
         {
             let mut pass = self.begin_pass(encoder, "mrsl hierarchical final", 2, &[resources, gbuffer, &stage]);
-            pass.set_pipeline(&self.hierarchical[&13]);
-            pass.dispatch_workgroups(w.div_ceil(mrsl::layout::TILE), h.div_ceil(mrsl::layout::TILE), 1);
+            pass.set_pipeline(pipeline(entry::HIER_FINAL));
+            let (gx, gy) = geometry::pixel_workgroups(size);
+            pass.dispatch_workgroups(gx, gy, 1);
         }
         encoder.copy_buffer_to_buffer(&buffers.queue, 0, &self.queue_readback, 0, None);
     }
@@ -615,16 +578,15 @@ impl Shader {
         gbuffer: &wgpu::BindGroup,
         views: &HashMap<&str, wgpu::TextureView>,
     ) {
-        let (w, h) = bindings.size;
         let stage = self.record_stage(device, KernelKind::Checkerboard, bindings.size, views);
+        let pipeline = |name: &'static str| &self.pipelines[&(KernelKind::Checkerboard, None, name)];
         let mut pass = self.begin_pass(encoder, "mrsl checkerboard", 1, &[resources, gbuffer, &stage]);
-        // cb_shade: 16 shaded quads per workgroup along a row of quads.
-        let (quads_x, quads_y) = (w.div_ceil(2), h.div_ceil(2));
-        pass.set_pipeline(&self.checkerboard[0]);
-        let shaded_per_row = if self.forced { quads_x } else { quads_x.div_ceil(2) };
-        pass.dispatch_workgroups(shaded_per_row.div_ceil(16).max(1), quads_y, 1);
-        pass.set_pipeline(&self.checkerboard[1]);
-        pass.dispatch_workgroups(w.div_ceil(mrsl::layout::TILE), h.div_ceil(mrsl::layout::TILE), 1);
+        let (gx, gy) = geometry::checkerboard_workgroups(bindings.size, self.forced);
+        pass.set_pipeline(pipeline(entry::CB_SHADE));
+        pass.dispatch_workgroups(gx, gy, 1);
+        pass.set_pipeline(pipeline(entry::CB_FINAL));
+        let (gx, gy) = geometry::pixel_workgroups(bindings.size);
+        pass.dispatch_workgroups(gx, gy, 1);
     }
 
     /// Group 2 of the modes that keep a record per pixel (hierarchical, checkerboard):
@@ -658,9 +620,7 @@ impl Shader {
             return;
         }
         let (w, h) = (size.0 as u64, size.1 as u64);
-        let count = |start: u64, step: u64, n: u64| if n > start { (n - start - 1) / step + 1 } else { 0 };
-        let work_words =
-            count(2, 4, w) * count(2, 4, h) + count(0, 2, w) * count(0, 2, h) + count(1, 2, w) * count(1, 2, h) + w * h;
+        let work_words = geometry::work_list_words(size);
         let storage = |label, bytes: u64, extra| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -673,8 +633,16 @@ impl Shader {
         let buffers = HierBuffers {
             values: storage("mrsl hierarchical values", w * h * record * 4, wgpu::BufferUsages::empty()),
             work: storage("mrsl hierarchical work lists", work_words * 4, wgpu::BufferUsages::empty()),
-            queue: storage("mrsl hierarchical queues", 80, wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC),
-            args: storage("mrsl hierarchical dispatch arguments", 80, wgpu::BufferUsages::INDIRECT),
+            queue: storage(
+                "mrsl hierarchical queues",
+                geometry::HIERARCHICAL_QUEUE_BYTES,
+                wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            ),
+            args: storage(
+                "mrsl hierarchical dispatch arguments",
+                geometry::HIERARCHICAL_QUEUE_BYTES,
+                wgpu::BufferUsages::INDIRECT,
+            ),
         };
         self.hier_buffers = Some((buffers, size));
     }
@@ -684,7 +652,7 @@ impl Shader {
         encoder: &mut wgpu::CommandEncoder,
         label: &str,
         stage: u32,
-        pipeline: (KernelKind, u32),
+        pipeline: PipelineKey,
         groups: &[&wgpu::BindGroup],
         workgroups: (u32, u32),
     ) {
@@ -721,7 +689,7 @@ impl Shader {
         let stride = (self.layout.interface.stride_words + u32::from(tagged)).max(1) as u64;
         let fresh = self.interfaces.get(&(block, tagged)).is_none_or(|(_, s)| *s != size);
         if fresh {
-            let (nx, ny) = sample_grid(size, block);
+            let (nx, ny) = geometry::sample_grid(size, block);
             let buffer = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("mrsl interface"),
                 size: nx as u64 * ny as u64 * stride * 4,
@@ -889,18 +857,19 @@ impl Shader {
         let mut stats = Stats::new(&self.layout, options, size, &counters, timings);
         if options.mode == Mode::Hierarchical {
             let queue: Vec<u32> = read_buffer(device, &self.queue_readback)?;
-            stats.work_lists = (1..=4).map(|l| queue[4 * l] as u64).collect();
+            let words = geometry::QUEUE_WORDS_PER_LEVEL as usize;
+            stats.work_lists = (1..=HIERARCHICAL_LEVELS.len()).map(|l| queue[words * l] as u64).collect();
             let queued: u64 = stats.work_lists.iter().sum();
-            let lanes: u64 = stats.work_lists.iter().map(|c| c.div_ceil(64) * 64).sum();
+            let lane = u64::from(geometry::WORK_LIST_WORKGROUP);
+            let lanes: u64 = stats.work_lists.iter().map(|c| c.div_ceil(lane) * lane).sum();
             stats.lane_utilisation = Some(if lanes == 0 { 1.0 } else { queued as f64 / lanes as f64 });
         }
         Ok(stats)
     }
 
-    /// Number of coarse samples for a size and block size (as the kernels compute it).
-    pub fn coarse_samples(size: (u32, u32), block: u32) -> u64 {
-        let (nx, ny) = sample_grid(size, block);
-        nx as u64 * ny as u64
+    /// Whether the program has the kernel `kind` for `block` (as a mode needs it).
+    fn has_kernel(&self, kind: KernelKind, block: Option<u32>) -> bool {
+        kind.entry_points().iter().all(|e| self.pipelines.contains_key(&(kind, block, *e)))
     }
 }
 
@@ -928,56 +897,27 @@ pub(crate) fn describe(error: &wgpu::Error) -> String {
     }
 }
 
-/// Number of scalar components of an mrsl type name (`float3` = 3, `float4[8]` = 32).
-pub fn components(ty: &str) -> usize {
-    match ty {
-        "float2x2" => 4,
-        "float3x3" => 9,
-        "float4x4" => 16,
-        t if t.ends_with(']') => {
-            let (elem, n) = t.trim_end_matches(']').split_once('[').unwrap_or((t, "1"));
-            components(elem) * n.parse::<usize>().unwrap_or(1)
-        }
-        t => match t.chars().last() {
-            Some(c @ '2'..='4') => c.to_digit(10).unwrap_or(1) as usize,
-            _ => 1,
-        },
-    }
-}
-
 /// Writes a uniform's components at the start of `out`, laid out as WGSL's
-/// uniform address space wants (matrix columns and array elements 16-byte aligned).
-fn write_field(out: &mut [u8], wgsl_type: &str, ty: &str, values: &[f64]) {
-    let float = wgsl_type.contains("f32");
-    let signed = wgsl_type.contains("i32");
+/// uniform address space wants (matrix columns 16-byte aligned but for
+/// `mat2x2`; arrays hold 16-byte elements only, so their words are packed).
+fn write_field(out: &mut [u8], ty: &ValueType, values: &[f64]) {
+    let scalar = ty.scalar();
     let mut put = |index: usize, v: f64| {
-        let bytes = if float {
-            (v as f32).to_le_bytes()
-        } else if signed {
-            (v as i32).to_le_bytes()
-        } else {
-            (v as u32).to_le_bytes()
+        let bytes = match scalar {
+            Scalar::Float => (v as f32).to_le_bytes(),
+            Scalar::Int => (v as i32).to_le_bytes(),
+            Scalar::Uint | Scalar::Bool => (v as u32).to_le_bytes(),
         };
         out[index * 4..index * 4 + 4].copy_from_slice(&bytes);
     };
-    let matrix = match ty {
-        "float2x2" => Some(2),
-        "float3x3" => Some(3),
-        "float4x4" => Some(4),
-        _ => None,
-    };
-    if let Some(n) = matrix {
+    if let ValueType::Matrix(n) = ty {
+        let n = usize::from(*n);
         // Columns of a mat2x2 are 8 bytes apart, of mat3x3/mat4x4 16 bytes.
         let column_words = if n == 2 { 2 } else { 4 };
         for col in 0..n {
             for row in 0..n {
                 put(col * column_words + row, values[col * n + row]);
             }
-        }
-    } else if ty.ends_with(']') {
-        // Arrays of 16-byte elements (float4, int4, uint4, float4x4): tightly packed words.
-        for (i, v) in values.iter().enumerate() {
-            put(i, *v);
         }
     } else {
         for (i, v) in values.iter().enumerate() {
@@ -986,18 +926,21 @@ fn write_field(out: &mut [u8], wgsl_type: &str, ty: &str, values: &[f64]) {
     }
 }
 
-fn storage_format(name: &str) -> wgpu::TextureFormat {
+/// The wgpu format of a layout format.
+pub fn wgpu_format(format: TextureFormat) -> wgpu::TextureFormat {
     use wgpu::TextureFormat as F;
-    match name {
-        "r32float" => F::R32Float,
-        "rg32float" => F::Rg32Float,
-        "rgba16float" => F::Rgba16Float,
-        "rgba8unorm" => F::Rgba8Unorm,
-        "r32uint" => F::R32Uint,
-        "rgba32uint" => F::Rgba32Uint,
-        "r32sint" => F::R32Sint,
-        "rgba32sint" => F::Rgba32Sint,
-        _ => F::Rgba32Float,
+    match format {
+        TextureFormat::R32Float => F::R32Float,
+        TextureFormat::Rg32Float => F::Rg32Float,
+        TextureFormat::Rgba32Float => F::Rgba32Float,
+        TextureFormat::Rgba16Float => F::Rgba16Float,
+        TextureFormat::Rgba8Unorm => F::Rgba8Unorm,
+        TextureFormat::R32Uint => F::R32Uint,
+        TextureFormat::Rg32Uint => F::Rg32Uint,
+        TextureFormat::Rgba32Uint => F::Rgba32Uint,
+        TextureFormat::R32Sint => F::R32Sint,
+        TextureFormat::Rg32Sint => F::Rg32Sint,
+        TextureFormat::Rgba32Sint => F::Rgba32Sint,
     }
 }
 
@@ -1049,9 +992,9 @@ fn gbuffer_layout(device: &wgpu::Device, l: &Layout) -> wgpu::BindGroupLayout {
             visibility: wgpu::ShaderStages::COMPUTE,
             ty: wgpu::BindingType::Texture {
                 sample_type: match c.sample_type {
-                    "uint" => wgpu::TextureSampleType::Uint,
-                    "sint" => wgpu::TextureSampleType::Sint,
-                    _ => wgpu::TextureSampleType::Float { filterable: false },
+                    SampleType::Uint => wgpu::TextureSampleType::Uint,
+                    SampleType::Sint => wgpu::TextureSampleType::Sint,
+                    SampleType::UnfilterableFloat => wgpu::TextureSampleType::Float { filterable: false },
                 },
                 view_dimension: wgpu::TextureViewDimension::D2,
                 multisampled: false,
@@ -1102,7 +1045,7 @@ fn stage_layout(device: &wgpu::Device, l: &Layout, kind: KernelKind) -> wgpu::Bi
                 visibility: wgpu::ShaderStages::COMPUTE,
                 ty: wgpu::BindingType::StorageTexture {
                     access: wgpu::StorageTextureAccess::WriteOnly,
-                    format: storage_format(&o.format),
+                    format: wgpu_format(o.format),
                     view_dimension: wgpu::TextureViewDimension::D2,
                 },
                 count: None,

@@ -2,8 +2,8 @@
 //! and how many re-evaluated it, and the work relative to the reference.
 
 use crate::shader::DispatchOptions;
-use mrsl::layout::Layout;
-use mrsl::syntax::ast::Rate;
+use mrsl_abi::geometry::sample_grid;
+use mrsl_abi::{Layout, Rate};
 
 /// GPU time of the passes, from timestamp queries.
 ///
@@ -66,7 +66,11 @@ impl Stats {
         timings: Option<Timings>,
     ) -> Stats {
         let pixels = size.0 as u64 * size.1 as u64;
-        let mut samples = options.mode.block_size().map(|b| crate::Shader::coarse_samples(size, b)).unwrap_or(0);
+        let samples_of = |block| {
+            let (nx, ny) = sample_grid(size, block);
+            nx as u64 * ny as u64
+        };
+        let mut samples = options.mode.block_size().map(samples_of).unwrap_or(0);
         if options.mode == crate::Mode::Dynamic {
             // The 2x2 samples the second level shaded, counted by its kernel.
             samples += counters.get(layout.stats.counters.len()).copied().unwrap_or(0) as u64;

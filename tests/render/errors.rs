@@ -1,8 +1,8 @@
 //! Bad bindings give the typed error that names what is wrong, never a panic.
 
-use crate::{compile, gpu, run};
-use mrsl_runtime::gpu::Gpu;
-use mrsl_runtime::scene::{ChannelData, GBuffer, Scene};
+use crate::{compile, run};
+use mrsl_lab::gpu::Gpu;
+use mrsl_lab::scene::{ChannelData, GBuffer, Scene};
 use mrsl_runtime::{Bindings, DispatchOptions, Error, Mode, Shader};
 
 const PROGRAM: &str = "
@@ -19,9 +19,7 @@ fn dispatch(gpu: &Gpu, shader: &mut Shader, bindings: &Bindings) -> Result<(), E
     shader.encode(&gpu.device, &gpu.queue, &mut encoder, bindings, DispatchOptions::new(Mode::Coarse4x4))
 }
 
-#[test]
-fn binding_mismatches_are_typed_errors() {
-    let Some(gpu) = gpu() else { return };
+pub fn binding_mismatches_are_typed_errors(gpu: &Gpu) {
     let program = compile(PROGRAM);
     let gbuffer = Scene::Demo.render(16, 8);
     let channels = gbuffer.upload(gpu);
@@ -76,17 +74,14 @@ fn binding_mismatches_are_typed_errors() {
     dispatch(gpu, &mut shader, &bindings).unwrap();
 }
 
-#[test]
-fn unknown_modes_are_named() {
+pub fn unknown_modes_are_named() {
     assert_eq!("coarse8x8".parse::<Mode>(), Err(Error::UnknownMode("coarse8x8".into())));
     assert_eq!("coarse4x4".parse::<Mode>(), Ok(Mode::Coarse4x4));
 }
 
 /// A G-buffer channel the program does not declare is simply unused, and
 /// the run helper reports missing bindings rather than panicking.
-#[test]
-fn extra_channels_are_ignored() {
-    let Some(gpu) = gpu() else { return };
+pub fn extra_channels_are_ignored(gpu: &Gpu) {
     let program = compile("in float depth;\nfine out float4 color = float4(depth);");
     let mut gbuffer = Scene::Gradient.render(8, 8);
     gbuffer.channels.push(("unused".into(), ChannelData::Uint(vec![0; 64])));
@@ -96,9 +91,7 @@ fn extra_channels_are_ignored() {
 }
 
 /// A mode whose kernels were not compiled is a typed error, not a panic.
-#[test]
-fn modes_without_kernels_are_unsupported() {
-    let Some(gpu) = gpu() else { return };
+pub fn modes_without_kernels_are_unsupported(gpu: &Gpu) {
     let source = "in float depth;\ncoarse effect float d = depth * 2.0;\nfine out float4 color = float4(d);";
     let options = mrsl::Options { hierarchical: false, dynamic: false, block_sizes: vec![4], ..Default::default() };
     let program = mrsl::compile(source, &options).unwrap();

@@ -1,24 +1,43 @@
 //! Shared device and a `run` helper: one program, one G-buffer, one mode.
 
-use mrsl_runtime::gpu::Gpu;
-use mrsl_runtime::scene::GBuffer;
+use mrsl_lab::gpu::Gpu;
+use mrsl_lab::scene::GBuffer;
 use mrsl_runtime::{Bindings, DispatchOptions, Error, Mode, Shader, Stats};
 use std::sync::OnceLock;
 
-static GPU: OnceLock<Option<Gpu>> = OnceLock::new();
-
-/// The shared device, or `None` (with a message) when there is no adapter
-/// outside CI. Under `CI=true` a missing adapter panics: a failure, not a skip.
-pub fn gpu() -> Option<&'static Gpu> {
+/// The shared device, or `None` when there is no adapter outside CI, after
+/// printing why and how many GPU tests will be reported as skipped. Under
+/// `CI=true` a missing adapter panics: a failure, not a skip. It also tells
+/// the evaluation kit where cargo unpacked the Sponza model.
+pub fn gpu(gpu_tests: usize) -> Option<&'static Gpu> {
+    static GPU: OnceLock<Option<Gpu>> = OnceLock::new();
+    locate_sponza();
     let gpu = GPU.get_or_init(|| match Gpu::new() {
         Ok(gpu) => Some(gpu),
         Err(e) if std::env::var("CI").is_ok_and(|v| v == "true") => panic!("CI=true but no GPU adapter: {e}"),
         Err(e) => {
-            eprintln!("SKIPPED render test: no GPU adapter ({e})");
+            println!(
+                "SKIPPING {gpu_tests} render tests (reported as ignored below): no GPU adapter ({e}). \
+                 Install Mesa's software Vulkan driver to run them: apt-get install mesa-vulkan-drivers libvulkan1"
+            );
             None
         }
     });
     gpu.as_ref()
+}
+
+/// The Sponza model's path, as cargo unpacked the `obj-rs` 0.7.4 package
+/// (a dependency of the evaluation kit), unless `$MRSL_SPONZA` names it.
+fn locate_sponza() {
+    if std::env::var_os("MRSL_SPONZA").is_some() {
+        return;
+    }
+    let cargo_home = std::env::var_os("CARGO_HOME")
+        .map(std::path::PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|home| std::path::PathBuf::from(home).join(".cargo")));
+    if let Some(path) = cargo_home.and_then(|home| mrsl_lab::mesh::find_sponza_in_cargo_home(&home)) {
+        mrsl_lab::mesh::set_sponza_path(path);
+    }
 }
 
 /// What one dispatch produced.
@@ -49,7 +68,7 @@ pub fn run(
     if let Some(block) = &program.layout.uniforms {
         for f in &block.fields {
             if f.default.is_none() {
-                let n = mrsl_runtime::components(&f.ty);
+                let n = f.ty.components();
                 let values: Vec<f64> = (0..n).map(|i| 0.25 + 0.5 * ((i * 7919) % 13) as f64 / 13.0).collect();
                 shader.set_uniform(&f.name, &values)?;
             }
@@ -72,7 +91,7 @@ pub fn run(
         .outputs
         .iter()
         .map(|o| {
-            assert_eq!(o.format, "rgba32float", "render tests read rgba32float outputs");
+            assert_eq!(o.format, mrsl_abi::TextureFormat::Rgba32Float, "render tests read rgba32float outputs");
             (o.name.clone(), gpu.output_texture(&o.name, size, wgpu::TextureFormat::Rgba32Float))
         })
         .collect();
@@ -99,7 +118,7 @@ pub fn run(
     )?;
     gpu.queue.submit([encoder.finish()]);
     let stats = shader.read_stats(&gpu.device)?;
-    let pixels = gpu.read_rgba32f(&outputs[0].1)?;
+    let pixels = gpu.read_rgba32f(&outputs[0].1).map_err(|e| Error::Readback(e.to_string()))?;
     Ok(Output { pixels, stats, width: size.0 })
 }
 

@@ -1,8 +1,9 @@
 //! Every mode against the reference of the same program.
 
-use crate::{compile, gpu, max_abs_diff, run, ulps};
+use crate::{compile, max_abs_diff, run, ulps};
+use mrsl_lab::gpu::Gpu;
+use mrsl_lab::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
 use mrsl_runtime::Mode;
-use mrsl_runtime::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
 
 const COARSE_MODES: [Mode; 5] =
     [Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic, Mode::Hierarchical, Mode::Checkerboard];
@@ -22,9 +23,7 @@ fn examples() -> Vec<(String, String)> {
 /// With every refine predicate forced, each coarse mode evaluates every
 /// effect per pixel with the same code as the reference kernel: the images
 /// must be bit-identical.
-#[test]
-fn forced_refinement_equals_reference_for_every_example() {
-    let Some(gpu) = gpu() else { return };
+pub fn forced_refinement_equals_reference_for_every_example(gpu: &Gpu) {
     let gbuffer = Scene::Demo.render(75, 43);
     for (name, source) in examples() {
         let program = compile(&source);
@@ -62,9 +61,7 @@ fine out float4 color = float4(ramp, ramp * 0.5, 1.0 - ramp, 1.0);
 /// float rounding: values are below 1, where an ulp is 6e-8, and the
 /// resampling adds four products, so 5e-7 (8 ulps) bounds the error. The
 /// effect is shaded once per 4x4 block plus the border row and column.
-#[test]
-fn gradient_is_reconstructed_at_one_sixteenth_of_the_cost() {
-    let Some(gpu) = gpu() else { return };
+pub fn gradient_is_reconstructed_at_one_sixteenth_of_the_cost(gpu: &Gpu) {
     let program = compile(GRADIENT);
     let gbuffer = Scene::Gradient.render(256, 256);
     let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
@@ -89,9 +86,7 @@ fine out float4 color = float4(shade, shade, shade, 1.0);
 /// pixel may blend two steps. A blended pixel would be off by at least a
 /// step height (> 0.05); interpolating equal corners is exact up to the
 /// rounding of weights that sum to one (2e-7).
-#[test]
-fn steps_keep_their_edges() {
-    let Some(gpu) = gpu() else { return };
+pub fn steps_keep_their_edges(gpu: &Gpu) {
     let program = compile(STEPS);
     for (w, h) in [(256, 64), (131, 37)] {
         let gbuffer = Scene::Steps { count: 9 }.render(w, h);
@@ -119,9 +114,7 @@ fine out float4 color = float4(tint, 1.0);
 /// object must never be blended across an object's outline, so every pixel
 /// equals the reference (to the 2e-7 of weights summing to one) although
 /// most of the image is resampled.
-#[test]
-fn silhouettes_are_never_blended() {
-    let Some(gpu) = gpu() else { return };
+pub fn silhouettes_are_never_blended(gpu: &Gpu) {
     let program = compile(PER_OBJECT);
     let gbuffer = Scene::Demo.render(203, 117);
     let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
@@ -144,9 +137,7 @@ fn silhouettes_are_never_blended() {
 
 /// Sizes that are not multiples of the block or the tile: every pixel is
 /// written (alpha is 1) and matches the reference.
-#[test]
-fn odd_sizes_cover_every_pixel() {
-    let Some(gpu) = gpu() else { return };
+pub fn odd_sizes_cover_every_pixel(gpu: &Gpu) {
     let program = compile(GRADIENT);
     for (w, h) in [(1, 1), (5, 3), (2, 7), (1023, 769)] {
         let gbuffer = Scene::Gradient.render(w, h);
@@ -164,9 +155,7 @@ fn odd_sizes_cover_every_pixel() {
 
 /// The statistics add up: the reference shades everything once; coarse
 /// modes shade less, and 4x4 less than 2x2, on the demo program and scene.
-#[test]
-fn shaded_fraction_falls_from_reference_to_coarse4x4() {
-    let Some(gpu) = gpu() else { return };
+pub fn shaded_fraction_falls_from_reference_to_coarse4x4(gpu: &Gpu) {
     let program = compile(include_str!("../../examples/demo.mrsl"));
     let gbuffer = Scene::Demo.render(160, 96);
     let fractions: Vec<f64> =
@@ -192,9 +181,7 @@ fn shaded_fraction_falls_from_reference_to_coarse4x4() {
 
 /// A G-buffer made by hand, to check the runtime reads the engine's data
 /// without assumptions about the scene module.
-#[test]
-fn hand_made_gbuffer_reads_back() {
-    let Some(gpu) = gpu() else { return };
+pub fn hand_made_gbuffer_reads_back(gpu: &Gpu) {
     let program = compile("in float depth;\nfine out float4 color = float4(depth, depth * 2.0, 0.0, 1.0);");
     let data: Vec<f32> = (0..12).map(|i| i as f32 * 0.125).collect();
     let gbuffer = GBuffer {
@@ -212,9 +199,7 @@ fn hand_made_gbuffer_reads_back() {
 /// Sinusoids at several angles and frequencies: a coarse effect that follows
 /// the oscillation refines where it bends fastest, and every mode stays
 /// within a tolerance of the reference that shrinks as the blocks shrink.
-#[test]
-fn sinusoids_at_many_angles_and_frequencies() {
-    let Some(gpu) = gpu() else { return };
+pub fn sinusoids_at_many_angles_and_frequencies(gpu: &Gpu) {
     let program = compile(
         "in float3 normal;
 uniform float threshold = 0.08;
@@ -233,7 +218,7 @@ fine out float4 color = float4(shade, shade, shade, 1.0);",
     // a known limit of DACS's similarity test that no tolerance would cover.
     let block_modes = [Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic];
     for (angle, frequency) in [(0.0, 2.0), (30.0, 4.0), (45.0, 6.0), (80.0, 8.0)] {
-        let scene = mrsl_runtime::scene::Scene::parse(&format!("sinusoid:{angle}:{frequency}")).unwrap();
+        let scene = mrsl_lab::scene::Scene::parse(&format!("sinusoid:{angle}:{frequency}")).unwrap();
         let gbuffer = scene.render(160, 96);
         let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
         for mode in block_modes {
@@ -260,9 +245,7 @@ fine out float4 color = float4(shade, shade, shade, 1.0);",
 /// the centre of its four previous-level neighbours, so their average is the
 /// exact value (to rounding); only level 0 (1/16 of the pixels) and the
 /// border pixels without a complete pair of neighbours are shaded.
-#[test]
-fn hierarchical_interpolates_a_gradient_from_level_zero() {
-    let Some(gpu) = gpu() else { return };
+pub fn hierarchical_interpolates_a_gradient_from_level_zero(gpu: &Gpu) {
     let program = compile(GRADIENT);
     let gbuffer = Scene::Gradient.render(256, 256);
     let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
@@ -273,31 +256,33 @@ fn hierarchical_interpolates_a_gradient_from_level_zero() {
     // Level 0 (64 x 64 pixels) plus the last two columns and rows, whose
     // pixels lack one neighbour of every pair and so are shaded.
     assert!(ramp.pixel_evaluations >= 64 * 64 && ramp.shaded_fraction <= 0.07, "{ramp:?}");
-    assert!(out.stats.work_lists.iter().sum::<u64>() <= 4 * 256, "{:?}", out.stats.work_lists);
+    // The work-list counters (queue atomics) and the per-pixel statistics
+    // (counted in the final pass from the records) are independent tallies of
+    // the same pixels: everything shaded beyond level 0.
+    let queued: u64 = out.stats.work_lists.iter().sum();
+    assert_eq!(queued, ramp.pixel_evaluations - 64 * 64, "{:?}", out.stats.work_lists);
+    assert!(queued <= 4 * 256, "{:?}", out.stats.work_lists);
 }
 
 /// Work compaction: on the demo scene every queued pixel is shaded by a
 /// full lane except the last partial group of each level.
-#[test]
-fn hierarchical_work_lists_keep_lanes_full() {
-    let Some(gpu) = gpu() else { return };
+pub fn hierarchical_work_lists_keep_lanes_full(gpu: &Gpu) {
     let program = compile(include_str!("../../examples/demo.mrsl"));
     let gbuffer = Scene::Demo.render(320, 180);
     let out = run(gpu, &program, &gbuffer, Mode::Hierarchical, false).unwrap();
     let queued: u64 = out.stats.work_lists.iter().sum();
     assert!(queued > 0, "silhouettes must be queued");
-    let partial_groups = out.stats.work_lists.iter().filter(|c| **c % 64 != 0).count() as u64;
-    let lanes = queued + partial_groups * 64;
-    assert!(out.stats.lane_utilisation.unwrap() >= queued as f64 / lanes as f64);
-    assert!(out.stats.lane_utilisation.unwrap() > 0.9, "{:?}", out.stats);
+    // Only the last group of each of the four levels may be partly empty.
+    let lanes_wasted_at_most = 4.0 * 63.0;
+    let utilisation = out.stats.lane_utilisation.unwrap();
+    assert!(utilisation >= queued as f64 / (queued as f64 + lanes_wasted_at_most), "{utilisation} for {queued}");
+    assert!(utilisation > 0.9, "{:?}", out.stats);
 }
 
 /// The checkerboard baseline reconstructs a linear ramp exactly from the
 /// centred pairs of taps, shading half the quads plus the border pixels that
 /// lack a complete pair.
-#[test]
-fn checkerboard_reconstructs_a_gradient_at_half_rate() {
-    let Some(gpu) = gpu() else { return };
+pub fn checkerboard_reconstructs_a_gradient_at_half_rate(gpu: &Gpu) {
     let program = compile(GRADIENT);
     let gbuffer = Scene::Gradient.render(128, 96);
     let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();

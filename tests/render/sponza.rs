@@ -2,12 +2,12 @@
 //! every mode, and the pieces that make it (mesh loaders, the rasteriser,
 //! scene files) checked on small inputs with known answers.
 
-use crate::{Output, compile, gpu};
-use mrsl_runtime::gpu::Gpu;
-use mrsl_runtime::mesh::{Mesh, MeshError};
-use mrsl_runtime::raster::{self, Camera, RasterError};
-use mrsl_runtime::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
-use mrsl_runtime::scene_file::{MeshSource, SceneFile, SceneFileError};
+use crate::{Output, compile};
+use mrsl_lab::gpu::Gpu;
+use mrsl_lab::mesh::{Mesh, MeshError};
+use mrsl_lab::raster::{self, Camera, RasterError};
+use mrsl_lab::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
+use mrsl_lab::scene_file::{MeshSource, SceneFile, SceneFileError};
 use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader};
 use std::path::PathBuf;
 
@@ -62,9 +62,7 @@ fn shade(
 /// for that. Blending across silhouettes costs far more: the same program
 /// without `@key` on `material` measured 34.1 dB (2x2) and 31.6 dB (4x4),
 /// under both bars.
-#[test]
-fn sponza_coarse_modes_stay_close_to_the_reference() {
-    let Some(gpu) = gpu() else { return };
+pub fn sponza_coarse_modes_stay_close_to_the_reference(gpu: &Gpu) {
     let program = compile(DEMO);
     let channels = Scene::Sponza.textures_on(gpu, SIZE.0, SIZE.1).unwrap();
     let eye = Scene::sponza_camera().eye;
@@ -100,12 +98,16 @@ fn sponza_coarse_modes_stay_close_to_the_reference() {
         // The stats add up: every coarse effect was shaded once per coarse
         // sample of the grid plus once per refining pixel, every other
         // effect once per pixel, and the total is the reported fraction.
-        let samples = Shader::coarse_samples(SIZE, mode.block_size().unwrap());
+        // Independently of the runtime's formula: every B-th pixel along each
+        // axis, plus the last pixel when the lattice misses it.
+        let block = mode.block_size().unwrap();
+        let per_axis = |n: u32| u64::from(n.div_ceil(block) + u32::from((n - 1) % block != 0));
+        let samples = per_axis(SIZE.0) * per_axis(SIZE.1);
         assert_eq!(out.stats.coarse_samples, samples);
         let mut shaded = 0u64;
         for e in &out.stats.effects {
             assert_eq!(e.pixel_evaluations + e.resampled, pixels, "{mode}: {e:?}");
-            if e.rate == mrsl::syntax::ast::Rate::Coarse {
+            if e.rate == mrsl_abi::Rate::Coarse {
                 assert_eq!(e.coarse_evaluations, samples, "{mode}: {e:?}");
                 assert!(e.pixel_evaluations < pixels, "{mode}: `{}` refined everywhere", e.name);
             } else {
@@ -129,11 +131,10 @@ fn sponza_coarse_modes_stay_close_to_the_reference() {
 /// The model as obj-rs 0.7.4 ships it: 76,154 triangles once its polygons
 /// (up to 78-gons) are triangulated, 35 materials numbered in the order the
 /// file first uses them, all used, unit normals everywhere.
-#[test]
-fn sponza_loads_with_its_35_materials() {
-    let path = mrsl_runtime::mesh::sponza_path().unwrap();
+pub fn sponza_loads_with_its_35_materials() {
+    let path = mrsl_lab::mesh::sponza_path().unwrap();
     assert!(path.ends_with("obj-rs-0.7.4/tests/fixtures/sponza.obj"), "{}", path.display());
-    let mesh = mrsl_runtime::mesh::sponza_shared().unwrap();
+    let mesh = mrsl_lab::mesh::sponza_shared().unwrap();
     mesh.validate().unwrap();
     assert_eq!(mesh.triangle_count(), 76_154);
     assert_eq!(mesh.material_names.len(), 35);
@@ -189,9 +190,7 @@ fn floats<'a>(g: &'a GBuffer, name: &str) -> (&'a [f32], usize) {
 /// The rasteriser against analytic answers: ray-plane intersections for
 /// position and depth, the face normal, uv, material ids, the background
 /// convention; seen from behind, the normal flips to face the camera.
-#[test]
-fn rasterised_quads_match_the_analytic_gbuffer() {
-    let Some(gpu) = gpu() else { return };
+pub fn rasterised_quads_match_the_analytic_gbuffer(gpu: &Gpu) {
     let (w, h) = (96u32, 54u32);
     for (with_normals, eye, normal_sign) in
         [(true, [0.0, 0.0, 5.0], 1.0f32), (false, [0.0, 0.0, 5.0], 1.0), (true, [0.0, 0.0, -5.0], -1.0)]
@@ -304,8 +303,7 @@ f 9/1 10/1 11/1 12/1 13/1 14/1 15/1 16/1
 /// C's area is kept, which a fan from its first corner would not), the
 /// cube's normals stay flat across its 90 degree creases, and materials are
 /// numbered in order of use.
-#[test]
-fn obj_written_to_a_temp_dir_loads() {
+pub fn obj_written_to_a_temp_dir_loads() {
     let dir = temp_dir("obj");
     let path = dir.join("model.obj");
     std::fs::write(&path, OBJ).unwrap();
@@ -351,8 +349,7 @@ fn obj_written_to_a_temp_dir_loads() {
 
 /// A glTF file with an embedded (base64) buffer and a GLB with the same
 /// content: one triangle without normals under a translated node.
-#[test]
-fn gltf_and_glb_written_to_a_temp_dir_load() {
+pub fn gltf_and_glb_written_to_a_temp_dir_load() {
     let dir = temp_dir("gltf");
     let mut bin: Vec<u8> = vec![];
     for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
@@ -418,8 +415,7 @@ fn base64(bytes: &[u8]) -> String {
 }
 
 /// Unreadable files and formats are typed errors, never panics.
-#[test]
-fn bad_mesh_files_are_typed_errors() {
+pub fn bad_mesh_files_are_typed_errors() {
     let dir = temp_dir("bad");
     match Mesh::load(dir.join("missing.obj")) {
         Err(MeshError::Io { path, source }) => {
@@ -445,8 +441,7 @@ fn bad_mesh_files_are_typed_errors() {
 
 /// Scene files: relative mesh paths, camera, size and uniforms; each
 /// mistake names the file and the key.
-#[test]
-fn scene_files_parse_and_name_their_mistakes() {
+pub fn scene_files_parse_and_name_their_mistakes(gpu: &Gpu) {
     let dir = temp_dir("scene");
     std::fs::create_dir_all(dir.join("models")).unwrap();
     std::fs::write(dir.join("models/model.obj"), OBJ).unwrap();
@@ -520,36 +515,34 @@ show_checker = false
 
     // Rendered: the C (material 1) seen straight on, its notch open to the
     // background, its normal +z.
-    if let Some(gpu) = gpu() {
-        let size = scene.size.unwrap();
-        let g = scene.render_on(gpu, size).unwrap();
-        assert_eq!((g.width, g.height), size);
-        let Some(ChannelData::Uint(material)) = g.channel("material") else { panic!() };
-        let (normal, _) = floats(&g, "normal");
-        let (mut on_bar, mut in_notch) = (0, 0);
-        for y in 0..size.1 {
-            for x in 0..size.0 {
-                let d = camera.ray(x, y, size).unwrap();
-                let t = -camera.eye[2] / d[2];
-                let (hx, hy) = (camera.eye[0] + t * d[0], camera.eye[1] + t * d[1]);
-                let i = (y * size.0 + x) as usize;
-                if (3.1..5.9).contains(&hx) && (0.1..0.9).contains(&hy) {
-                    on_bar += 1;
-                    assert_eq!(material[i], 1, "pixel ({x}, {y}) on the C");
-                    assert!((normal[3 * i + 2] - 1.0).abs() < 1e-5);
-                } else if (4.1..5.9).contains(&hx) && (1.1..1.9).contains(&hy) {
-                    in_notch += 1;
-                    assert_eq!(material[i], BACKGROUND, "pixel ({x}, {y}) in the C's notch");
-                }
+    let size = scene.size.unwrap();
+    let g = scene.render_on(gpu, size).unwrap();
+    assert_eq!((g.width, g.height), size);
+    let Some(ChannelData::Uint(material)) = g.channel("material") else { panic!() };
+    let (normal, _) = floats(&g, "normal");
+    let (mut on_bar, mut in_notch) = (0, 0);
+    for y in 0..size.1 {
+        for x in 0..size.0 {
+            let d = camera.ray(x, y, size).unwrap();
+            let t = -camera.eye[2] / d[2];
+            let (hx, hy) = (camera.eye[0] + t * d[0], camera.eye[1] + t * d[1]);
+            let i = (y * size.0 + x) as usize;
+            if (3.1..5.9).contains(&hx) && (0.1..0.9).contains(&hy) {
+                on_bar += 1;
+                assert_eq!(material[i], 1, "pixel ({x}, {y}) on the C");
+                assert!((normal[3 * i + 2] - 1.0).abs() < 1e-5);
+            } else if (4.1..5.9).contains(&hx) && (1.1..1.9).contains(&hy) {
+                in_notch += 1;
+                assert_eq!(material[i], BACKGROUND, "pixel ({x}, {y}) in the C's notch");
             }
         }
-        assert!(on_bar > 10 && in_notch > 10, "{on_bar} {in_notch}");
-        // A camera looking straight along `up` is a typed error.
-        let mesh = scene.load_mesh().unwrap();
-        let bad = Camera { eye: [0.0, 5.0, 0.0], target: [0.0, 0.0, 0.0], up: [0.0, 1.0, 0.0], fov_y_degrees: 50.0 };
-        assert!(matches!(raster::rasterize(gpu, &mesh, &bad, (8, 8)), Err(RasterError::BadCamera(_))));
-        assert!(matches!(raster::rasterize(gpu, &mesh, &camera, (0, 8)), Err(RasterError::BadSize { .. })));
     }
+    assert!(on_bar > 10 && in_notch > 10, "{on_bar} {in_notch}");
+    // A camera looking straight along `up` is a typed error.
+    let mesh = scene.load_mesh().unwrap();
+    let bad = Camera { eye: [0.0, 5.0, 0.0], target: [0.0, 0.0, 0.0], up: [0.0, 1.0, 0.0], fov_y_degrees: 50.0 };
+    assert!(matches!(raster::rasterize(gpu, &mesh, &bad, (8, 8)), Err(RasterError::BadCamera(_))));
+    assert!(matches!(raster::rasterize(gpu, &mesh, &camera, (0, 8)), Err(RasterError::BadSize { .. })));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -558,9 +551,7 @@ show_checker = false
 /// bind it: the rig reaches the program, the shadow map agrees with the
 /// view's G-buffer, every mode with every predicate forced is bit-identical
 /// to the reference, and the adaptive modes stay close to it.
-#[test]
-fn sponza_lights_workload_matches_its_reference() {
-    let Some(gpu) = gpu() else { return };
+pub fn sponza_lights_workload_matches_its_reference(gpu: &Gpu) {
     let program = compile(include_str!("../../examples/sponza_lights.mrsl"));
     let mut scene = Scene::Sponza.mesh_scene(gpu).unwrap().expect("Sponza is a mesh scene");
     let channels = scene.gbuffer(gpu, &scene.camera, SIZE).unwrap();

@@ -23,10 +23,10 @@
 //! `r = f16(d)`, `g = f16(d - r)` — about 22 bits of precision instead of
 //! half's 11, which keeps the shadow bias at millimetres on Sponza.
 
-use crate::Shader;
 use crate::gpu::Gpu;
 use crate::mesh::{Bounds, length, normalize, sub};
 use crate::raster::{Camera, GpuMesh, RasterError, Rasterizer};
+use mrsl_runtime::Shader;
 
 /// A point light.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -132,19 +132,19 @@ impl LightRig {
 
     /// Sets the rig's uniforms that the shader's program declares (names
     /// above); arrays take as many lights as they hold. Returns the names set.
-    pub fn apply(&self, shader: &mut Shader) -> Result<Vec<String>, crate::Error> {
-        let declared: Vec<(String, String)> = shader
+    pub fn apply(&self, shader: &mut Shader) -> Result<Vec<String>, RigError> {
+        let declared: Vec<(String, mrsl_abi::ValueType)> = shader
             .layout()
             .uniforms
             .as_ref()
             .map(|u| u.fields.iter().map(|f| (f.name.clone(), f.ty.clone())).collect())
             .unwrap_or_default();
         let focal = 0.5 / (self.sun.camera.fov_y_degrees.to_radians() / 2.0).tan();
-        let view_proj = self.sun_view_proj().map_err(|e| crate::Error::Rig(e.to_string()))?;
+        let view_proj = self.sun_view_proj()?;
         let light_capacity = declared_capacity(shader, "light_pos").unwrap_or(self.lights.len());
         let mut set = vec![];
         for (name, ty) in declared {
-            let capacity = crate::components(&ty) / 4;
+            let capacity = ty.components() as usize / 4;
             let lights = || self.lights.iter().take(capacity);
             let values: Vec<f64> = match name.as_str() {
                 "light_pos" => lights().flat_map(|l| [l.position[0], l.position[1], l.position[2], l.range]).collect(),
@@ -163,7 +163,7 @@ impl LightRig {
             // Arrays larger than the rig: the rest stays zero (lights past light_count).
             let mut values = values;
             if name == "light_pos" || name == "light_color" {
-                values.resize(crate::components(&ty), 0.0);
+                values.resize(ty.components() as usize, 0.0);
             }
             shader.set_uniform(&name, &values)?;
             set.push(name);
@@ -208,10 +208,21 @@ impl LightRig {
     }
 }
 
+/// Why the rig's uniforms could not be set.
+#[derive(Debug, thiserror::Error)]
+pub enum RigError {
+    /// The sun's camera is degenerate.
+    #[error("the light rig cannot be used: {0}")]
+    Camera(#[from] RasterError),
+    /// The shader refused a value.
+    #[error(transparent)]
+    Uniform(#[from] mrsl_runtime::Error),
+}
+
 /// How many float4 elements the program's array uniform `name` holds.
 fn declared_capacity(shader: &Shader, name: &str) -> Option<usize> {
     let field = shader.layout().uniforms.as_ref()?.fields.iter().find(|f| f.name == name)?;
-    Some(crate::components(&field.ty) / 4)
+    Some(field.ty.components() as usize / 4)
 }
 
 #[cfg(test)]

@@ -17,11 +17,12 @@
 //! show_checker = true
 //! ```
 
+use crate::gbuffer::GBuffer;
 use crate::gpu::Gpu;
 use crate::mesh::{DEFAULT_CREASE_ANGLE, Mesh, MeshError};
 use crate::mesh_scene::MeshScene;
 use crate::raster::{Camera, RasterError};
-use crate::scene::{GBuffer, Scene};
+use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 

@@ -27,9 +27,9 @@
 //! Triangles are two-sided: a triangle seen from behind reports its normal
 //! flipped, so every normal in the G-buffer faces the camera.
 
+use crate::gbuffer::{BACKGROUND, ChannelData, GBuffer};
 use crate::gpu::Gpu;
 use crate::mesh::{Bounds, Mesh, MeshError, cross, dot, normalize, sub};
-use crate::scene::{BACKGROUND, ChannelData, GBuffer};
 use wgpu::util::DeviceExt;
 
 /// Channel names and formats, in the order [`Rasterizer::render`] returns them
@@ -58,7 +58,7 @@ pub enum RasterError {
     #[error("bad camera: {0}")]
     BadCamera(String),
     #[error(transparent)]
-    Gpu(#[from] crate::Error),
+    Gpu(#[from] crate::gpu::GpuError),
 }
 
 /// A camera's unit view direction, right axis and up axis.

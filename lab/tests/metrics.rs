@@ -1,8 +1,8 @@
-//! Tests of `mrsl_runtime::metrics`: fixtures with MSSIM, RMSE, PSNR and FLIP computed in Python (scikit-image, a
+//! Tests of `mrsl_lab::metrics`: fixtures with MSSIM, RMSE, PSNR and FLIP computed in Python (scikit-image, a
 //! transcription of Wang's `ssim_index.m`, NVIDIA's `flip_evaluator`; see `tests/data/gen_fixtures.py`), closed
 //! forms, symmetry and identity, and every error path.
 
-use mrsl_runtime::metrics::{self, Metrics, MetricsError};
+use mrsl_lab::metrics::{self, Metrics, MetricsError};
 use serde::Deserialize;
 use std::path::PathBuf;
 

@@ -44,7 +44,8 @@ pub enum MeshError {
     Empty { path: PathBuf },
     #[error(
         "the Dabrovic Sponza (tests/fixtures/sponza.obj of the crates.io package obj-rs 0.7.4) was not found; \
-         run `cargo fetch` in the workspace, or set MRSL_SPONZA to the file. Looked at: {}",
+         run `cargo fetch` in the workspace (mrslc finds it in cargo's registry), or set MRSL_SPONZA to the file. \
+         Looked at: {}",
         searched.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
     )]
     SponzaNotFound { searched: Vec<PathBuf> },
@@ -585,83 +586,42 @@ fn triangle_list(mode: gltf::mesh::Mode, raw: &[u32]) -> Vec<u32> {
     }
 }
 
-/// The path of the Dabrovic Sponza OBJ file: `$MRSL_SPONZA` if set, else
-/// the `obj-rs` 0.7.4 package as `cargo metadata` reports it for this
-/// workspace, else `$CARGO_HOME/registry/src/*/obj-rs-0.7.4/` (`CARGO_HOME`
-/// defaulting to `~/.cargo`). The answer is remembered.
-pub fn sponza_path() -> Result<PathBuf, MeshError> {
-    static FOUND: Mutex<Option<PathBuf>> = Mutex::new(None);
-    if let Some(p) = FOUND.lock().map(|g| g.clone()).unwrap_or(None) {
-        return Ok(p);
-    }
-    let mut searched = vec![];
-    let mut candidates: Vec<PathBuf> = vec![];
-    if let Some(p) = std::env::var_os("MRSL_SPONZA") {
-        candidates.push(PathBuf::from(p));
-    }
-    let mut found = candidates.iter().find(|p| p.is_file()).cloned();
-    searched.extend(candidates);
-    if found.is_none() {
-        match sponza_from_cargo_metadata() {
-            Some(p) if p.is_file() => found = Some(p),
-            Some(p) => searched.push(p),
-            None => searched.push(PathBuf::from("(cargo metadata found no obj-rs 0.7.4)")),
-        }
-    }
-    if found.is_none() {
-        let home = std::env::var_os("CARGO_HOME")
-            .map(PathBuf::from)
-            .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cargo")));
-        if let Some(home) = home {
-            let src = home.join("registry").join("src");
-            let mut registries: Vec<PathBuf> = std::fs::read_dir(&src)
-                .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
-                .unwrap_or_default();
-            registries.sort();
-            for r in registries {
-                let p = r.join(format!("{SPONZA_PACKAGE}-{SPONZA_VERSION}")).join(SPONZA_IN_PACKAGE);
-                if p.is_file() {
-                    found = Some(p);
-                    break;
-                }
-            }
-            if found.is_none() {
-                searched.push(src.join("*").join(format!("{SPONZA_PACKAGE}-{SPONZA_VERSION}")).join(SPONZA_IN_PACKAGE));
-            }
-        }
-    }
-    match found {
-        Some(p) => {
-            if let Ok(mut g) = FOUND.lock() {
-                *g = Some(p.clone());
-            }
-            Ok(p)
-        }
-        None => Err(MeshError::SponzaNotFound { searched }),
-    }
+/// The Sponza path the application chose ([`set_sponza_path`]).
+static SPONZA_PATH: Mutex<Option<PathBuf>> = Mutex::new(None);
+
+/// Tells [`sponza_path`] where the Dabrovic Sponza OBJ file is. The library
+/// does not go looking for it: the command-line tool and the tests find it
+/// in cargo's registry ([`find_sponza_in_cargo_home`]) and say so here.
+pub fn set_sponza_path(path: PathBuf) {
+    *SPONZA_PATH.lock().unwrap_or_else(|e| e.into_inner()) = Some(path);
 }
 
-/// Asks `cargo metadata` where `obj-rs` 0.7.4 is, for the workspace this
-/// crate was built in (or the current directory's).
-fn sponza_from_cargo_metadata() -> Option<PathBuf> {
-    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-    let mut command = std::process::Command::new(cargo);
-    command.args(["metadata", "--format-version", "1"]);
-    let manifest = Path::new(env!("CARGO_MANIFEST_DIR")).join("Cargo.toml");
-    if manifest.is_file() {
-        command.arg("--manifest-path").arg(manifest);
+/// The path of the Dabrovic Sponza OBJ file: the one given to
+/// [`set_sponza_path`], else `$MRSL_SPONZA`.
+pub fn sponza_path() -> Result<PathBuf, MeshError> {
+    let mut searched = vec![];
+    let chosen = SPONZA_PATH.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    for candidate in chosen.into_iter().chain(std::env::var_os("MRSL_SPONZA").map(PathBuf::from)) {
+        if candidate.is_file() {
+            return Ok(candidate);
+        }
+        searched.push(candidate);
     }
-    let output = command.stderr(std::process::Stdio::null()).output().ok()?;
-    if !output.status.success() {
-        return None;
-    }
-    let json: serde_json::Value = serde_json::from_slice(&output.stdout).ok()?;
-    let package = json["packages"]
-        .as_array()?
-        .iter()
-        .find(|p| p["name"].as_str() == Some(SPONZA_PACKAGE) && p["version"].as_str() == Some(SPONZA_VERSION))?;
-    let manifest = PathBuf::from(package["manifest_path"].as_str()?);
-    Some(manifest.parent()?.join(SPONZA_IN_PACKAGE))
+    Err(MeshError::SponzaNotFound { searched })
+}
+
+/// Where cargo unpacked `obj-rs` 0.7.4's Sponza under `cargo_home`
+/// (`$CARGO_HOME`, by default `~/.cargo`): `registry/src/*/obj-rs-0.7.4/tests/fixtures/sponza.obj`.
+/// Building this crate makes cargo download and unpack that package.
+pub fn find_sponza_in_cargo_home(cargo_home: &Path) -> Option<PathBuf> {
+    let mut registries: Vec<PathBuf> = std::fs::read_dir(cargo_home.join("registry").join("src"))
+        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    registries.sort();
+    registries
+        .into_iter()
+        .map(|r| r.join(format!("{SPONZA_PACKAGE}-{SPONZA_VERSION}")).join(SPONZA_IN_PACKAGE))
+        .find(|p| p.is_file())
 }
 
 /// The Sponza mesh, loaded once per process and shared.

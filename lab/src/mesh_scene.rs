@@ -5,8 +5,9 @@
 use crate::gpu::Gpu;
 use crate::mesh::Mesh;
 use crate::raster::{Camera, GpuMesh, RasterError, Rasterizer};
-use crate::rig::{DEFAULT_LIGHTS, DEFAULT_SHADOW_MAP_SIZE, LightRig};
-use crate::{Error, Shader};
+use crate::rig::{DEFAULT_LIGHTS, DEFAULT_SHADOW_MAP_SIZE, LightRig, RigError};
+use mrsl_abi::{Scalar, ValueType};
+use mrsl_runtime::Shader;
 
 /// A mesh scene ready to render.
 pub struct MeshScene {
@@ -49,13 +50,11 @@ impl MeshScene {
     /// Sets what the scene provides among the uniforms the program declares:
     /// the rig's (see [`crate::rig`]) and `camera_pos` (a `float3`: the eye of
     /// `camera`). Returns the names set.
-    pub fn set_uniforms(&self, shader: &mut Shader, camera: &Camera) -> Result<Vec<String>, Error> {
+    pub fn set_uniforms(&self, shader: &mut Shader, camera: &Camera) -> Result<Vec<String>, RigError> {
         let mut set = self.rig.apply(shader)?;
-        let has_camera_pos = shader
-            .layout()
-            .uniforms
-            .as_ref()
-            .is_some_and(|u| u.fields.iter().any(|f| f.name == "camera_pos" && f.ty == "float3"));
+        let has_camera_pos = shader.layout().uniforms.as_ref().is_some_and(|u| {
+            u.fields.iter().any(|f| f.name == "camera_pos" && f.ty == ValueType::Vector(Scalar::Float, 3))
+        });
         if has_camera_pos {
             shader.set_uniform("camera_pos", &camera.eye.map(f64::from))?;
             set.push("camera_pos".into());

@@ -10,37 +10,16 @@
 //! [`crate::raster`]: build it with [`Scene::render_on`] or
 //! [`Scene::textures_on`]. See docs/scenes.md.
 
+pub use crate::gbuffer::{BACKGROUND, ChannelData, GBuffer};
 use crate::gpu::Gpu;
 use crate::mesh::MeshError;
 use crate::mesh_scene::MeshScene;
 use crate::raster::{Camera, RasterError};
 
-/// Material id of background pixels.
-pub const BACKGROUND: u32 = 255;
-
 // Sponza's default camera (see `Scene::sponza_camera`).
 const SPONZA_EYE: [f32; 3] = [-11.5, 2.2, -0.3];
 const SPONZA_TARGET: [f32; 3] = [10.0, 4.5, 0.4];
 const SPONZA_FOV: f32 = 60.0;
-
-/// The data of one channel, row-major, top row first.
-#[derive(Debug, Clone, PartialEq)]
-pub enum ChannelData {
-    /// `components` floats per pixel (1 to 4).
-    Float {
-        components: u32,
-        data: Vec<f32>,
-    },
-    Uint(Vec<u32>),
-}
-
-/// A G-buffer in CPU memory.
-#[derive(Debug, Clone, PartialEq)]
-pub struct GBuffer {
-    pub width: u32,
-    pub height: u32,
-    pub channels: Vec<(String, ChannelData)>,
-}
 
 /// Which synthetic scene to make.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,6 +1,17 @@
 //! Device acquisition for tools and tests, and texture upload/readback helpers.
 
-use crate::error::Error;
+/// Why no device could be had, or a readback failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GpuError {
+    #[error("no adapter: {0}")]
+    NoAdapter(String),
+    #[error("device request failed: {0}")]
+    Device(String),
+    #[error("reading results back failed: {0}")]
+    Readback(String),
+}
+
+use GpuError as Error;
 
 /// A headless device: the first adapter wgpu finds (lavapipe on a machine
 /// without a GPU), with timestamp queries when the adapter has them.
