@@ -1,7 +1,7 @@
 //! The coarse-to-fine interface on cases whose optimum is known by hand.
 
 use crate::compile_ok;
-use mrsl::layout::Layout;
+use mrsl::Layout;
 
 /// Slots as sorted lists of effect names, and the record's total value words.
 fn slots(layout: &Layout) -> (Vec<Vec<String>>, u32) {
