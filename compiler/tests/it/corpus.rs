@@ -1,9 +1,9 @@
 //! Data-driven tests: every program under `tests/data/ok` must compile without
-//! errors, every program under `tests/data/err` must fail with at least one
-//! error. Snapshots hold the source together with the result (layout and
-//! kernels, or the rendered diagnostics); every kernel is validated by naga.
+//! errors to the full default kernel table, every program under `tests/data/err`
+//! must fail with at least one error. Snapshots hold the source together with
+//! the result (the layout and every kernel, or the rendered diagnostics).
 
-use mrsl::{KernelKind, Options, Severity};
+use mrsl::{Options, Severity};
 use std::fmt::Write;
 
 fn source_of(path: &std::path::Path) -> String {
@@ -26,17 +26,7 @@ fn ok_programs() {
         };
         let expects_warning = source.contains("expect-warning:");
         assert_eq!(!program.warnings.is_empty(), expects_warning, "{name}: warnings are {:?}", program.warnings);
-        // Every kernel, for both block sizes, is valid WGSL by naga's validator.
-        for kernel in &program.kernels {
-            if let Err(e) = mrsl::validate_wgsl(&kernel.wgsl) {
-                panic!("{name}: {:?} kernel fails naga validation:\n{e}", kernel.kind);
-            }
-        }
-        assert_eq!(
-            program.kernels.len(),
-            9,
-            "coarse+fine for 2x2 and 4x4, reference, two dynamic-mode kernels, hierarchical, checkerboard"
-        );
+        crate::assert_kernel_table(&name, &program);
         let mut snapshot = String::new();
         writeln!(snapshot, "----- SOURCE\n{}", source.trim_end()).unwrap();
         if !program.warnings.is_empty() {
@@ -44,9 +34,10 @@ fn ok_programs() {
                 .unwrap();
         }
         writeln!(snapshot, "----- LAYOUT\n{}", serde_json::to_string_pretty(&program.layout).unwrap()).unwrap();
-        for (kind, block) in [(KernelKind::Coarse, 4), (KernelKind::Fine, 4), (KernelKind::Reference, 1)] {
-            let kernel = program.kernel(kind, block).expect("kernel generated");
-            writeln!(snapshot, "----- {} KERNEL\n{}", kind.name().to_uppercase(), kernel.wgsl.trim_end()).unwrap();
+        for kernel in &program.kernels {
+            let block = kernel.block_size.map(|b| format!(" b{b}")).unwrap_or_default();
+            writeln!(snapshot, "----- {}{block} KERNEL\n{}", kernel.kind.name().to_uppercase(), kernel.wgsl.trim_end())
+                .unwrap();
         }
         insta::assert_snapshot!(snapshot);
     });
