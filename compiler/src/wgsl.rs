@@ -11,10 +11,10 @@ use crate::deriv::{DerivInfo, visit_expr, visit_stmt_exprs};
 use crate::graph::EffectGraph;
 use crate::interface::Interface;
 use crate::layout;
-use mrsl_abi::geometry::TILE;
-use mrsl_abi::{CONTROL_FIELDS, Layout, entry};
 use crate::syntax::ast::*;
 use crate::types::{Scalar, Type};
+use mrsl_abi::geometry::TILE;
+use mrsl_abi::{CONTROL_FIELDS, Layout, entry};
 use std::collections::{BTreeSet, HashMap};
 
 pub use mrsl_abi::KernelKind;
@@ -51,7 +51,6 @@ pub fn write_string(inputs: &Inputs, kind: KernelKind, block: u32) -> String {
     w.module();
     w.out
 }
-
 
 /// Renames user identifiers that collide with WGSL keywords, WGSL builtins or
 /// the generated `mrsl_` namespace, so source names survive everywhere else.
@@ -982,7 +981,10 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         let iface = self.i.interface;
         let [wx, wy, wz] = self.kind.workgroup_size();
         self.line(0, format!("@compute @workgroup_size({wx}, {wy}, {wz})"));
-        self.line(0, format!("fn {}(@builtin(global_invocation_id) mrsl_gid: vec3<u32>) {{", self.kind.main_entry_point()));
+        self.line(
+            0,
+            format!("fn {}(@builtin(global_invocation_id) mrsl_gid: vec3<u32>) {{", self.kind.main_entry_point()),
+        );
         self.line(1, "let mrsl_n = mrsl_grid();");
         self.line(1, "if (mrsl_gid.x >= u32(mrsl_n.x) || mrsl_gid.y >= u32(mrsl_n.y)) { return; }");
         self.line(1, "let mrsl_pos = vec2<i32>(mrsl_gid.xy);");

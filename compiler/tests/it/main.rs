@@ -1,5 +1,6 @@
 //! The compiler's integration tests, in one binary (see tests/README.md).
 
+mod contract;
 mod corpus;
 mod examples;
 mod fuzz;

@@ -1,0 +1,75 @@
+//! The compiler–runtime contract round-trips: what `mrslc compile -o DIR`
+//! writes (kernels and `STEM.layout.json`) reads back as the very program
+//! the compiler produced, and a layout of another format version or with an
+//! unknown format name is refused instead of being guessed at.
+
+use mrsl::{CompiledProgram, Layout, Options};
+use std::path::PathBuf;
+
+fn examples() -> Vec<(String, String)> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples");
+    let mut out: Vec<(String, String)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "mrsl"))
+        .map(|p| (p.file_stem().unwrap().to_string_lossy().into_owned(), std::fs::read_to_string(&p).unwrap()))
+        .collect();
+    out.sort();
+    out
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mrsl-contract-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn compiled_programs_read_back_from_their_files_unchanged() {
+    let examples = examples();
+    assert!(examples.len() >= 6);
+    for (stem, source) in &examples {
+        let program = mrsl::compile(source, &Options::default()).unwrap();
+        let dir = temp_dir(stem);
+        let written = program.compiled.write_dir(&dir, stem).unwrap();
+        assert_eq!(written.len(), program.kernels.len() + 1, "{stem}: a file per kernel and the layout");
+        // The layout alone, from its JSON text.
+        let json = std::fs::read_to_string(dir.join(format!("{stem}.layout.json"))).unwrap();
+        assert_eq!(Layout::from_json(&json).unwrap(), program.layout, "{stem}: layout JSON round trip");
+        // The whole program, with the stem found or named.
+        assert_eq!(CompiledProgram::read_dir(&dir, None).unwrap(), program.compiled, "{stem}");
+        assert_eq!(CompiledProgram::read_dir(&dir, Some(stem)).unwrap(), program.compiled, "{stem}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
+#[test]
+fn foreign_or_broken_layouts_are_refused() {
+    let program = mrsl::compile(&examples()[0].1, &Options::default()).unwrap();
+    let json = program.layout.to_json();
+    let other_version = json.replacen("mrsl-layout/1", "mrsl-layout/2", 1);
+    let message = Layout::from_json(&other_version).unwrap_err();
+    assert!(message.contains("mrsl-layout/2") && message.contains("mrsl-layout/1"), "{message}");
+    // A format the runtime could only guess at is an error, not rgba32float.
+    let first_format = program.layout.channels[0].format.name();
+    let bad_format = json.replacen(&format!("\"format\": \"{first_format}\""), "\"format\": \"bgra8unorm\"", 1);
+    assert_ne!(bad_format, json);
+    assert!(Layout::from_json(&bad_format).unwrap_err().contains("bgra8unorm"));
+    let bad_type = json.replacen("\"type\": \"float3\"", "\"type\": \"vec3\"", 1);
+    assert_ne!(bad_type, json);
+    assert!(Layout::from_json(&bad_type).unwrap_err().contains("vec3"));
+
+    // A directory without a program, and one with two, say so.
+    let dir = temp_dir("empty");
+    let err = CompiledProgram::read_dir(&dir, None).unwrap_err();
+    assert!(err.to_string().contains("mrslc compile"), "{err}");
+    program.compiled.write_dir(&dir, "a").unwrap();
+    program.compiled.write_dir(&dir, "b").unwrap();
+    let err = CompiledProgram::read_dir(&dir, None).unwrap_err();
+    assert!(err.to_string().contains("a, b"), "{err}");
+    std::fs::write(dir.join("c.layout.json"), "{}").unwrap();
+    let err = CompiledProgram::read_dir(&dir, Some("c")).unwrap_err();
+    assert!(err.to_string().contains("no `format` field"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
