@@ -446,10 +446,15 @@ impl Shader {
             bindings.outputs.iter().map(|(k, t)| (k.as_str(), t.create_view(&Default::default()))).collect();
         encoder.clear_buffer(&self.stats, 0, None);
         let tiles = geometry::pixel_workgroups(bindings.size);
-        if mode == Mode::Hierarchical {
-            self.encode_hierarchical(device, encoder, bindings, &resources, &gbuffer, &views);
-        } else if mode == Mode::Checkerboard {
-            self.encode_checkerboard(device, encoder, bindings, &resources, &gbuffer, &views);
+        if matches!(mode, Mode::Hierarchical | Mode::Checkerboard) {
+            let kind = mode.kernels()[0].0;
+            let stage = self.record_stage(device, kind, bindings.size, &views);
+            let groups = [&resources, &gbuffer, &stage];
+            if kind == KernelKind::Hierarchical {
+                self.hierarchical_passes(device, encoder, bindings.size, &groups);
+            } else {
+                self.checkerboard_passes(encoder, bindings.size, &groups);
+            }
         } else {
             match mode.block_size() {
                 None => {
@@ -523,16 +528,13 @@ impl Shader {
 
     /// The hierarchical mode: level 0, then per level classify, args and an
     /// indirect shade over the compacted work list, then the final per-pixel pass.
-    fn encode_hierarchical(
-        &mut self,
+    fn hierarchical_passes(
+        &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        bindings: &Bindings,
-        resources: &wgpu::BindGroup,
-        gbuffer: &wgpu::BindGroup,
-        views: &HashMap<&str, wgpu::TextureView>,
+        size: (u32, u32),
+        groups: &[&wgpu::BindGroup; 3],
     ) {
-        let stage = self.record_stage(device, KernelKind::Hierarchical, bindings.size, views);
         let (buffers, _) = self.hier_buffers.as_ref().expect("created by record_stage");
         encoder.clear_buffer(&buffers.queue, 0, None);
         let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -540,10 +542,9 @@ impl Shader {
             layout: &self.args_group_layout,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffers.args.as_entire_binding() }],
         });
-        let size = bindings.size;
         let pipeline = |name: &'static str| &self.pipelines[&(KernelKind::Hierarchical, None, name)];
         {
-            let mut pass = self.begin_pass(encoder, "mrsl hierarchical levels", 1, &[resources, gbuffer, &stage]);
+            let mut pass = self.begin_pass(encoder, "mrsl hierarchical levels", 1, groups);
             let (gx, gy) = HIERARCHICAL_LEVEL0.workgroups(size);
             pass.set_pipeline(pipeline(entry::HIER_LEVEL0));
             pass.dispatch_workgroups(gx, gy, 1);
@@ -559,7 +560,7 @@ impl Shader {
             }
         }
         {
-            let mut pass = self.begin_pass(encoder, "mrsl hierarchical final", 2, &[resources, gbuffer, &stage]);
+            let mut pass = self.begin_pass(encoder, "mrsl hierarchical final", 2, groups);
             pass.set_pipeline(pipeline(entry::HIER_FINAL));
             let (gx, gy) = geometry::pixel_workgroups(size);
             pass.dispatch_workgroups(gx, gy, 1);
@@ -569,23 +570,19 @@ impl Shader {
 
     /// The checkerboard baseline: shade the coarse effects in half the quads,
     /// then reconstruct and finish every pixel.
-    fn encode_checkerboard(
-        &mut self,
-        device: &wgpu::Device,
+    fn checkerboard_passes(
+        &self,
         encoder: &mut wgpu::CommandEncoder,
-        bindings: &Bindings,
-        resources: &wgpu::BindGroup,
-        gbuffer: &wgpu::BindGroup,
-        views: &HashMap<&str, wgpu::TextureView>,
+        size: (u32, u32),
+        groups: &[&wgpu::BindGroup; 3],
     ) {
-        let stage = self.record_stage(device, KernelKind::Checkerboard, bindings.size, views);
         let pipeline = |name: &'static str| &self.pipelines[&(KernelKind::Checkerboard, None, name)];
-        let mut pass = self.begin_pass(encoder, "mrsl checkerboard", 1, &[resources, gbuffer, &stage]);
-        let (gx, gy) = geometry::checkerboard_workgroups(bindings.size, self.forced);
+        let mut pass = self.begin_pass(encoder, "mrsl checkerboard", 1, groups);
+        let (gx, gy) = geometry::checkerboard_workgroups(size, self.forced);
         pass.set_pipeline(pipeline(entry::CB_SHADE));
         pass.dispatch_workgroups(gx, gy, 1);
         pass.set_pipeline(pipeline(entry::CB_FINAL));
-        let (gx, gy) = geometry::pixel_workgroups(bindings.size);
+        let (gx, gy) = geometry::pixel_workgroups(size);
         pass.dispatch_workgroups(gx, gy, 1);
     }
 
