@@ -36,6 +36,8 @@ impl Key<'_> {
         self.compare(a, b, false)
     }
 
+    /// The one comparison of key values: exact (`any` over vector components)
+    /// or by distance against the key's threshold, in either sense.
     fn compare(&self, a: &str, b: &str, differs: bool) -> String {
         let (equal, reduce, close) = if differs { ("!=", "any", ">") } else { ("==", "all", "<=") };
         let test = match self.compare {
@@ -47,7 +49,7 @@ impl Key<'_> {
     }
 }
 
-impl<'a, 'b> Writer<'_, 'a, 'b> {
+impl<'b> Writer<'_, '_, 'b> {
     /// The program's discontinuity keys, in declaration order.
     pub(super) fn keys(&self) -> Vec<Key<'b>> {
         let c = self.checked();
@@ -57,6 +59,9 @@ impl<'a, 'b> Writer<'_, 'a, 'b> {
             .collect()
     }
 
+    /// Every binding the kernel uses, where the layout puts it: the control
+    /// block, user uniforms, textures and samplers, the G-buffer channels,
+    /// then the stage's buffers (per kernel family), statistics and outputs.
     pub(super) fn bindings(&mut self) {
         let l = self.i.layout;
         let [control, user, channels, stage, end] =
@@ -122,6 +127,9 @@ impl<'a, 'b> Writer<'_, 'a, 'b> {
         self.template(0, end, &[]);
     }
 
+    /// `mrsl_grid` (the positions of this kernel), `mrsl_pixel` (where a
+    /// position loads its inputs) and `mrsl_pair_x` / `mrsl_pair_y` (a
+    /// position's quad, which derivatives difference across).
     pub(super) fn position_helpers(&mut self) {
         let (grid, pixel) = if self.kind.is_coarse() {
             (
@@ -134,6 +142,7 @@ impl<'a, 'b> Writer<'_, 'a, 'b> {
         self.template(0, include_str!("templates/positions.wgsl"), &[("GRID", &grid), ("PIXEL", &pixel)]);
     }
 
+    /// `mrsl_load_<input>(pos)`: a G-buffer channel at a position's pixel.
     pub(super) fn input_loaders(&mut self) {
         for input in &self.checked().inputs {
             let swizzle = match input.ty.components() {
@@ -185,6 +194,8 @@ impl<'a, 'b> Writer<'_, 'a, 'b> {
         read
     }
 
+    /// `mrsl_eval_<effect>`: the effect's body at `mrsl_pos`, given its
+    /// dependencies' values (and a refine flag to set, if it can refine).
     pub(super) fn eval_function(&mut self, e: EffectId) {
         let c = self.checked();
         let info = &c.effects[e.index()];
@@ -318,9 +329,9 @@ impl<'a, 'b> Writer<'_, 'a, 'b> {
         args.extend(self.deps_params(e).into_iter().map(|d| self.effect_name(d)));
         self.line(indent, format!("{declare}{} = mrsl_eval_{}({});", self.effect_name(e), info.name, args.join(", ")));
     }
-}
 
-impl Writer<'_, '_, '_> {
+    // ---- Refine flags ----------------------------------------------------------------
+
     /// Declares the refine flag words `mrsl_flags<w>`, all clear.
     pub(super) fn declare_flag_words(&mut self, words: u32) {
         for w in 0..words {

@@ -67,12 +67,15 @@ fn lattice_pixel(lattice: Lattice) -> String {
     }
 }
 
-/// `x, y, 1`: the workgroup of the entry points dispatched over a lattice.
+/// The workgroup size of the entry points dispatched over a lattice (see
+/// [`Lattice::workgroups`]).
 fn lattice_workgroup() -> String {
     format!("{COARSE_WORKGROUP}, {COARSE_WORKGROUP}, 1")
 }
 
 impl Writer<'_, '_, '_> {
+    /// The records, the work lists, the per-level queue counters and (in a
+    /// group of their own) the indirect dispatch arguments.
     pub(super) fn hierarchical_bindings(&mut self) {
         let l = self.i.layout;
         let h = &l.hierarchical;
@@ -89,6 +92,7 @@ impl Writer<'_, '_, '_> {
         );
     }
 
+    /// Every entry point, in dispatch order, after the helpers they share.
     pub(super) fn hierarchical_entries(&mut self) {
         self.record_helpers();
         self.work_lists();
@@ -96,6 +100,8 @@ impl Writer<'_, '_, '_> {
         self.level0();
         self.classify_function();
         for (index, (lattice, level)) in HIERARCHICAL_LEVELS.iter().zip(classified_levels()).enumerate() {
+            // The level's words in the queue (its count first) and in the
+            // indirect arguments (x, y, z).
             let queue = (index as u32 + 1) * QUEUE_WORDS_PER_LEVEL;
             let neighbours = neighbours(level.neighbours);
             let valid = if level.odd_only { "((gid.x + gid.y) & 1u) == 1u" } else { "true" };

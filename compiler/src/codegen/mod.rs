@@ -62,7 +62,7 @@ use crate::graph::EffectGraph;
 use crate::interface::Interface;
 use crate::syntax::ast::{Rate, Span};
 use body::{Mode, wgsl_ident};
-use mrsl_abi::geometry::{DYNAMIC_INNER_BLOCK, DYNAMIC_OUTER_BLOCK, DYNAMIC_TAG_WORDS};
+use mrsl_abi::geometry::{DYNAMIC_INNER_BLOCK, DYNAMIC_OUTER_BLOCK, DYNAMIC_TAG_WORDS, HIERARCHICAL_LEVEL0};
 use mrsl_abi::{KernelKind, Layout};
 use std::collections::HashMap;
 use writer::{Code, Values};
@@ -210,9 +210,10 @@ fn describe(kind: KernelKind, block: u32) -> String {
         KernelKind::DynamicFine => {
             format!("dynamic mode, fine kernel: {outer}x{outer}, then {inner}x{inner}, then per pixel")
         }
-        KernelKind::Hierarchical => {
-            "hierarchical (DACS) mode: every 4th pixel, then four levels interpolated or shaded".to_string()
-        }
+        KernelKind::Hierarchical => format!(
+            "hierarchical (DACS) mode: every {}th pixel, then four levels interpolated or shaded",
+            HIERARCHICAL_LEVEL0.step
+        ),
         KernelKind::Checkerboard => {
             "checkerboard baseline: half the 2x2 quads shaded, the rest reconstructed".to_string()
         }

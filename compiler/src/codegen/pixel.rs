@@ -6,7 +6,7 @@
 use super::Writer;
 use crate::check::EffectId;
 use crate::syntax::ast::Rate;
-use crate::types::Type;
+use crate::types::{Scalar, Type};
 use mrsl_abi::KernelKind;
 use mrsl_abi::geometry::{PIXEL_WORKGROUP, TILE};
 
@@ -20,6 +20,7 @@ impl Writer<'_, '_, '_> {
         per_pixel_reuse && !self.coarse_live().is_empty()
     }
 
+    /// The statistics counters (global and per workgroup) and the rate image.
     pub(super) fn stats_bindings(&mut self) {
         let l = self.i.layout;
         self.template(
@@ -124,8 +125,8 @@ impl Writer<'_, '_, '_> {
 /// Widens an output value to the `vec4` that `textureStore` takes.
 fn to_vec4(value: &str, ty: &Type) -> String {
     let (s, one) = match ty.scalar() {
-        Some(crate::types::Scalar::Uint) => ("u32", "1u"),
-        Some(crate::types::Scalar::Int) => ("i32", "1i"),
+        Some(Scalar::Uint) => ("u32", "1u"),
+        Some(Scalar::Int) => ("i32", "1i"),
         _ => ("f32", "1.0"),
     };
     match ty.components() {

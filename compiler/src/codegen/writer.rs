@@ -7,7 +7,7 @@
 //! `include_str!`), so that it reads as WGSL rather than as Rust strings. A
 //! template is written verbatim: every line with the indentation it has in
 //! the file (plus that of the level it is written at), blank lines included,
-//! and nothing else. Two marks, both impossible in WGSL, make it a template:
+//! and nothing else. Two marks that generated WGSL never uses make it a template:
 //!
 //! - `{{NAME}}` inside a line is a *placeholder*, replaced by the value the
 //!   caller gives for `NAME`: a number, a name or an expression, never text
@@ -17,10 +17,11 @@
 //! - A line holding only `{{#NAME}}` (indented or not) is a *hole*: [`cut`]
 //!   splits the template there into sections, and the generator writes the
 //!   lines that depend on the program (one per effect, per key, per flag
-//!   word) between them. The name says what goes there.
+//!   word) between them. The name says what goes there. Sections may also
+//!   be alternatives, of which the generator writes one.
 //!
-//! Either mistake (a missing value, a hole of another name) panics the first
-//! time the template is written, which the tests of every kernel kind do.
+//! Either mistake (a missing value, a hole of another name) panics where the
+//! template is written, so compiling the test corpus finds it.
 
 use std::fmt::{Display, Write};
 
