@@ -287,12 +287,12 @@ impl Writer<'_, '_, '_> {
     /// A coarse effect in a fine kernel: evaluated where it is refined,
     /// resampled elsewhere (when it is passed).
     pub(super) fn resolved_coarse_value(&mut self, e: EffectId, indent: usize) {
-        if self.kind == KernelKind::DynamicFine {
-            return self.dynamic_coarse_value(e, indent);
-        }
         let info = &self.checked().effects[e.index()];
         let (index, name) = (self.coarse_index[&e], self.effect_name(e));
         self.line(indent, format!("var {name}: {};", info.ty.wgsl()));
+        if self.kind == KernelKind::DynamicFine {
+            return self.dynamic_coarse_value(e, indent);
+        }
         self.line(indent, format!("if (mrsl_is_refined(mrsl_b, {index}u)) {{"));
         self.evaluate(e, indent + 1, "");
         if self.i.interface.is_passed(e) {

@@ -22,7 +22,8 @@ impl Level {
 }
 
 impl Writer<'_, '_, '_> {
-    /// `dynamic_coarse_main` reads the outer level and writes the inner one.
+    /// `dynamic_coarse_main` reads the outer level, writes the inner one and
+    /// counts the samples it shades.
     pub(super) fn dynamic_coarse_bindings(&mut self) {
         let l = self.i.layout;
         self.template(
@@ -33,10 +34,10 @@ impl Writer<'_, '_, '_> {
                 ("PARENT_BINDING", &l.interface.binding),
                 ("GROUP", &l.interface2.group),
                 ("BINDING", &l.interface2.binding),
-                ("STATS_GROUP", &l.stats.group),
-                ("STATS_BINDING", &l.stats.binding),
             ],
         );
+        // The count of shaded samples (the last counter).
+        self.stats_buffer();
     }
 
     /// `dynamic_fine_main` also reads the inner level.
@@ -113,13 +114,12 @@ impl Writer<'_, '_, '_> {
         self.template(indent, include_str!("templates/resolve_inner.wgsl"), &[]);
     }
 
-    /// A coarse effect in `dynamic_fine_main`: resampled from the outer level
-    /// unless refined there, else from the inner level unless refined there,
-    /// else evaluated.
+    /// A coarse effect in `dynamic_fine_main`, into its declared variable:
+    /// resampled from the outer level unless refined there, else from the
+    /// inner level unless refined there, else evaluated.
     pub(super) fn dynamic_coarse_value(&mut self, e: EffectId, indent: usize) {
         let info = &self.checked().effects[e.index()];
         let (index, name) = (self.coarse_index[&e], self.effect_name(e));
-        self.line(indent, format!("var {name}: {};", info.ty.wgsl()));
         if self.i.interface.is_passed(e) {
             self.line(indent, format!("if (!mrsl_is_refined(mrsl_b, {index}u)) {{"));
             self.line(indent + 1, format!("{name} = mrsl_resample_{}(mrsl_b);", info.name));

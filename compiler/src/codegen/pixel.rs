@@ -4,6 +4,7 @@
 //! stores, and the per-workgroup statistics that must all reach a barrier.
 
 use super::Writer;
+use super::writer::cut;
 use crate::check::EffectId;
 use crate::syntax::ast::Rate;
 use crate::types::{Scalar, Type};
@@ -23,16 +24,27 @@ impl Writer<'_, '_, '_> {
     /// The statistics counters (global and per workgroup) and the rate image.
     pub(super) fn stats_bindings(&mut self) {
         let l = self.i.layout;
+        let [head, tail] = cut(include_str!("templates/stats.wgsl"), &["BUFFER"]);
+        self.template(0, head, &[]);
+        self.stats_buffer();
         self.template(
             0,
-            include_str!("templates/stats.wgsl"),
+            tail,
             &[
-                ("STATS_GROUP", &l.stats.group),
-                ("STATS_BINDING", &l.stats.binding),
                 ("COUNTERS", &self.coarse_live().len()),
                 ("RATE_GROUP", &l.rate_image.group),
                 ("RATE_BINDING", &l.rate_image.binding),
             ],
+        );
+    }
+
+    /// The global statistics counters (layout `stats`).
+    pub(super) fn stats_buffer(&mut self) {
+        let stats = &self.i.layout.stats;
+        self.template(
+            0,
+            include_str!("templates/stats_buffer.wgsl"),
+            &[("GROUP", &stats.group), ("BINDING", &stats.binding)],
         );
     }
 
