@@ -20,6 +20,17 @@ pub const WORK_LIST_WORKGROUP: u32 = 64;
 /// Checkerboard `cb_shade`: shaded 2x2 quads per workgroup, along a row of quads.
 pub const CHECKERBOARD_QUADS_PER_WORKGROUP: u32 = 16;
 
+/// Block size of the dynamic mode's first level: the ordinary coarse kernel of this block size.
+pub const DYNAMIC_OUTER_BLOCK: u32 = 4;
+
+/// Block size of the dynamic mode's second level (`dynamic_coarse_main`), shaded
+/// only inside refined [`DYNAMIC_OUTER_BLOCK`] blocks.
+pub const DYNAMIC_INNER_BLOCK: u32 = 2;
+
+/// Words after each record of the dynamic mode's second level: a validity tag,
+/// so its interface records are `stride_words + DYNAMIC_TAG_WORDS` words.
+pub const DYNAMIC_TAG_WORDS: u32 = 1;
+
 /// Words per level in the hierarchical queue and indirect-argument buffers:
 /// the queue's first word counts queued pixels; the arguments are x, y, z, unused.
 pub const QUEUE_WORDS_PER_LEVEL: u32 = 4;

@@ -27,6 +27,7 @@
 //! The crate does no I/O and touches no GPU: everything here runs anywhere.
 
 pub mod check;
+mod codegen;
 pub mod deriv;
 pub mod diagnostic;
 pub mod graph;
@@ -34,7 +35,6 @@ pub mod interface;
 pub mod layout;
 pub mod syntax;
 pub mod types;
-pub mod wgsl;
 
 pub use diagnostic::{Diagnostic, Label, Severity, render_all};
 pub use mrsl_abi::{CompiledProgram, Kernel, KernelKind, Layout};
@@ -123,7 +123,7 @@ fn generate(
 ) -> Result<Program, Vec<Diagnostic>> {
     let interface = interface::allocate(checked, graph);
     let layout = layout::build(checked, graph, &interface);
-    let inputs = wgsl::Inputs {
+    let inputs = codegen::Inputs {
         checked,
         graph,
         interface: &interface,
@@ -161,7 +161,7 @@ fn generate(
     }
     let texts: Vec<(KernelKind, Option<u32>, String)> = wanted
         .into_iter()
-        .map(|(kind, block)| (kind, block, wgsl::write_string(&inputs, kind, block.unwrap_or(1))))
+        .map(|(kind, block)| (kind, block, codegen::write_string(&inputs, kind, block.unwrap_or(1))))
         .collect();
     // naga validation dominates compile time; the kernels are independent, so
     // they are validated on as many threads as there are kernels.

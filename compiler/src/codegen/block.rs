@@ -1,0 +1,331 @@
+//! The block kernels. The coarse kernel shades one coarse sample per B x B
+//! block corner and writes its interface record; the fine kernel resolves,
+//! per pixel, the four samples around it and resamples or re-evaluates each
+//! coarse effect; the reference kernel evaluates everything per pixel. The
+//! dynamic mode's kernels are the coarse and fine ones over two levels of
+//! blocks; what only they add is in [`super::dynamic`].
+
+use super::Writer;
+use super::effects::Key;
+use super::words::{bit, pack_words, test_bit, unpack_words};
+use super::writer::cut;
+use crate::check::EffectId;
+use crate::layout;
+use crate::syntax::ast::Rate;
+use mrsl_abi::KernelKind;
+use mrsl_abi::geometry::DYNAMIC_TAG_WORDS;
+
+/// One level of coarse samples as a fine kernel reads it.
+pub(super) struct Level {
+    /// Suffix of the generated functions (`mrsl_resolve{suffix}`).
+    pub(super) suffix: &'static str,
+    pub(super) block: u32,
+    pub(super) buffer: &'static str,
+    /// Refines only within the parent level's refined effects (dynamic mode);
+    /// its records carry a validity tag.
+    pub(super) parent: bool,
+}
+
+/// The number of coarse samples along each axis of a `block` grid over an
+/// image of `size`, as WGSL: the rule of [`mrsl_abi::geometry::sample_grid`].
+pub(super) fn sample_grid(block: u32) -> String {
+    format!("(size + vec2<i32>({})) / {block} + vec2<i32>(1)", block as i32 - 2)
+}
+
+/// Tests of `key` between corner `k00_<key>` and the corners `k10_`, `k01_`,
+/// `k11_`: whether the block's own corners disagree.
+pub(super) fn corners_differ(key: &Key) -> Vec<String> {
+    let name = key.name;
+    ["k10", "k01", "k11"]
+        .iter()
+        .map(|corner| key.differs(&format!("k00_{name}"), &format!("{corner}_{name}")))
+        .collect()
+}
+
+impl Writer<'_, '_, '_> {
+    /// The interface buffer of the coarse (written) and fine (read) kernels.
+    pub(super) fn interface_bindings(&mut self) {
+        let l = self.i.layout;
+        let access = if self.kind == KernelKind::Coarse { "read_write" } else { "read" };
+        self.template(
+            0,
+            include_str!("templates/interface.wgsl"),
+            &[("GROUP", &l.interface.group), ("BINDING", &l.interface.binding), ("ACCESS", &access)],
+        );
+        if self.kind == KernelKind::DynamicFine {
+            self.inner_interface_binding();
+        }
+    }
+
+    // ---- Coarse kernel ----------------------------------------------------------
+
+    pub(super) fn coarse_entry(&mut self) {
+        if self.kind == KernelKind::DynamicCoarse {
+            self.parent_refined();
+        }
+        let c = self.checked();
+        let iface = self.i.interface;
+        let [x, y, z] = self.kind.workgroup_size();
+        let [head, tail] = cut(include_str!("templates/coarse_main.wgsl"), &["BODY"]);
+        self.template(0, head, &[("WORKGROUP", &format!("{x}, {y}, {z}")), ("ENTRY", &self.kind.main_entry_point())]);
+        if self.kind == KernelKind::DynamicCoarse {
+            self.dynamic_coarse_gate();
+        }
+        let coarse = self.coarse_live();
+        for &e in &coarse {
+            self.line(1, format!("// coarse effect `{}`", c.effects[e.index()].name));
+            self.effect_chain(&[e], 1);
+        }
+        if iface.flag_words > 0 {
+            self.template(0, include_str!("templates/refine_flags.wgsl"), &[]);
+            self.declare_flag_words(iface.flag_words);
+            for &e in &coarse {
+                self.set_refine_flag(e, 1);
+            }
+            self.store_flag_words(iface.flag_words, "mrsl_interface", "mrsl_rec");
+        }
+        for (k, slot) in iface.slots.iter().enumerate() {
+            let names: Vec<&str> = slot.effects.iter().map(|e| c.effects[e.index()].name.as_str()).collect();
+            self.line(
+                1,
+                format!("// slot {k}: words {}..{} ({})", slot.offset, slot.offset + slot.size, names.join(", ")),
+            );
+            for &e in &slot.effects {
+                let words = pack_words(&self.effect_name(e), &c.effects[e.index()].ty);
+                let writes: Vec<String> = words
+                    .iter()
+                    .enumerate()
+                    .map(|(j, w)| format!("mrsl_interface[mrsl_rec + {}u] = {w};", slot.offset as usize + j))
+                    .collect();
+                if slot.effects.len() > 1 {
+                    // A shared slot holds whichever effect this sample's own flags say is passed.
+                    let cond = self.store_condition(e, &|bit| test_bit("mrsl_flags", bit));
+                    self.line(1, format!("if ({cond}) {{"));
+                    for wline in writes {
+                        self.line(2, wline);
+                    }
+                    self.line(1, "}");
+                } else {
+                    for wline in writes {
+                        self.line(1, wline);
+                    }
+                }
+            }
+        }
+        self.template(0, tail, &[]);
+    }
+
+    /// The pass condition of `e` as WGSL, over flag bits rendered by `bit`.
+    fn store_condition(&self, e: EffectId, bit: &dyn Fn(u32) -> String) -> String {
+        let iface = self.i.interface;
+        let cond = iface.conditions[e.index()].as_ref().expect("passed effects have a condition");
+        let mut any = vec![];
+        if cond.fine_user {
+            any.push("true".to_string());
+        }
+        for u in &cond.refining_users {
+            any.push(bit(iface.refine_bit[u.index()].expect("refining users have a bit")));
+        }
+        let any = if any.is_empty() { "false".to_string() } else { any.join(" || ") };
+        match iface.refine_bit[e.index()] {
+            Some(b) if cond.self_refines => format!("!{} && ({any})", bit(b)),
+            _ => format!("({any})"),
+        }
+    }
+
+    // ---- Fine kernel ------------------------------------------------------------
+
+    /// `MrslBlock` and the resolvers, getters and resamplers of the fine kernel's levels.
+    pub(super) fn fine_support(&mut self) {
+        let coarse = self.coarse_live();
+        if coarse.is_empty() {
+            return;
+        }
+        let mask_words = (coarse.len() as u32).div_ceil(32);
+        let [head, tail] = cut(include_str!("templates/block_struct.wgsl"), &["REFINED_WORDS"]);
+        self.template(0, head, &[]);
+        // Separate words, not an array: llvmpipe spills dynamically indexed
+        // arrays in structs to memory, which made every lookup a memory access.
+        for w in 0..mask_words {
+            self.line(1, format!("refined{w}: u32, // bit k: coarse effect 32 * {w} + k is evaluated per pixel"));
+        }
+        let mut word = "b.refined0".to_string();
+        for w in 1..mask_words {
+            word = format!("select({word}, b.refined{w}, k >= {}u)", 32 * w);
+        }
+        self.template(0, tail, &[("WORD", &word)]);
+        if self.kind == KernelKind::DynamicFine {
+            self.any_refined(mask_words);
+            self.fine_level(&Level::DYNAMIC_OUTER);
+            self.fine_level(&Level::DYNAMIC_INNER);
+        } else {
+            self.fine_level(&Level { suffix: "", block: self.block, buffer: "mrsl_interface", parent: false });
+        }
+    }
+
+    /// `mrsl_resolve{suffix}` and the getters and resamplers of one level of coarse samples.
+    fn fine_level(&mut self, level: &Level) {
+        let c = self.checked();
+        let coarse = self.coarse_live();
+        let iface = self.i.interface;
+        let (sfx, bk, buf) = (level.suffix, level.block, level.buffer);
+        let stride = if level.parent { iface.stride + DYNAMIC_TAG_WORDS } else { iface.stride };
+        let [head, corners, refined] = cut(include_str!("templates/resolve.wgsl"), &["CORNERS", "REFINED"]);
+        let params = if level.parent {
+            self.inner_level_note(bk);
+            "pos: vec2<i32>, parent: MrslBlock"
+        } else {
+            "pos: vec2<i32>"
+        };
+        self.template(0, head, &[("SUFFIX", &sfx), ("PARAMS", &params), ("GRID", &sample_grid(bk)), ("BLOCK", &bk)]);
+        if level.parent {
+            self.stale_corners(buf, stride);
+        }
+        for key in self.keys() {
+            let name = key.name;
+            let mut tests: Vec<String> = ["k00", "k10", "k01", "k11"]
+                .iter()
+                .map(|corner| key.differs(&format!("k_{name}"), &format!("{corner}_{name}")))
+                .collect();
+            tests.extend(corners_differ(&key));
+            self.template(
+                0,
+                include_str!("templates/resolve_key.wgsl"),
+                &[("NAME", &name), ("TESTS", &tests.join(" || "))],
+            );
+        }
+        if iface.flag_words > 0 {
+            for (ci, corner) in ["x", "y", "z", "w"].iter().enumerate() {
+                for w in 0..iface.flag_words {
+                    self.line(1, format!("let f{ci}_{w} = {buf}[b.corners.{corner} * {stride}u + {w}u];"));
+                }
+            }
+        }
+        self.template(0, corners, &[]);
+        for &e in coarse.iter().rev() {
+            let info = &c.effects[e.index()];
+            let k = self.coarse_index[&e];
+            let mut terms = vec!["disc".to_string()];
+            if let Some(b) = iface.refine_bit[e.index()] {
+                let (word, mask) = bit(b);
+                let words: Vec<String> = (0..4).map(|ci| format!("f{ci}_{word}")).collect();
+                terms.push(format!("((({}) & {mask}u) != 0u)", words.join(" | ")));
+            }
+            // Needed coarsely: some live user runs per pixel here.
+            let mut needed = vec![];
+            for &u in &self.i.graph.users[e.index()] {
+                if !self.i.graph.live[u.index()] {
+                    continue;
+                }
+                match c.effects[u.index()].rate {
+                    Rate::Coarse => needed.push(format!("mrsl_r{}", self.coarse_index[&u])),
+                    _ => needed.push("true".into()),
+                }
+            }
+            needed.sort();
+            needed.dedup();
+            let needed = if needed.is_empty() { "false".to_string() } else { needed.join(" || ") };
+            if !iface.is_passed(e) {
+                terms.push(format!("({needed})"));
+            } else if iface.is_shared(e) {
+                let misses: Vec<String> = (0..4)
+                    .map(|ci| format!("!({})", self.store_condition(e, &|b| test_bit(&format!("f{ci}_"), b))))
+                    .collect();
+                terms.push(format!("(({needed}) && ({}))", misses.join(" || ")));
+            }
+            let value = if level.parent {
+                format!("mrsl_is_refined(parent, {k}u) && ({})", terms.join(" || "))
+            } else {
+                terms.join(" || ")
+            };
+            let (word, mask) = bit(k);
+            self.line(1, format!("let mrsl_r{k} = {value}; // `{}`", info.name));
+            self.line(1, format!("if (mrsl_r{k}) {{ b.refined{word} |= {mask}u; }}"));
+        }
+        self.template(0, refined, &[]);
+        for &e in &coarse {
+            let Some(slot) = iface.slot_of[e.index()].map(|s| &iface.slots[s]) else {
+                continue;
+            };
+            let info = &c.effects[e.index()];
+            let (filter, value) = if layout::uses_nearest(c, e) {
+                (
+                    "nearest corner",
+                    "select(select(v0, v1, b.nearest == 1u), select(v2, v3, b.nearest == 3u), b.nearest >= 2u)",
+                )
+            } else {
+                ("bilinear", "v0 * b.weights.x + v1 * b.weights.y + v2 * b.weights.z + v3 * b.weights.w")
+            };
+            self.template(
+                0,
+                include_str!("templates/resample.wgsl"),
+                &[
+                    ("SUFFIX", &sfx),
+                    ("NAME", &info.name),
+                    ("TYPE", &info.ty.wgsl()),
+                    ("STRIDE", &stride),
+                    ("OFFSET", &slot.offset),
+                    ("UNPACK", &unpack_words(&info.ty, buf)),
+                    ("FILTER", &filter),
+                    ("VALUE", &value),
+                ],
+            );
+        }
+    }
+
+    /// Declares `mrsl_b` (and in the dynamic mode `mrsl_b2`) for the pixel at
+    /// `mrsl_pos` in the fine kernels; nothing elsewhere.
+    pub(super) fn resolve_preamble(&mut self, indent: usize) {
+        if self.kind.is_fine() {
+            self.line(indent, "let mrsl_b = mrsl_resolve(mrsl_pos);");
+            if self.kind == KernelKind::DynamicFine {
+                self.resolve_inner(indent);
+            }
+        }
+    }
+
+    /// A coarse effect in a fine kernel: evaluated where it is refined,
+    /// resampled elsewhere (when it is passed).
+    pub(super) fn resolved_coarse_value(&mut self, e: EffectId, indent: usize) {
+        let info = &self.checked().effects[e.index()];
+        let (index, name) = (self.coarse_index[&e], self.effect_name(e));
+        self.line(indent, format!("var {name}: {};", info.ty.wgsl()));
+        if self.kind == KernelKind::DynamicFine {
+            return self.dynamic_coarse_value(e, indent);
+        }
+        self.line(indent, format!("if (mrsl_is_refined(mrsl_b, {index}u)) {{"));
+        self.evaluate(e, indent + 1, "");
+        if self.i.interface.is_passed(e) {
+            self.line(indent, "} else {");
+            self.line(indent + 1, format!("{name} = mrsl_resample_{}(mrsl_b);", info.name));
+        }
+        self.line(indent, "}");
+    }
+
+    /// Entry point of the fine and reference kernels.
+    pub(super) fn pixel_entry(&mut self) {
+        // The reference kernel has no blocks; it lays its tiles out in 2x2 ones.
+        self.tile_pixel_blocks(if self.kind.is_fine() { self.block } else { 2 });
+        let counted = self.counts_stats();
+        let coarse = self.coarse_live().len();
+        self.pixel_main(
+            |w| {
+                if !counted {
+                    return;
+                }
+                w.resolve_preamble(2);
+                // `mrsl_last` holds the innermost level: effects refined there are evaluated per pixel.
+                let (last, from_inner) = if w.kind == KernelKind::DynamicFine {
+                    ("mrsl_b2", "mrsl_b.refined0 & ~mrsl_b2.refined0")
+                } else {
+                    ("mrsl_b", "0u")
+                };
+                w.template(2, include_str!("templates/rate.wgsl"), &[("LAST", &last), ("FROM_INNER", &from_inner)]);
+                for k in 0..coarse {
+                    w.count_refined(k, &format!("mrsl_is_refined(mrsl_last, {k}u)"));
+                }
+            },
+            |w, e, indent| w.effect_chain(&[e], indent),
+        );
+    }
+}

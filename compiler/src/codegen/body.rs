@@ -1,0 +1,318 @@
+//! User code as WGSL: the statements and expressions of effect bodies and
+//! functions, and the renaming that keeps source names clear of WGSL's
+//! keywords and of the generated `mrsl_` namespace and entry points.
+//!
+//! The same expression is written in two modes: in its body, where names are
+//! in scope, and rebuilt at another position for a derivative, where inputs
+//! are loaded and effects fetched there instead.
+
+use super::Writer;
+use crate::check::{Callee, Checked, LocalId, Symbol, UniformKind};
+use crate::syntax::ast::*;
+use crate::types::{Scalar, Type};
+use mrsl_abi::{KernelKind, entry};
+
+/// Renames user identifiers that collide with WGSL keywords, WGSL builtins or
+/// the generated `mrsl_` namespace, so source names survive everywhere else.
+pub(super) fn wgsl_ident(name: &str) -> String {
+    let reserved = naga::keywords::wgsl::RESERVED.contains(&name)
+        || naga::keywords::wgsl::BUILTIN_IDENTIFIERS.contains(&name)
+        || name.to_ascii_lowercase().starts_with("mrsl")
+        || KernelKind::ALL.iter().any(|k| k.entry_points().contains(&name))
+        || entry::RESERVED_PREFIXES.iter().any(|p| name.starts_with(p))
+        || name.starts_with("__")
+        || matches!(name, "u" | "pos");
+    if reserved { format!("{name}_") } else { name.to_string() }
+}
+
+/// The WGSL name of a local variable or parameter.
+pub(super) fn local_name(checked: &Checked, id: LocalId) -> String {
+    let info = &checked.locals[id.index()];
+    // Locals may shadow module-scope user names (C allows it, WGSL would then
+    // hide the function or texture), so they are suffixed when they would.
+    let base = wgsl_ident(&info.name);
+    let clashes = checked.functions.iter().any(|f| f.name == info.name)
+        || checked.consts.iter().any(|c| c.name == info.name)
+        || checked.uniforms.iter().any(|u| u.name == info.name && !matches!(u.kind, UniformKind::Value { .. }));
+    if clashes { format!("{base}_l") } else { base }
+}
+
+#[derive(Clone, Copy)]
+pub(super) enum Mode<'s> {
+    /// Inside an effect body or function: names are in scope.
+    Body,
+    /// Rebuilding a derivative operand at another position.
+    Neighbour(&'s crate::deriv::DerivSite<'s>),
+}
+
+impl Writer<'_, '_, '_> {
+    pub(super) fn function(&mut self, id: crate::check::FunctionId) {
+        let c = self.checked();
+        let f = c.function_decl(id);
+        let info = &c.functions[id.index()];
+        let params: Vec<String> = info
+            .params
+            .iter()
+            .map(|p| {
+                let l = &c.locals[p.index()];
+                let name = local_name(c, *p);
+                if l.reassigned { format!("{name}_in: {}", l.ty.wgsl()) } else { format!("{name}: {}", l.ty.wgsl()) }
+            })
+            .collect();
+        self.line(0, format!("// function `{}` (line {})", f.name.name, self.line_of(f.span)));
+        self.line(0, format!("fn {}({}) -> {} {{", wgsl_ident(&f.name.name), params.join(", "), info.ret.wgsl()));
+        for p in &info.params {
+            if c.locals[p.index()].reassigned {
+                let name = local_name(c, *p);
+                self.line(1, format!("var {name} = {name}_in;"));
+            }
+        }
+        for s in &f.body.stmts {
+            self.stmt(s, 1);
+        }
+        self.line(0, "}");
+        self.line(0, "");
+    }
+
+    pub(super) fn stmt(&mut self, s: &Stmt, indent: usize) {
+        let c = self.checked();
+        match &s.kind {
+            StmtKind::Local { init, .. } => {
+                let id = c.local_decls[&s.id];
+                let info = &c.locals[id.index()];
+                let name = local_name(c, id);
+                match init {
+                    Some(v) => {
+                        let keyword = if info.reassigned { "var" } else { "let" };
+                        let value = self.expr(v, Mode::Body);
+                        self.line(indent, format!("{keyword} {name}: {} = {value};", info.ty.wgsl()));
+                    }
+                    None => self.line(indent, format!("var {name}: {};", info.ty.wgsl())),
+                }
+            }
+            StmtKind::Assign { .. } | StmtKind::Step { .. } => {
+                let text = self.simple_stmt(s);
+                self.line(indent, format!("{text};"));
+            }
+            StmtKind::If { cond, then, otherwise } => {
+                let cond = self.expr(cond, Mode::Body);
+                self.line(indent, format!("if ({cond}) {{"));
+                self.body(then, indent + 1);
+                if let Some(o) = otherwise {
+                    self.line(indent, "} else {");
+                    self.body(o, indent + 1);
+                }
+                self.line(indent, "}");
+            }
+            StmtKind::For { init, cond, step, body } => {
+                let init = init.as_ref().map(|i| self.for_init(i)).unwrap_or_default();
+                let cond = cond.as_ref().map(|x| self.expr(x, Mode::Body)).unwrap_or_default();
+                let step = step.as_ref().map(|st| self.simple_stmt(st)).unwrap_or_default();
+                self.line(indent, format!("for ({init}; {cond}; {step}) {{"));
+                self.body(body, indent + 1);
+                self.line(indent, "}");
+            }
+            StmtKind::Block(b) => {
+                self.line(indent, "{");
+                for s in &b.stmts {
+                    self.stmt(s, indent + 1);
+                }
+                self.line(indent, "}");
+            }
+            StmtKind::Refine => self.line(indent, "*mrsl_refine = true; // refine"),
+            StmtKind::Return(Some(v)) => {
+                let v = self.expr(v, Mode::Body);
+                self.line(indent, format!("return {v};"));
+            }
+            StmtKind::Return(None) => self.line(indent, "return;"),
+            StmtKind::Break => self.line(indent, "break;"),
+            StmtKind::Continue => self.line(indent, "continue;"),
+        }
+    }
+
+    fn body(&mut self, s: &Stmt, indent: usize) {
+        match &s.kind {
+            StmtKind::Block(b) => b.stmts.iter().for_each(|s| self.stmt(s, indent)),
+            _ => self.stmt(s, indent),
+        }
+    }
+
+    fn for_init(&mut self, s: &Stmt) -> String {
+        let c = self.checked();
+        match &s.kind {
+            StmtKind::Local { init, .. } => {
+                let id = c.local_decls[&s.id];
+                let info = &c.locals[id.index()];
+                let value = init.as_ref().map(|v| format!(" = {}", self.expr(v, Mode::Body))).unwrap_or_default();
+                format!("var {}: {}{value}", local_name(c, id), info.ty.wgsl())
+            }
+            _ => self.simple_stmt(s),
+        }
+    }
+
+    fn simple_stmt(&mut self, s: &Stmt) -> String {
+        match &s.kind {
+            StmtKind::Assign { target, op, value } => {
+                let t = self.expr(target, Mode::Body);
+                let v = self.expr(value, Mode::Body);
+                let op = match op {
+                    AssignOp::Set => "=",
+                    AssignOp::Add => "+=",
+                    AssignOp::Sub => "-=",
+                    AssignOp::Mul => "*=",
+                    AssignOp::Div => "/=",
+                };
+                format!("{t} {op} {v}")
+            }
+            StmtKind::Step { target, increment } => {
+                // `++` is integer-only in WGSL; `+= 1` works for every numeric type.
+                let t = self.expr(target, Mode::Body);
+                format!("{t} {} 1", if *increment { "+=" } else { "-=" })
+            }
+            StmtKind::Local { .. } => self.for_init(s),
+            _ => String::new(),
+        }
+    }
+
+    // ---- Expressions --------------------------------------------------------
+
+    pub(super) fn expr(&self, e: &Expr, mode: Mode) -> String {
+        let c = self.checked();
+        match &e.kind {
+            ExprKind::Int(v, IntSuffix::None) => v.to_string(),
+            ExprKind::Int(v, IntSuffix::U) => format!("{v}u"),
+            ExprKind::Int(v, IntSuffix::I) => format!("{v}i"),
+            ExprKind::Float(v) => float_literal(*v),
+            ExprKind::Bool(b) => b.to_string(),
+            ExprKind::Name(name) => self.name(e, name, mode),
+            ExprKind::Unary(op, inner) => {
+                let x = self.expr(inner, mode);
+                let sym = match op {
+                    UnaryOp::Pos => "",
+                    UnaryOp::Neg => "-",
+                    UnaryOp::Not => "!",
+                    UnaryOp::BitNot => "~",
+                };
+                format!("{sym}({x})")
+            }
+            ExprKind::Binary(op, a, b) => {
+                let x = self.expr(a, mode);
+                let mut y = self.expr(b, mode);
+                match op {
+                    BinaryOp::Shl | BinaryOp::Shr => {
+                        // WGSL shifts take an unsigned amount.
+                        match c.ty(b) {
+                            Type::Scalar(Scalar::Int) => y = format!("u32({y})"),
+                            Type::Vector(Scalar::Int, n) => y = format!("vec{n}<u32>({y})"),
+                            _ => {}
+                        }
+                        format!("({x} {} {y})", op.symbol())
+                    }
+                    BinaryOp::BitXor if c.ty(a).scalar() == Some(Scalar::Bool) => {
+                        format!("({x} != {y})")
+                    }
+                    _ => format!("({x} {} {y})", op.symbol()),
+                }
+            }
+            ExprKind::Ternary(cond, a, b) => {
+                let cond = self.expr(cond, mode);
+                let x = self.expr(a, mode);
+                let y = self.expr(b, mode);
+                format!("select({y}, {x}, {cond})")
+            }
+            ExprKind::Field { base, field } => format!("{}.{}", self.expr(base, mode), field.name),
+            ExprKind::Index { base, index } => {
+                format!("{}[{}]", self.expr(base, mode), self.expr(index, mode))
+            }
+            ExprKind::Call { callee, args } => self.call(e, callee, args, mode),
+        }
+    }
+
+    fn name(&self, e: &Expr, name: &str, mode: Mode) -> String {
+        let c = self.checked();
+        match c.symbols.get(&e.id) {
+            Some(Symbol::Local(l)) => match mode {
+                Mode::Neighbour(site) if !site.params.contains(l) => match self.i.deriv.definitions.get(l) {
+                    Some(def) => format!("({})", self.expr(def, mode)),
+                    None => local_name(c, *l),
+                },
+                _ => local_name(c, *l),
+            },
+            Some(Symbol::Input(i)) => match mode {
+                Mode::Body => wgsl_ident(name),
+                Mode::Neighbour(_) => format!("mrsl_load_{}(mrsl_pos)", c.inputs[i.index()].name),
+            },
+            Some(Symbol::Uniform(u)) => {
+                let info = &c.uniforms[u.index()];
+                match (&info.kind, &info.ty) {
+                    (UniformKind::Value { .. }, Type::Scalar(Scalar::Bool)) => {
+                        format!("(mrsl_u.{} != 0u)", wgsl_ident(name))
+                    }
+                    (UniformKind::Value { .. }, Type::Vector(Scalar::Bool, n)) => {
+                        format!("(mrsl_u.{} != vec{n}<u32>(0u))", wgsl_ident(name))
+                    }
+                    (UniformKind::Value { .. }, _) => format!("mrsl_u.{}", wgsl_ident(name)),
+                    _ => wgsl_ident(name),
+                }
+            }
+            Some(Symbol::Const(_)) => wgsl_ident(name),
+            Some(Symbol::Effect(id)) => match mode {
+                Mode::Body => self.effect_name(*id),
+                Mode::Neighbour(_) => format!("mrsl_at_{}(mrsl_pos)", c.effects[id.index()].name),
+            },
+            None => wgsl_ident(name),
+        }
+    }
+
+    fn call(&self, e: &Expr, callee: &Ident, args: &[Expr], mode: Mode) -> String {
+        let c = self.checked();
+        let arg = |k: usize| {
+            let text = self.expr(&args[k], mode);
+            match c.splats.get(&args[k].id) {
+                Some(target) => format!("{}({text})", target.wgsl()),
+                None => text,
+            }
+        };
+        let all = || (0..args.len()).map(arg).collect::<Vec<_>>().join(", ");
+        match c.callees.get(&e.id) {
+            Some(Callee::Construct(ty)) => format!("{}({})", ty.wgsl(), all()),
+            Some(Callee::Function(_)) => format!("{}({})", wgsl_ident(&callee.name), all()),
+            Some(Callee::Builtin(name)) => match *name {
+                "ddx" | "ddy" | "fwidth" | "sample" => {
+                    let site_index = self.i.deriv.site_of[&e.id];
+                    let site = &self.i.deriv.sites[site_index];
+                    let mut call_args = vec!["mrsl_pos".to_string()];
+                    call_args.extend(site.params.iter().map(|p| local_name(c, *p)));
+                    let call_args = call_args.join(", ");
+                    let dx = format!("mrsl_ddx_{site_index}({call_args})");
+                    let dy = format!("mrsl_ddy_{site_index}({call_args})");
+                    match *name {
+                        "ddx" => dx,
+                        "ddy" => dy,
+                        "fwidth" => format!("(abs({dx}) + abs({dy}))"),
+                        _ => format!("textureSampleGrad({}, {}, {}, {dx}, {dy})", arg(0), arg(1), arg(2)),
+                    }
+                }
+                "sample_level" => format!("textureSampleLevel({})", all()),
+                "sample_grad" => format!("textureSampleGrad({})", all()),
+                "load" if args.len() == 2 => format!("textureLoad({}, {}, 0)", arg(0), arg(1)),
+                "load" => format!("textureLoad({})", all()),
+                "texture_size" => format!("vec2<i32>(textureDimensions({}))", arg(0)),
+                "lerp" => format!("mix({})", all()),
+                "faceforward" => format!("faceForward({})", all()),
+                "inversesqrt" => format!("inverseSqrt({})", all()),
+                other => format!("{other}({})", all()),
+            },
+            None => format!("{}({})", wgsl_ident(&callee.name), all()),
+        }
+    }
+}
+
+pub(super) fn float_literal(v: f64) -> String {
+    let text = format!("{v:?}");
+    if text.contains('.') || text.contains('e') || text.contains("inf") || text.contains("NaN") {
+        text
+    } else {
+        format!("{text}.0")
+    }
+}

@@ -1,0 +1,102 @@
+//! The checkerboard kernel, a baseline: `cb_shade` shades the coarse
+//! effects in half the 2x2 quads (a checkerboard of quads; all of them when
+//! refinement is forced) into the per-pixel records, and `cb_final`
+//! reconstructs the other quads' pixels from the same pixel of the
+//! edge-adjacent quads (rejecting taps across a discontinuity key, using only
+//! complete opposite pairs), shading in place where no pair is usable, then
+//! evaluates the fine effects and outputs.
+
+use super::Writer;
+use super::records::{axis_neighbours, neighbours};
+use super::writer::cut;
+use crate::types::{Scalar, Type};
+use mrsl_abi::entry;
+use mrsl_abi::geometry::CHECKERBOARD_QUADS_PER_WORKGROUP;
+use std::fmt::Display;
+
+/// Lanes of a 2x2 quad.
+const QUAD_LANES: u32 = 4;
+
+impl Writer<'_, '_, '_> {
+    pub(super) fn checkerboard_bindings(&mut self) {
+        self.record_binding(
+            "Checkerboard mode: per pixel records of the coarse effects' values (layout `hierarchical`).",
+        );
+    }
+
+    pub(super) fn checkerboard_entries(&mut self) {
+        let c = self.checked();
+        let coarse = self.coarse_live();
+        // The same pixel of the edge-adjacent quads.
+        let taps = neighbours(axis_neighbours(2));
+        self.record_helpers();
+        let [head, end] = cut(include_str!("templates/checkerboard_shade.wgsl"), &["EFFECTS"]);
+        self.template(
+            0,
+            head,
+            &[
+                ("QUADS", &CHECKERBOARD_QUADS_PER_WORKGROUP),
+                ("WORKGROUP", &(CHECKERBOARD_QUADS_PER_WORKGROUP * QUAD_LANES)),
+                ("ENTRY", &entry::CB_SHADE),
+            ],
+        );
+        for &e in &coarse {
+            self.effect_chain(&[e], 1);
+            let info = &c.effects[e.index()];
+            self.line(1, format!("mrsl_hput_{}(mrsl_pos, {});", info.name, self.effect_name(e)));
+        }
+        self.template(0, end, &[]);
+
+        let [head, note, end] = cut(include_str!("templates/taps.wgsl"), &["IN_IMAGE", "PAIRS"]);
+        self.template(0, head, &[("TAPS", &taps)]);
+        let tap_tests: Vec<String> = self
+            .keys()
+            .iter()
+            .map(|key| {
+                let load = |at: &str| format!("mrsl_load_{}({at})", key.name);
+                format!("ok[k] = ok[k] && ({});", key.matches(&load("taps[k]"), &load("p")))
+            })
+            .collect();
+        self.neighbour_pairs("taps", &tap_tests, note, ["pair_x", "pair_y"]);
+        self.template(0, end, &[]);
+
+        let [head, blend, first_tap, end] =
+            cut(include_str!("templates/reconstruct.wgsl"), &["BLEND", "FIRST_TAP", "END"]);
+        for &e in &coarse {
+            let info = &c.effects[e.index()];
+            let blendable =
+                matches!(info.ty, Type::Scalar(Scalar::Float) | Type::Vector(Scalar::Float, _) | Type::Matrix(_));
+            let ty = info.ty.wgsl();
+            let values: [(&str, &dyn Display); 3] = [("NAME", &info.name), ("TYPE", &ty), ("TAPS", &taps)];
+            self.template(0, head, &values);
+            self.template(0, if blendable { blend } else { first_tap }, &values);
+            self.template(0, end, &values);
+        }
+        self.line(0, "");
+
+        let coarse = coarse.len();
+        let [head, stats, end] = cut(include_str!("templates/checkerboard_final.wgsl"), &["STATS", "COUNTS"]);
+        let [value, evaluated] = cut(include_str!("templates/checkerboard_value.wgsl"), &["EVALUATE"]);
+        self.record_final(
+            |w| {
+                w.template(0, head, &[]);
+                if coarse > 0 {
+                    let all = if coarse >= 32 { u32::MAX } else { (1u32 << coarse) - 1 };
+                    w.template(0, stats, &[("ALL", &all)]);
+                    for k in 0..coarse {
+                        w.line(3, format!("atomicAdd(&mrsl_wg_stats[{k}], 1u);"));
+                    }
+                    w.template(0, end, &[]);
+                }
+            },
+            |w, e, indent| {
+                let info = &w.checked().effects[e.index()];
+                let (var, ty) = (w.effect_name(e), info.ty.wgsl());
+                let values: [(&str, &dyn Display); 3] = [("VAR", &var), ("TYPE", &ty), ("NAME", &info.name)];
+                w.template(indent, value, &values);
+                w.evaluate(e, indent + 1, "");
+                w.template(indent, evaluated, &values);
+            },
+        );
+    }
+}

@@ -1,0 +1,357 @@
+//! What every kernel declares before its entry points: the bindings, the
+//! position helpers and input loaders, one `mrsl_eval_<effect>` function per
+//! effect, the derivative helpers and the `mrsl_at_<effect>` functions that
+//! give an effect's value at another position; and how an effect is
+//! evaluated in a chain, and how discontinuity keys are compared, which the
+//! entry points of every family use.
+
+use super::Writer;
+use super::body::{Mode, float_literal, local_name, wgsl_ident};
+use super::words::bit;
+use super::writer::cut;
+use crate::check::{EffectId, KeyCompare, Symbol};
+use crate::deriv::{visit_expr, visit_stmt_exprs};
+use crate::syntax::ast::*;
+use mrsl_abi::{CONTROL_FIELDS, KernelKind};
+use std::collections::BTreeSet;
+
+/// A discontinuity key: an input that, where its values at two positions
+/// differ, keeps them from sharing coarse values.
+pub(super) struct Key<'c> {
+    pub(super) name: &'c str,
+    compare: KeyCompare,
+    scalar: bool,
+}
+
+impl Key<'_> {
+    /// WGSL that is true where the key's values `a` and `b` differ: an
+    /// operand of `||` (a call, or parenthesised).
+    pub(super) fn differs(&self, a: &str, b: &str) -> String {
+        self.compare(a, b, true)
+    }
+
+    /// WGSL that is true where `a` and `b` match: a bare comparison, which
+    /// the caller parenthesises.
+    pub(super) fn matches(&self, a: &str, b: &str) -> String {
+        self.compare(a, b, false)
+    }
+
+    /// The one comparison of key values: exact (`any` over vector components)
+    /// or by distance against the key's threshold, in either sense.
+    fn compare(&self, a: &str, b: &str, differs: bool) -> String {
+        let (equal, reduce, close) = if differs { ("!=", "any", ">") } else { ("==", "all", "<=") };
+        let test = match self.compare {
+            KeyCompare::Exact if self.scalar => format!("{a} {equal} {b}"),
+            KeyCompare::Exact => return format!("{reduce}({a} {equal} {b})"),
+            KeyCompare::Threshold { threshold } => format!("distance({a}, {b}) {close} {}", float_literal(threshold)),
+        };
+        if differs { format!("({test})") } else { test }
+    }
+}
+
+impl<'b> Writer<'_, '_, 'b> {
+    /// The program's discontinuity keys, in declaration order.
+    pub(super) fn keys(&self) -> Vec<Key<'b>> {
+        let c = self.checked();
+        c.inputs
+            .iter()
+            .filter_map(|x| x.key.map(|compare| Key { name: &x.name, compare, scalar: x.ty.components() == 1 }))
+            .collect()
+    }
+
+    /// Every binding the kernel uses, where the layout puts it: the control
+    /// block, user uniforms, textures and samplers, the G-buffer channels,
+    /// then the stage's buffers (per kernel family), statistics and outputs.
+    pub(super) fn bindings(&mut self) {
+        let l = self.i.layout;
+        let [control, user, channels, stage, end] =
+            cut(include_str!("templates/resources.wgsl"), &["CONTROL_FIELDS", "USER_RESOURCES", "CHANNELS", "STAGE"]);
+        self.template(0, control, &[]);
+        for f in &CONTROL_FIELDS {
+            match f.comment {
+                Some(comment) => self.line(1, format!("{}: {}, // {comment}", f.name, f.wgsl_type)),
+                None => self.line(1, format!("{}: {},", f.name, f.wgsl_type)),
+            }
+        }
+        self.template(0, user, &[("GROUP", &l.control.group), ("BINDING", &l.control.binding)]);
+        if let Some(u) = &l.uniforms {
+            let [head, tail] = cut(include_str!("templates/uniforms.wgsl"), &["FIELDS"]);
+            self.template(0, head, &[]);
+            for f in &u.fields {
+                self.line(1, format!("{}: {}, // offset {}", wgsl_ident(&f.name), f.wgsl_type, f.offset));
+            }
+            self.template(0, tail, &[("GROUP", &u.group), ("BINDING", &u.binding)]);
+        }
+        for t in &l.textures {
+            self.line(
+                0,
+                format!("@group({}) @binding({}) var {}: texture_2d<f32>;", t.group, t.binding, wgsl_ident(&t.name)),
+            );
+        }
+        for s in &l.samplers {
+            self.line(0, format!("@group({}) @binding({}) var {}: sampler;", s.group, s.binding, wgsl_ident(&s.name)));
+        }
+        self.template(0, channels, &[]);
+        for ch in &l.channels {
+            let sample = ch.format.scalar().wgsl();
+            self.line(
+                0,
+                format!(
+                    "@group({}) @binding({}) var mrsl_gb_{}: texture_2d<{sample}>; // {}",
+                    ch.group, ch.binding, ch.name, ch.format
+                ),
+            );
+        }
+        self.template(0, stage, &[]);
+        match self.kind {
+            KernelKind::Coarse | KernelKind::Fine | KernelKind::DynamicFine => self.interface_bindings(),
+            KernelKind::DynamicCoarse => self.dynamic_coarse_bindings(),
+            KernelKind::Hierarchical => self.hierarchical_bindings(),
+            KernelKind::Checkerboard => self.checkerboard_bindings(),
+            KernelKind::Reference => {}
+        }
+        if self.counts_stats() {
+            self.stats_bindings();
+        }
+        if !self.kind.is_coarse() {
+            for o in &l.outputs {
+                self.line(
+                    0,
+                    format!(
+                        "@group({}) @binding({}) var mrsl_out_{}: texture_storage_2d<{}, write>;",
+                        o.group, o.binding, o.name, o.format
+                    ),
+                );
+            }
+        }
+        self.template(0, end, &[]);
+    }
+
+    /// `mrsl_grid` (the positions of this kernel), `mrsl_pixel` (where a
+    /// position loads its inputs) and `mrsl_pair_x` / `mrsl_pair_y` (a
+    /// position's quad, which derivatives difference across).
+    pub(super) fn position_helpers(&mut self) {
+        let (grid, pixel) = if self.kind.is_coarse() {
+            (
+                "(size + vec2<i32>(MRSL_BLOCK - 2)) / MRSL_BLOCK + vec2<i32>(1)",
+                "min(pos * MRSL_BLOCK, vec2<i32>(mrsl_ctl.size) - vec2<i32>(1))",
+            )
+        } else {
+            ("size", "pos")
+        };
+        self.template(0, include_str!("templates/positions.wgsl"), &[("GRID", &grid), ("PIXEL", &pixel)]);
+    }
+
+    /// `mrsl_load_<input>(pos)`: a G-buffer channel at a position's pixel.
+    pub(super) fn input_loaders(&mut self) {
+        for input in &self.checked().inputs {
+            let swizzle = match input.ty.components() {
+                1 => ".x",
+                2 => ".xy",
+                3 => ".xyz",
+                _ => "",
+            };
+            self.template(
+                0,
+                include_str!("templates/load.wgsl"),
+                &[("NAME", &input.name), ("TYPE", &input.ty.wgsl()), ("SWIZZLE", &swizzle)],
+            );
+        }
+    }
+
+    fn deps_params(&self, e: EffectId) -> Vec<EffectId> {
+        self.checked().effects[e.index()].deps.iter().map(|(d, _)| *d).collect()
+    }
+
+    fn eval_signature(&self, e: EffectId) -> String {
+        let c = self.checked();
+        let info = &c.effects[e.index()];
+        let mut params = vec!["mrsl_pos: vec2<i32>".to_string()];
+        if info.has_refine {
+            params.push("mrsl_refine: ptr<function, bool>".into());
+        }
+        for d in self.deps_params(e) {
+            params.push(format!("{}: {}", self.effect_name(d), c.effects[d.index()].ty.wgsl()));
+        }
+        format!("fn mrsl_eval_{}({}) -> {}", info.name, params.join(", "), info.ty.wgsl())
+    }
+
+    /// Inputs an effect body reads directly.
+    fn inputs_read(&self, decl: &EffectDecl) -> BTreeSet<usize> {
+        let c = self.checked();
+        let mut read = BTreeSet::new();
+        let mut visit = |e: &Expr| {
+            visit_expr(e, &mut |x| {
+                if let Some(Symbol::Input(i)) = c.symbols.get(&x.id) {
+                    read.insert(i.index());
+                }
+            })
+        };
+        match &decl.body {
+            EffectBody::Expr(e) => visit(e),
+            EffectBody::Block(b) => b.stmts.iter().for_each(|s| visit_stmt_exprs(s, &mut visit)),
+        }
+        read
+    }
+
+    /// `mrsl_eval_<effect>`: the effect's body at `mrsl_pos`, given its
+    /// dependencies' values (and a refine flag to set, if it can refine).
+    pub(super) fn eval_function(&mut self, e: EffectId) {
+        let c = self.checked();
+        let info = &c.effects[e.index()];
+        let decl = c.effect_decl(e);
+        let rate = match info.rate {
+            Rate::Coarse => "coarse effect",
+            Rate::Fine => "fine effect",
+            Rate::Out => "fine out",
+        };
+        self.line(0, format!("// ---- {rate} `{}` (line {}) ----", info.name, self.line_of(decl.span)));
+        let sig = self.eval_signature(e);
+        self.line(0, format!("{sig} {{"));
+        for i in self.inputs_read(decl) {
+            let name = &c.inputs[i].name;
+            self.line(1, format!("let {} = mrsl_load_{name}(mrsl_pos);", wgsl_ident(name)));
+        }
+        match &decl.body {
+            EffectBody::Expr(x) => {
+                let v = self.expr(x, Mode::Body);
+                self.line(1, format!("return {v};"));
+            }
+            EffectBody::Block(b) => {
+                let result = info.result.expect("block effects have a result local");
+                let name = local_name(c, result);
+                self.line(1, format!("var {name}: {};", info.ty.wgsl()));
+                self.line(1, "{");
+                for s in &b.stmts {
+                    self.stmt(s, 2);
+                }
+                self.line(1, "}");
+                self.line(1, format!("return {name};"));
+            }
+        }
+        self.line(0, "}");
+        self.line(0, "");
+    }
+
+    // ---- Derivatives and values at other positions ------------------------------
+
+    fn live_sites(&self) -> Vec<usize> {
+        let effects = self.kernel_effects();
+        (0..self.i.deriv.sites.len()).filter(|&k| effects.contains(&self.i.deriv.sites[k].effect)).collect()
+    }
+
+    /// `mrsl_d<k>` (the operand of derivative site k at a position) and its
+    /// differences across the position's quad, `mrsl_ddx_<k>` and `mrsl_ddy_<k>`.
+    pub(super) fn derivative_helpers(&mut self) {
+        let c = self.checked();
+        for k in self.live_sites() {
+            let site = &self.i.deriv.sites[k];
+            let ty = c.ty(site.operand).concretize();
+            let mut params = vec!["mrsl_pos: vec2<i32>".to_string()];
+            params.extend(
+                site.params.iter().map(|p| format!("{}: {}", local_name(c, *p), c.locals[p.index()].ty.wgsl())),
+            );
+            let args: String = site.params.iter().map(|p| format!(", {}", local_name(c, *p))).collect();
+            let text = &self.i.source[site.operand.span.range()];
+            let text: String = text.split_whitespace().collect::<Vec<_>>().join(" ");
+            let operand = self.expr(site.operand, Mode::Neighbour(site));
+            self.template(
+                0,
+                include_str!("templates/derivative.wgsl"),
+                &[
+                    ("SITE", &k),
+                    ("EFFECT", &c.effects[site.effect.index()].name),
+                    ("TEXT", &text),
+                    ("PARAMS", &params.join(", ")),
+                    ("TYPE", &ty.wgsl()),
+                    ("OPERAND", &operand),
+                    ("ARGS", &args),
+                ],
+            );
+        }
+    }
+
+    /// `mrsl_at_<effect>(pos)`: the effect's value at another position, as this kernel sees it.
+    pub(super) fn neighbour_functions(&mut self) {
+        let c = self.checked();
+        let mut needed: BTreeSet<EffectId> = BTreeSet::new();
+        for k in self.live_sites() {
+            let site = &self.i.deriv.sites[k];
+            needed.extend(site.effects.iter().copied().filter(|e| self.i.graph.live[e.index()]));
+        }
+        for e in needed {
+            let info = &c.effects[e.index()];
+            self.line(
+                0,
+                format!(
+                    "// `{}` at another position, as the {} kernel computes it there.",
+                    info.name,
+                    self.kind.name()
+                ),
+            );
+            self.line(0, format!("fn mrsl_at_{}(mrsl_pos: vec2<i32>) -> {} {{", info.name, info.ty.wgsl()));
+            let chain = self.i.graph.closure(e, c);
+            if chain.iter().any(|x| c.effects[x.index()].rate == Rate::Coarse) {
+                self.resolve_preamble(1);
+            }
+            self.effect_chain(&chain, 1);
+            self.line(1, format!("return {};", self.effect_name(e)));
+            self.line(0, "}");
+            self.line(0, "");
+        }
+    }
+
+    // ---- Evaluating effects ----------------------------------------------------------
+
+    /// Computes `effects` (in dependency order) into locals named after them:
+    /// evaluated, except coarse effects in the fine kernels, which may be resampled.
+    pub(super) fn effect_chain(&mut self, effects: &[EffectId], indent: usize) {
+        let c = self.checked();
+        for &e in effects {
+            if self.kind.is_fine() && c.effects[e.index()].rate == Rate::Coarse {
+                self.resolved_coarse_value(e, indent);
+            } else {
+                self.evaluate(e, indent, "let ");
+            }
+        }
+    }
+
+    /// Evaluates effect `e` at `mrsl_pos` into `{declare}{name}` (`declare`
+    /// is `"let "`, or empty for a variable already declared), declaring its
+    /// refine flag first if it has one.
+    pub(super) fn evaluate(&mut self, e: EffectId, indent: usize, declare: &str) {
+        let info = &self.checked().effects[e.index()];
+        let mut args = vec!["mrsl_pos".to_string()];
+        if info.has_refine {
+            self.line(indent, format!("var mrsl_r_{} = false;", info.name));
+            args.push(format!("&mrsl_r_{}", info.name));
+        }
+        args.extend(self.deps_params(e).into_iter().map(|d| self.effect_name(d)));
+        self.line(indent, format!("{declare}{} = mrsl_eval_{}({});", self.effect_name(e), info.name, args.join(", ")));
+    }
+
+    // ---- Refine flags ----------------------------------------------------------------
+
+    /// Declares the refine flag words `mrsl_flags<w>`, all clear.
+    pub(super) fn declare_flag_words(&mut self, words: u32) {
+        for w in 0..words {
+            self.line(1, format!("var mrsl_flags{w} = 0u;"));
+        }
+    }
+
+    /// Sets effect `e`'s refine flag (if it has one) where it refined or refinement is forced.
+    pub(super) fn set_refine_flag(&mut self, e: EffectId, indent: usize) {
+        if let Some(k) = self.i.interface.refine_bit[e.index()] {
+            let (word, mask) = bit(k);
+            let name = &self.checked().effects[e.index()].name;
+            self.line(indent, format!("if (mrsl_r_{name} || mrsl_force) {{ mrsl_flags{word} |= {mask}u; }}"));
+        }
+    }
+
+    /// Stores the refine flag words at `{buffer}[{base} + w]`.
+    pub(super) fn store_flag_words(&mut self, words: u32, buffer: &str, base: &str) {
+        for w in 0..words {
+            self.line(1, format!("{buffer}[{base} + {w}u] = mrsl_flags{w};"));
+        }
+    }
+}

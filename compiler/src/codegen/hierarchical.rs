@@ -1,0 +1,305 @@
+//! The hierarchical (DACS) kernel: one module with every entry point of the
+//! mode, in dispatch order. Level 0 shades its lattice of pixels. Each
+//! classified level then decides, per pixel of its lattice and per coarse
+//! effect, whether the mean of its previous-level neighbours is good enough
+//! (no key discontinuity, no refine flag among them, small variance) or the
+//! pixel must be shaded; pixels to shade are compacted into the level's work
+//! list, whose count the `hier_args_*` entry point turns into the indirect
+//! dispatch of `hier_shade_*`. `hier_final` reads the records per pixel.
+//! The lattices, work-list capacities and queue layout are the runtime's
+//! too: they come from `mrsl_abi::geometry`.
+
+use super::Writer;
+use super::records::{axis_neighbours, diagonal_neighbours, neighbours};
+use super::words::bit;
+use super::writer::cut;
+use crate::types::{Scalar, Type};
+use mrsl_abi::entry;
+use mrsl_abi::geometry::{
+    COARSE_WORKGROUP, HIERARCHICAL_LEVEL0, HIERARCHICAL_LEVELS, Lattice, QUEUE_WORDS_PER_LEVEL, WORK_LIST_WORKGROUP,
+};
+use std::fmt::Display;
+
+/// How a classified level (1 to 4, dispatched over [`HIERARCHICAL_LEVELS`])
+/// picks its pixels and the neighbours it interpolates from.
+struct Classified {
+    what: &'static str,
+    /// Only lattice points with an odd coordinate sum: the others belong to
+    /// a coarser level.
+    odd_only: bool,
+    neighbours: [(i32, i32); 4],
+}
+
+fn classified_levels() -> [Classified; 4] {
+    [
+        Classified {
+            what: "every 4th pixel offset by (2, 2), from its diagonal neighbours at distance 2",
+            odd_only: false,
+            neighbours: diagonal_neighbours(2),
+        },
+        Classified {
+            what: "the remaining pixels of the 2-grid, from axis neighbours at distance 2",
+            odd_only: true,
+            neighbours: axis_neighbours(2),
+        },
+        Classified {
+            what: "odd pixels, from diagonal neighbours at distance 1",
+            odd_only: false,
+            neighbours: diagonal_neighbours(1),
+        },
+        Classified {
+            what: "the rest, from axis neighbours at distance 1",
+            odd_only: true,
+            neighbours: axis_neighbours(1),
+        },
+    ]
+}
+
+/// The pixel of lattice point `gid.xy`, as WGSL.
+fn lattice_pixel(lattice: Lattice) -> String {
+    let scaled = match lattice.step {
+        1 => "vec2<i32>(gid.xy)".to_string(),
+        step => format!("vec2<i32>(gid.xy) * {step}"),
+    };
+    match lattice.start {
+        0 => scaled,
+        start => format!("vec2<i32>({start}) + {scaled}"),
+    }
+}
+
+/// The workgroup size of the entry points dispatched over a lattice (see
+/// [`Lattice::workgroups`]).
+fn lattice_workgroup() -> String {
+    format!("{COARSE_WORKGROUP}, {COARSE_WORKGROUP}, 1")
+}
+
+impl Writer<'_, '_, '_> {
+    /// The records, the work lists, the per-level queue counters and (in a
+    /// group of their own) the indirect dispatch arguments.
+    pub(super) fn hierarchical_bindings(&mut self) {
+        let l = self.i.layout;
+        let h = &l.hierarchical;
+        self.record_binding("Hierarchical mode: per pixel record (flags, evaluated-mask, values), work lists, queues.");
+        self.template(
+            0,
+            include_str!("templates/hierarchical_queues.wgsl"),
+            &[
+                ("GROUP", &l.interface.group),
+                ("WORK_BINDING", &h.work_binding),
+                ("QUEUE_BINDING", &h.queue_binding),
+                ("ARGS_GROUP", &h.args_group),
+            ],
+        );
+    }
+
+    /// Every entry point, in dispatch order, after the helpers they share.
+    pub(super) fn hierarchical_entries(&mut self) {
+        self.record_helpers();
+        self.work_lists();
+        self.shade_function();
+        self.level0();
+        self.classify_function();
+        for (index, (lattice, level)) in HIERARCHICAL_LEVELS.iter().zip(classified_levels()).enumerate() {
+            // The level's words in the queue (its count first) and in the
+            // indirect arguments (x, y, z).
+            let queue = (index as u32 + 1) * QUEUE_WORDS_PER_LEVEL;
+            let neighbours = neighbours(level.neighbours);
+            let valid = if level.odd_only { "((gid.x + gid.y) & 1u) == 1u" } else { "true" };
+            self.template(
+                0,
+                include_str!("templates/level.wgsl"),
+                &[
+                    ("LEVEL", &(index + 1)),
+                    ("WHAT", &level.what),
+                    ("CLASSIFY_WORKGROUP", &lattice_workgroup()),
+                    ("CLASSIFY", &entry::HIER_CLASSIFY[index]),
+                    ("PIXEL", &lattice_pixel(*lattice)),
+                    ("VALID", &valid),
+                    ("NEIGHBOURS", &neighbours),
+                    ("ARGS", &entry::HIER_ARGS[index]),
+                    ("QUEUE", &queue),
+                    ("ARGS_X", &queue),
+                    ("ARGS_Y", &(queue + 1)),
+                    ("ARGS_Z", &(queue + 2)),
+                    ("WORK_GROUP_LESS_1", &(WORK_LIST_WORKGROUP - 1)),
+                    ("WORK_GROUP", &WORK_LIST_WORKGROUP),
+                    ("SHADE", &entry::HIER_SHADE[index]),
+                ],
+            );
+        }
+        let flag_words = self.i.layout.hierarchical.flag_words;
+        let coarse = self.coarse_live().len();
+        self.record_final(
+            |w| {
+                if coarse == 0 {
+                    return;
+                }
+                w.template(0, include_str!("templates/hierarchical_final.wgsl"), &[("FLAG_WORDS", &flag_words)]);
+                for k in 0..coarse {
+                    let (word, mask) = bit(k as u32);
+                    w.count_refined(k, &format!("(mrsl_values[mrsl_r0 + {}u] & {mask}u) != 0u", flag_words + word));
+                }
+            },
+            |w, e, indent| {
+                let name = &w.checked().effects[e.index()].name;
+                w.line(indent, format!("let {} = mrsl_hget_{name}(mrsl_pos);", w.effect_name(e)));
+            },
+        );
+    }
+
+    /// `mrsl_count` and `mrsl_work_offset`: where each level's work list
+    /// starts, the lists lying one after another with their lattices' sizes.
+    fn work_lists(&mut self) {
+        let [head, tail] = cut(include_str!("templates/work_lists.wgsl"), &["LEVEL_SIZES"]);
+        self.template(0, head, &[]);
+        let last = HIERARCHICAL_LEVELS.len();
+        for (index, l) in HIERARCHICAL_LEVELS[..last - 1].iter().enumerate() {
+            let count = |axis: &str| format!("mrsl_count({}u, {}u, {axis})", l.start, l.step);
+            self.line(1, format!("let c{} = {} * {};", index + 1, count("w"), count("h")));
+        }
+        let mut offset = "0u".to_string();
+        for level in 2..=last {
+            let before: Vec<String> = (1..level).map(|j| format!("c{j}")).collect();
+            offset = format!("select({offset}, {}, level >= {level}u)", before.join(" + "));
+        }
+        self.template(0, tail, &[("OFFSET", &offset)]);
+    }
+
+    /// `mrsl_shade(pos)`: evaluates the coarse effects the pixel's mask names
+    /// (reading the others from the records) and stores their values and
+    /// refine flags.
+    fn shade_function(&mut self) {
+        let c = self.checked();
+        let flag_words = self.i.layout.hierarchical.flag_words;
+        let [head, force, end] = cut(include_str!("templates/shade.wgsl"), &["FLAG_WORDS", "EFFECTS"]);
+        self.template(0, head, &[]);
+        self.declare_flag_words(flag_words);
+        self.template(0, force, &[]);
+        let [evaluate, flag, read] = cut(include_str!("templates/shade_effect.wgsl"), &["EVALUATE", "FLAG"]);
+        for e in self.coarse_live() {
+            let info = &c.effects[e.index()];
+            let (word, mask) = bit(self.coarse_index[&e]);
+            let var = self.effect_name(e);
+            let ty = info.ty.wgsl();
+            let word = flag_words + word;
+            let values: [(&str, &dyn Display); 5] =
+                [("VAR", &var), ("TYPE", &ty), ("WORD", &word), ("MASK", &mask), ("NAME", &info.name)];
+            self.template(1, evaluate, &values);
+            self.evaluate(e, 2, "");
+            self.template(1, flag, &values);
+            self.set_refine_flag(e, 2);
+            self.template(1, read, &values);
+        }
+        self.store_flag_words(flag_words, "mrsl_values", "mrsl_r0");
+        self.template(0, end, &[]);
+    }
+
+    /// Level 0: every pixel of its lattice is shaded.
+    fn level0(&mut self) {
+        let h = &self.i.layout.hierarchical;
+        let coarse = self.coarse_live().len() as u32;
+        let [head, tail] = cut(include_str!("templates/level0.wgsl"), &["MASKS"]);
+        self.template(
+            0,
+            head,
+            &[
+                ("STEP", &HIERARCHICAL_LEVEL0.step),
+                ("WORKGROUP", &lattice_workgroup()),
+                ("ENTRY", &entry::HIER_LEVEL0),
+                ("PIXEL", &lattice_pixel(HIERARCHICAL_LEVEL0)),
+            ],
+        );
+        for w in 0..h.mask_words {
+            let bits = coarse.saturating_sub(w * 32).min(32);
+            let mask = if bits == 32 { u32::MAX } else { (1u32 << bits) - 1 };
+            self.line(1, format!("mrsl_values[r + {}u] = {mask}u;", h.flag_words + w));
+        }
+        self.template(0, tail, &[]);
+    }
+
+    /// `mrsl_classify(p, n, level)`: per coarse effect, interpolate pixel `p`
+    /// from its neighbours `n` or mark it to be shaded; queue it if any is.
+    fn classify_function(&mut self) {
+        let c = self.checked();
+        let iface = self.i.interface;
+        let (fw, mw) = (self.i.layout.hierarchical.flag_words, self.i.layout.hierarchical.mask_words);
+        let [head, note, pairs, keys, end] =
+            cut(include_str!("templates/classify.wgsl"), &["IN_IMAGE", "PAIRS", "KEYS", "EFFECTS"]);
+        self.template(0, head, &[]);
+        self.neighbour_pairs("n", &[], note, ["pair_a", "pair_b"]);
+        self.template(0, pairs, &[]);
+        for key in self.keys() {
+            let name = key.name;
+            let differs = key.differs(&format!("k_{name}"), &format!("mrsl_load_{name}(q[k])"));
+            self.template(0, include_str!("templates/classify_key.wgsl"), &[("NAME", &name), ("DIFFERS", &differs)]);
+        }
+        self.template(0, keys, &[]);
+        for w in 0..mw {
+            self.line(1, format!("var mask{w} = 0u;"));
+        }
+        let [head_effect, tail_effect] = cut(include_str!("templates/classify_effect.wgsl"), &["TESTS"]);
+        for e in self.coarse_live() {
+            let info = &c.effects[e.index()];
+            let (word, mask) = bit(self.coarse_index[&e]);
+            self.template(0, head_effect, &[("NAME", &info.name)]);
+            let mut need = vec!["disc".to_string()];
+            if let Some(b) = iface.refine_bit[e.index()] {
+                // The program's own predicate, as evaluated at the neighbours.
+                let (word, mask) = bit(b);
+                self.template(0, include_str!("templates/classify_flagged.wgsl"), &[("WORD", &word), ("MASK", &mask)]);
+                need.push("flagged".into());
+            }
+            let interpolable = matches!(info.ty, Type::Scalar(Scalar::Float) | Type::Vector(Scalar::Float, _));
+            let value = if interpolable {
+                let zero = format!("{}(0.0)", info.ty.wgsl());
+                let w = |j: usize| format!("select({zero}, v{j}, ok[{j}])");
+                self.line(2, format!("let mean = ({} + {} + {} + {}) / total;", w(0), w(1), w(2), w(3)));
+                let dev = |j: usize| format!("select({zero}, (v{j} - mean) * (v{j} - mean), ok[{j}])");
+                self.line(2, format!("let variance = ({} + {} + {} + {}) / total;", dev(0), dev(1), dev(2), dev(3)));
+                let spread = match info.ty.components() {
+                    1 => "variance",
+                    2 => "max(variance.x, variance.y)",
+                    3 => "max(max(variance.x, variance.y), variance.z)",
+                    _ => "max(max(variance.x, variance.y), max(variance.z, variance.w))",
+                };
+                need.push(format!("!({spread} <= mrsl_ctl.similarity)"));
+                "mean"
+            } else {
+                // Integer, bool and matrix values are copied only when every neighbour agrees.
+                let agree = if matches!(info.ty, Type::Matrix(_)) {
+                    "false".to_string()
+                } else {
+                    let eq = |j: usize| {
+                        if info.ty.components() == 1 {
+                            format!("(!ok[{j}] || v{j} == v0)")
+                        } else {
+                            format!("(!ok[{j}] || all(v{j} == v0))")
+                        }
+                    };
+                    format!("{} && {} && {}", eq(1), eq(2), eq(3))
+                };
+                need.push(format!("!({agree})"));
+                "v0"
+            };
+            self.template(
+                0,
+                tail_effect,
+                &[
+                    ("NEED", &need.join(" || ")),
+                    ("WORD", &word),
+                    ("MASK", &mask),
+                    ("NAME", &info.name),
+                    ("VALUE", &value),
+                ],
+            );
+        }
+        for w in 0..fw {
+            self.line(1, format!("mrsl_values[r + {w}u] = 0u;"));
+        }
+        for w in 0..mw {
+            self.line(1, format!("mrsl_values[r + {}u] = mask{w};", fw + w));
+        }
+        let any: Vec<String> = (0..mw).map(|w| format!("mask{w}")).collect();
+        self.template(0, end, &[("ANY_MASK", &any.join(" | ")), ("QUEUE_WORDS", &QUEUE_WORDS_PER_LEVEL)]);
+    }
+}

@@ -1,0 +1,221 @@
+//! WGSL code generation: the compute kernels a checked program compiles to.
+//!
+//! Each [`KernelKind`] is one WGSL module; its entry points, their workgroup
+//! sizes and the dispatch geometry are the `mrsl_abi` contract, which the
+//! runtime dispatches by. What each kernel does:
+//!
+//! - **coarse** (`coarse_main`, per block size B): one invocation per coarse
+//!   sample (every B-th pixel, plus the last row and column). It evaluates
+//!   the coarse effects, collects their `refine` flags and writes the
+//!   sample's interface record (flag words, then the passed values).
+//! - **fine** (`fine_main`, per B): one invocation per pixel. It resolves
+//!   the four samples around the pixel and decides per coarse effect whether
+//!   to re-evaluate it (a corner flagged it, a discontinuity key differs, or
+//!   a shared slot holds another effect) or to resample the passed values;
+//!   then it evaluates fine effects and stores the outputs, and counts
+//!   re-evaluations in the statistics and the rate image.
+//! - **reference** (`reference_main`): every effect per pixel, what a fully
+//!   refined image must equal.
+//! - **dynamic coarse** (`dynamic_coarse_main`): the dynamic mode's second
+//!   level. The ordinary 4x4 coarse kernel is the first; this one shades 2x2
+//!   samples only inside 4x4 blocks that refined, tagging their records fresh.
+//! - **dynamic fine** (`dynamic_fine_main`): per pixel, a coarse value from
+//!   the 4x4 level, else from the 2x2 level, else evaluated.
+//! - **hierarchical** (`hier_*`, DACS): level 0 shades every 4th pixel; each
+//!   of four finer levels classifies its pixels (interpolate the previous
+//!   levels' neighbours, or shade), compacts the ones to shade into a work
+//!   list and shades it with an indirect dispatch; `hier_final` evaluates
+//!   the fine effects and outputs per pixel from the per-pixel records.
+//! - **checkerboard** (`cb_shade`, `cb_final`): the coarse effects are shaded
+//!   in half the 2x2 quads and reconstructed in the others from the
+//!   edge-adjacent quads; the final pass is the hierarchical one's.
+//!
+//! All kernels share the per-effect functions (`mrsl_eval_<effect>`), so an
+//! effect computes the same value wherever it runs. They differ in what a
+//! position is (a coarse sample or a pixel), in how an effect's value at
+//! another position is obtained (`mrsl_at_<effect>`, for derivatives) and in
+//! their entry points. See docs/language.md, "What the kernels do".
+//!
+//! The modules, from shared to specific: [`writer`] (the text, and fixed WGSL
+//! from `templates/*.wgsl`), [`body`] (user statements and expressions),
+//! [`words`] (values as `u32` words), [`effects`] (what every kernel
+//! declares: bindings, loaders, effect functions, derivatives, key tests),
+//! [`pixel`] (per-pixel entry points), then one module per kernel family:
+//! [`block`] (coarse, fine, reference), [`dynamic`], [`records`] (what the
+//! hierarchical and checkerboard modes share), [`hierarchical`] and
+//! [`checkerboard`].
+
+mod block;
+mod body;
+mod checkerboard;
+mod dynamic;
+mod effects;
+mod hierarchical;
+mod pixel;
+mod records;
+mod words;
+mod writer;
+
+use crate::check::{Checked, EffectId};
+use crate::deriv::DerivInfo;
+use crate::graph::EffectGraph;
+use crate::interface::Interface;
+use crate::syntax::ast::{Rate, Span};
+use body::{Mode, wgsl_ident};
+use mrsl_abi::geometry::{DYNAMIC_INNER_BLOCK, DYNAMIC_OUTER_BLOCK, DYNAMIC_TAG_WORDS, HIERARCHICAL_LEVEL0};
+use mrsl_abi::{KernelKind, Layout};
+use std::collections::HashMap;
+use writer::{Code, Values};
+
+/// Everything the writer reads.
+pub(crate) struct Inputs<'a, 'b> {
+    pub checked: &'b Checked<'a>,
+    pub graph: &'b EffectGraph,
+    pub interface: &'b Interface,
+    pub deriv: &'b DerivInfo<'a>,
+    pub layout: &'b Layout,
+    pub file_name: &'b str,
+    pub source: &'b str,
+}
+
+/// Writes one kernel. `block` is the coarse block size (ignored by the reference kernel).
+pub(crate) fn write_string(inputs: &Inputs, kind: KernelKind, block: u32) -> String {
+    let mut w = Writer::new(inputs, kind, if kind == KernelKind::Reference { 1 } else { block });
+    w.module();
+    w.code.into_string()
+}
+
+/// The state of writing one kernel; every module adds its part with an `impl Writer`.
+struct Writer<'i, 'a, 'b> {
+    i: &'i Inputs<'a, 'b>,
+    kind: KernelKind,
+    block: u32,
+    code: Code,
+    /// Live coarse effects, numbered for refine masks, statistics counters and records.
+    coarse_index: HashMap<EffectId, u32>,
+}
+
+impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
+    fn new(i: &'i Inputs<'a, 'b>, kind: KernelKind, block: u32) -> Self {
+        let coarse_index = i
+            .graph
+            .order
+            .iter()
+            .filter(|e| i.checked.effects[e.index()].rate == Rate::Coarse)
+            .enumerate()
+            .map(|(k, e)| (*e, k as u32))
+            .collect();
+        Writer { i, kind, block, code: Code::default(), coarse_index }
+    }
+
+    fn checked(&self) -> &'b Checked<'a> {
+        self.i.checked
+    }
+
+    fn line(&mut self, indent: usize, text: impl AsRef<str>) {
+        self.code.line(indent, text);
+    }
+
+    /// Writes a template (see [`writer`]) `indent` levels deeper than it stands in its file.
+    fn template(&mut self, indent: usize, template: &str, values: &Values) {
+        self.code.template(indent, template, values);
+    }
+
+    fn effect_name(&self, e: EffectId) -> String {
+        wgsl_ident(&self.checked().effects[e.index()].name)
+    }
+
+    fn line_of(&self, span: Span) -> usize {
+        self.i.source[..(span.start as usize).min(self.i.source.len())].matches('\n').count() + 1
+    }
+
+    /// The live coarse effects in dependency order (numbered by `coarse_index`).
+    fn coarse_live(&self) -> Vec<EffectId> {
+        self.i.graph.order.iter().copied().filter(|e| self.checked().effects[e.index()].rate == Rate::Coarse).collect()
+    }
+
+    /// Effects this kernel computes: the coarse kernels only coarse ones.
+    fn kernel_effects(&self) -> Vec<EffectId> {
+        let c = self.checked();
+        self.i
+            .graph
+            .order
+            .iter()
+            .copied()
+            .filter(|e| !self.kind.is_coarse() || c.effects[e.index()].rate == Rate::Coarse)
+            .collect()
+    }
+
+    fn module(&mut self) {
+        let c = self.checked();
+        let (file, block) = (self.i.file_name, self.block);
+        self.template(
+            0,
+            include_str!("templates/header.wgsl"),
+            &[
+                ("VERSION", &env!("CARGO_PKG_VERSION")),
+                ("FILE", &file),
+                ("WHAT", &describe(self.kind, block)),
+                ("BLOCK", &block),
+            ],
+        );
+        if self.kind != KernelKind::Reference {
+            // The dynamic mode's second level carries a validity tag after each record.
+            let extra = if self.kind == KernelKind::DynamicCoarse { DYNAMIC_TAG_WORDS } else { 0 };
+            self.line(0, format!("const MRSL_STRIDE: u32 = {}u;", self.i.interface.stride + extra));
+        }
+        self.line(0, "");
+        self.bindings();
+        for (k, info) in c.consts.iter().enumerate() {
+            let decl = c.const_decl(crate::check::ConstId(k as u32));
+            let value = self.expr(&decl.value, Mode::Body);
+            self.line(0, format!("const {}: {} = {};", wgsl_ident(&info.name), info.ty.wgsl(), value));
+        }
+        if !c.consts.is_empty() {
+            self.line(0, "");
+        }
+        self.position_helpers();
+        self.input_loaders();
+        for (k, _) in c.functions.iter().enumerate() {
+            self.function(crate::check::FunctionId(k as u32));
+        }
+        for e in self.kernel_effects() {
+            self.eval_function(e);
+        }
+        self.derivative_helpers();
+        self.neighbour_functions();
+        match self.kind {
+            KernelKind::Coarse | KernelKind::DynamicCoarse => self.coarse_entry(),
+            KernelKind::Fine | KernelKind::DynamicFine => {
+                self.fine_support();
+                self.pixel_entry();
+            }
+            KernelKind::Reference => self.pixel_entry(),
+            KernelKind::Hierarchical => self.hierarchical_entries(),
+            KernelKind::Checkerboard => self.checkerboard_entries(),
+        }
+    }
+}
+
+/// What a kernel is, for its header comment.
+fn describe(kind: KernelKind, block: u32) -> String {
+    let (outer, inner) = (DYNAMIC_OUTER_BLOCK, DYNAMIC_INNER_BLOCK);
+    match kind {
+        KernelKind::Coarse => format!("coarse kernel, {block}x{block} blocks: one invocation per coarse sample"),
+        KernelKind::Fine => format!("fine kernel, {block}x{block} blocks: one invocation per pixel"),
+        KernelKind::Reference => "reference kernel: every effect per pixel".to_string(),
+        KernelKind::DynamicCoarse => format!(
+            "dynamic mode, second level: one invocation per {inner}x{inner} coarse sample inside refined {outer}x{outer} blocks"
+        ),
+        KernelKind::DynamicFine => {
+            format!("dynamic mode, fine kernel: {outer}x{outer}, then {inner}x{inner}, then per pixel")
+        }
+        KernelKind::Hierarchical => format!(
+            "hierarchical (DACS) mode: every {}th pixel, then four levels interpolated or shaded",
+            HIERARCHICAL_LEVEL0.step
+        ),
+        KernelKind::Checkerboard => {
+            "checkerboard baseline: half the 2x2 quads shaded, the rest reconstructed".to_string()
+        }
+    }
+}

@@ -1,0 +1,150 @@
+//! Per-pixel entry points, as the fine, reference, dynamic fine and the
+//! record modes' final passes share them: lanes mapped to the pixels of a
+//! tile, the in-image guard, the effects in dependency order, the output
+//! stores, and the per-workgroup statistics that must all reach a barrier.
+
+use super::Writer;
+use super::writer::cut;
+use crate::check::EffectId;
+use crate::syntax::ast::Rate;
+use crate::types::{Scalar, Type};
+use mrsl_abi::KernelKind;
+use mrsl_abi::geometry::{PIXEL_WORKGROUP, TILE};
+
+impl Writer<'_, '_, '_> {
+    /// Whether the kernel counts per-pixel re-evaluations of coarse effects
+    /// (statistics and rate image): the per-pixel kernels that can reuse
+    /// coarse values, when there are live coarse effects.
+    pub(super) fn counts_stats(&self) -> bool {
+        let per_pixel_reuse =
+            self.kind.is_fine() || matches!(self.kind, KernelKind::Hierarchical | KernelKind::Checkerboard);
+        per_pixel_reuse && !self.coarse_live().is_empty()
+    }
+
+    /// The statistics counters (global and per workgroup) and the rate image.
+    pub(super) fn stats_bindings(&mut self) {
+        let l = self.i.layout;
+        let [head, tail] = cut(include_str!("templates/stats.wgsl"), &["BUFFER"]);
+        self.template(0, head, &[]);
+        self.stats_buffer();
+        self.template(
+            0,
+            tail,
+            &[
+                ("COUNTERS", &self.coarse_live().len()),
+                ("RATE_GROUP", &l.rate_image.group),
+                ("RATE_BINDING", &l.rate_image.binding),
+            ],
+        );
+    }
+
+    /// The global statistics counters (layout `stats`).
+    pub(super) fn stats_buffer(&mut self) {
+        let stats = &self.i.layout.stats;
+        self.template(
+            0,
+            include_str!("templates/stats_buffer.wgsl"),
+            &[("GROUP", &stats.group), ("BINDING", &stats.binding)],
+        );
+    }
+
+    /// `mrsl_tile_pixel` for tiles shaded in `block`x`block` blocks: consecutive
+    /// lanes cover whole blocks.
+    pub(super) fn tile_pixel_blocks(&mut self, block: u32) {
+        self.template(
+            0,
+            include_str!("templates/tile_pixel_blocks.wgsl"),
+            &[("TILE", &TILE), ("BLOCK", &block), ("PER_BLOCK", &(block * block)), ("BLOCKS_X", &(TILE / block))],
+        );
+    }
+
+    /// `mrsl_tile_pixel` for tiles shaded in row-major order.
+    pub(super) fn tile_pixel_rows(&mut self) {
+        self.template(0, include_str!("templates/tile_pixel_rows.wgsl"), &[("TILE", &TILE)]);
+    }
+
+    /// The kernel's main entry point, one lane per pixel of a tile (after
+    /// `mrsl_tile_pixel`). Inside the image, `prologue` runs (refine
+    /// decisions, rate image, statistics), then every live effect in
+    /// dependency order: coarse ones as `coarse` writes them (at an
+    /// indentation), the others evaluated; then the outputs are stored.
+    ///
+    /// Pixels outside the image return at once unless the kernel counts
+    /// statistics: then every lane must reach the barrier before the
+    /// workgroup's counters are added up, so they skip the work instead.
+    pub(super) fn pixel_main(
+        &mut self,
+        prologue: impl FnOnce(&mut Self),
+        mut coarse: impl FnMut(&mut Self, EffectId, usize),
+    ) {
+        let [x, y, z] = self.kind.workgroup_size();
+        self.template(
+            0,
+            include_str!("templates/pixel_main.wgsl"),
+            &[("WORKGROUP", &format!("{x}, {y}, {z}")), ("ENTRY", &self.kind.main_entry_point())],
+        );
+        let counted = self.counts_stats();
+        // The record modes' final passes keep one shape, counting or not.
+        let returns = !counted && !matches!(self.kind, KernelKind::Hierarchical | KernelKind::Checkerboard);
+        let indent = if returns {
+            self.line(1, "if (any(mrsl_pos >= mrsl_grid())) { return; }");
+            1
+        } else {
+            self.line(1, "if (all(mrsl_pos < mrsl_grid())) {");
+            2
+        };
+        prologue(self);
+        let order = self.i.graph.order.clone();
+        for &e in &order {
+            if self.checked().effects[e.index()].rate == Rate::Coarse {
+                coarse(self, e, indent);
+            } else {
+                self.evaluate(e, indent, "let ");
+            }
+        }
+        self.output_stores(&order, indent);
+        if !returns {
+            self.line(1, "}");
+        }
+        if counted {
+            self.template(
+                0,
+                include_str!("templates/stats_flush.wgsl"),
+                &[("COUNTERS", &self.coarse_live().len()), ("WORKGROUP", &PIXEL_WORKGROUP)],
+            );
+        }
+        self.line(0, "}");
+    }
+
+    /// Counts coarse effect `k` as re-evaluated by this pixel where `condition` holds.
+    pub(super) fn count_refined(&mut self, k: usize, condition: &str) {
+        self.line(2, format!("if ({condition}) {{ atomicAdd(&mrsl_wg_stats[{k}], 1u); }}"));
+    }
+
+    fn output_stores(&mut self, order: &[EffectId], indent: usize) {
+        let c = self.checked();
+        for e in order {
+            let info = &c.effects[e.index()];
+            if info.rate != Rate::Out {
+                continue;
+            }
+            let value = to_vec4(&self.effect_name(*e), &info.ty);
+            self.line(indent, format!("textureStore(mrsl_out_{}, mrsl_pos, {value});", info.name));
+        }
+    }
+}
+
+/// Widens an output value to the `vec4` that `textureStore` takes.
+fn to_vec4(value: &str, ty: &Type) -> String {
+    let (s, one) = match ty.scalar() {
+        Some(Scalar::Uint) => ("u32", "1u"),
+        Some(Scalar::Int) => ("i32", "1i"),
+        _ => ("f32", "1.0"),
+    };
+    match ty.components() {
+        1 => format!("vec4<{s}>({value}, 0, 0, {one})"),
+        2 => format!("vec4<{s}>({value}, 0, {one})"),
+        3 => format!("vec4<{s}>({value}, {one})"),
+        _ => value.to_string(),
+    }
+}

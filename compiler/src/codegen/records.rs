@@ -1,0 +1,95 @@
+//! Per-pixel records, shared by the hierarchical and checkerboard modes:
+//! both shade coarse effects at some pixels into a record per pixel
+//! (`mrsl_values`, layout `hierarchical`), fill the other pixels' records
+//! from neighbours that were shaded, and finish with one final per-pixel
+//! pass that reads the coarse values from the records. What they share: the
+//! record binding and accessors, the neighbour-pair test (neighbours in
+//! opposite pairs, only complete pairs used) and the final pass.
+
+use super::Writer;
+use super::words::{pack_words, unpack_words};
+use super::writer::cut;
+use crate::check::EffectId;
+
+/// The four neighbours at distance `d` along the axes, in opposite pairs (0, 1) and (2, 3).
+pub(super) fn axis_neighbours(d: i32) -> [(i32, i32); 4] {
+    [(-d, 0), (d, 0), (0, -d), (0, d)]
+}
+
+/// The four neighbours at distance `d` along the diagonals, in opposite pairs (0, 1) and (2, 3).
+pub(super) fn diagonal_neighbours(d: i32) -> [(i32, i32); 4] {
+    [(-d, -d), (d, d), (d, -d), (-d, d)]
+}
+
+/// The neighbours of pixel `p` at `offsets`, as a WGSL `array<vec2<i32>, 4>`.
+pub(super) fn neighbours(offsets: [(i32, i32); 4]) -> String {
+    let points: Vec<String> = offsets.iter().map(|(x, y)| format!("p + vec2<i32>({x}, {y})")).collect();
+    format!("array<vec2<i32>, 4>({})", points.join(", "))
+}
+
+impl Writer<'_, '_, '_> {
+    /// The record buffer, after a comment on what the mode keeps in it.
+    pub(super) fn record_binding(&mut self, what: &str) {
+        let l = self.i.layout;
+        self.template(
+            0,
+            include_str!("templates/record_binding.wgsl"),
+            &[("WHAT", &what), ("GROUP", &l.interface.group), ("BINDING", &l.hierarchical.values_binding)],
+        );
+    }
+
+    /// `mrsl_rec`, and `mrsl_hget_X` / `mrsl_hput_X` for every live coarse effect.
+    pub(super) fn record_helpers(&mut self) {
+        let c = self.checked();
+        let h = &self.i.layout.hierarchical;
+        self.template(0, include_str!("templates/records.wgsl"), &[("RECORD", &h.record_words)]);
+        let [access, end] = cut(include_str!("templates/record_access.wgsl"), &["STORES"]);
+        for (k, &e) in self.coarse_live().iter().enumerate() {
+            let info = &c.effects[e.index()];
+            let unpack = unpack_words(&info.ty, "mrsl_values");
+            let values = [
+                ("NAME", &info.name as &dyn std::fmt::Display),
+                ("TYPE", &info.ty.wgsl()),
+                ("OFFSET", &h.value_offsets[k]),
+                ("UNPACK", &unpack),
+            ];
+            self.template(0, access, &values);
+            for (j, word) in pack_words("v", &info.ty).iter().enumerate() {
+                self.line(1, format!("mrsl_values[base + {j}u] = {word};"));
+            }
+            self.template(0, end, &[]);
+        }
+        self.line(0, "");
+    }
+
+    /// The neighbour-pair test both record modes decide with, over
+    /// `ok: array<bool, 4>` and the neighbours `{points}[k]` in opposite pairs
+    /// (0, 1) and (2, 3): `ok[k]` is whether neighbour k lies inside the
+    /// image (and passes the `tap_tests` lines, written inside the loop);
+    /// then `note` (a template section); then `let {pairs[0]}` and
+    /// `let {pairs[1]}` say whether each pair is complete. Only complete
+    /// pairs are used, so that a mean stays centred (exact for linear values).
+    pub(super) fn neighbour_pairs(&mut self, points: &str, tap_tests: &[String], note: &str, pairs: [&str; 2]) {
+        let [head, tests, tail] = cut(include_str!("templates/neighbour_pairs.wgsl"), &["TAP_TESTS", "NOTE"]);
+        let values = [("POINTS", &points as &dyn std::fmt::Display), ("A", &pairs[0]), ("B", &pairs[1])];
+        self.template(0, head, &values);
+        for test in tap_tests {
+            self.line(2, test);
+        }
+        self.template(0, tests, &values);
+        self.template(0, note, &[]);
+        self.template(0, tail, &values);
+    }
+
+    /// The final pass of a record mode: one lane per pixel of a tile in row
+    /// order, `prologue`, then coarse effects as `coarse` writes them and
+    /// the others evaluated, then the outputs (see [`Writer::pixel_main`]).
+    pub(super) fn record_final(
+        &mut self,
+        prologue: impl FnOnce(&mut Self),
+        coarse: impl FnMut(&mut Self, EffectId, usize),
+    ) {
+        self.tile_pixel_rows();
+        self.pixel_main(prologue, coarse);
+    }
+}

@@ -1,0 +1,9 @@
+        let mrsl_shaded = mrsl_shaded_quad(mrsl_pos) || mrsl_ctl.force_refine != 0u;
+        let mrsl_ok = mrsl_taps(mrsl_pos);
+        // No usable tap (isolated by discontinuities): shaded here instead.
+        let mrsl_alone = !mrsl_shaded && !(mrsl_ok[0] || mrsl_ok[1] || mrsl_ok[2] || mrsl_ok[3]);
+{{#STATS}}
+        textureStore(mrsl_rate, mrsl_pos, vec4<u32>(select(0u, {{ALL}}u, mrsl_shaded || mrsl_alone), 0u, 0u, 1u));
+        if (mrsl_shaded || mrsl_alone) {
+{{#COUNTS}}
+        }

@@ -1,0 +1,2 @@
+    // Refine flags (all set when the runtime forces refinement).
+    let mrsl_force = mrsl_ctl.force_refine != 0u;

@@ -1,0 +1,8 @@
+var {{VAR}}: {{TYPE}};
+if ((mrsl_values[mrsl_r0 + {{WORD}}u] & {{MASK}}u) != 0u) {
+{{#EVALUATE}}
+    mrsl_hput_{{NAME}}(mrsl_pos, {{VAR}});
+{{#FLAG}}
+} else {
+    {{VAR}} = mrsl_hget_{{NAME}}(mrsl_pos);
+}

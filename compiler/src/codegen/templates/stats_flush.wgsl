@@ -1,0 +1,4 @@
+    workgroupBarrier();
+    for (var k = mrsl_li; k < {{COUNTERS}}u; k += {{WORKGROUP}}u) {
+        atomicAdd(&mrsl_stats[k], atomicLoad(&mrsl_wg_stats[k]));
+    }
