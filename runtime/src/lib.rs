@@ -34,6 +34,7 @@ mod shader;
 mod stats;
 
 pub use error::Error;
+use mrsl_abi::geometry::{DYNAMIC_INNER_BLOCK, DYNAMIC_OUTER_BLOCK};
 pub use mrsl_abi::{CompiledProgram, KernelKind, Layout, ReadError};
 pub use shader::{Bindings, DispatchOptions, Shader, wgpu_format};
 pub use stats::{EffectStats, Stats, Timings};
@@ -91,9 +92,9 @@ impl Mode {
             Mode::Coarse4x4 => &[(KernelKind::Coarse, Some(4)), (KernelKind::Fine, Some(4))],
             // The 4x4 level is the ordinary 4x4 coarse kernel; the dynamic mode has its own fine kernel.
             Mode::Dynamic => &[
-                (KernelKind::Coarse, Some(4)),
-                (KernelKind::DynamicCoarse, Some(2)),
-                (KernelKind::DynamicFine, Some(4)),
+                (KernelKind::Coarse, Some(DYNAMIC_OUTER_BLOCK)),
+                (KernelKind::DynamicCoarse, Some(DYNAMIC_INNER_BLOCK)),
+                (KernelKind::DynamicFine, Some(DYNAMIC_OUTER_BLOCK)),
             ],
             Mode::Hierarchical => &[(KernelKind::Hierarchical, None)],
             Mode::Checkerboard => &[(KernelKind::Checkerboard, None)],
@@ -105,7 +106,8 @@ impl Mode {
         match self {
             Mode::Reference | Mode::Hierarchical | Mode::Checkerboard => None,
             Mode::Coarse2x2 => Some(2),
-            Mode::Coarse4x4 | Mode::Dynamic => Some(4),
+            Mode::Coarse4x4 => Some(4),
+            Mode::Dynamic => Some(DYNAMIC_OUTER_BLOCK),
         }
     }
 }

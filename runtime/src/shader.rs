@@ -304,8 +304,9 @@ impl Shader {
             return Err(Error::BadSize { width, height, reason: format!("the largest supported side is {MAX_SIDE}") });
         }
         if mode == Mode::Dynamic {
-            let (nx, ny) = geometry::sample_grid(bindings.size, 2);
-            let bytes = nx as u64 * ny as u64 * (self.layout.interface.stride_words as u64 + 1) * 4;
+            let (nx, ny) = geometry::sample_grid(bindings.size, geometry::DYNAMIC_INNER_BLOCK);
+            let words = u64::from(self.layout.interface.stride_words + geometry::DYNAMIC_TAG_WORDS);
+            let bytes = nx as u64 * ny as u64 * words * 4;
             if bytes > MAX_STORAGE_BINDING_BYTES {
                 return Err(Error::BadSize {
                     width,
@@ -472,8 +473,11 @@ impl Shader {
                     let interface = self.interface(device, block, false, bindings.size).clone();
                     self.ensure_rate_image(device, bindings.size);
                     let dynamic = mode == Mode::Dynamic;
-                    let inner =
-                        if dynamic { Some(self.interface(device, 2, true, bindings.size).clone()) } else { None };
+                    let inner = if dynamic {
+                        Some(self.interface(device, geometry::DYNAMIC_INNER_BLOCK, true, bindings.size).clone())
+                    } else {
+                        None
+                    };
                     let coarse_stage = self.stage_group(device, KernelKind::Coarse, Some(&interface), None, &views);
                     let fine_kind = if dynamic { KernelKind::DynamicFine } else { KernelKind::Fine };
                     let fine_stage = self.stage_group(device, fine_kind, Some(&interface), inner.as_ref(), &views);
@@ -497,9 +501,9 @@ impl Shader {
                             encoder,
                             "mrsl dynamic coarse 2x2",
                             3,
-                            (KernelKind::DynamicCoarse, Some(2), entry::DYNAMIC_COARSE),
+                            (KernelKind::DynamicCoarse, Some(geometry::DYNAMIC_INNER_BLOCK), entry::DYNAMIC_COARSE),
                             &[&resources, &gbuffer, &stage],
-                            geometry::coarse_workgroups(bindings.size, 2),
+                            geometry::coarse_workgroups(bindings.size, geometry::DYNAMIC_INNER_BLOCK),
                         );
                     }
                     let fine_entry = if dynamic { entry::DYNAMIC_FINE } else { entry::FINE };
@@ -683,7 +687,8 @@ impl Shader {
     /// The interface buffer for `block`, (re)created when the size changes.
     /// Tagged records (the dynamic mode's 2x2 level) have one more word.
     fn interface(&mut self, device: &wgpu::Device, block: u32, tagged: bool, size: (u32, u32)) -> &wgpu::Buffer {
-        let stride = (self.layout.interface.stride_words + u32::from(tagged)).max(1) as u64;
+        let tag = if tagged { geometry::DYNAMIC_TAG_WORDS } else { 0 };
+        let stride = (self.layout.interface.stride_words + tag).max(1) as u64;
         let fresh = self.interfaces.get(&(block, tagged)).is_none_or(|(_, s)| *s != size);
         if fresh {
             let (nx, ny) = geometry::sample_grid(size, block);

@@ -3,7 +3,7 @@
 use crate::{compile, run};
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::scene::{ChannelData, GBuffer, Scene};
-use mrsl_runtime::{Bindings, DispatchOptions, Error, Mode, Shader};
+use mrsl_runtime::{Bindings, CompiledProgram, DispatchOptions, Error, Mode, Shader};
 
 const PROGRAM: &str = "
 in float3 normal;
@@ -88,6 +88,31 @@ pub fn extra_channels_are_ignored(gpu: &Gpu) {
     run(gpu, &program, &gbuffer, Mode::Coarse2x2, false).unwrap();
     let empty = GBuffer { width: 8, height: 8, channels: vec![] };
     assert_eq!(run(gpu, &program, &empty, Mode::Reference, false).err(), Some(Error::MissingChannel("depth".into())));
+}
+
+/// Kernels read back from the files `mrslc compile` writes, and kernels the
+/// runtime compiles at load time (its `compile` feature), render exactly the
+/// image of the compiler's own program; a broken source is a typed error
+/// carrying the rendered diagnostics.
+pub fn precompiled_and_load_time_kernels_render_alike(gpu: &Gpu) {
+    let source = include_str!("../../examples/demo.mrsl");
+    let program = compile(source);
+    let gbuffer = Scene::Demo.render(64, 40);
+    let dir = std::env::temp_dir().join(format!("mrsl-render-precompiled-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    program.compiled.write_dir(&dir, "demo").unwrap();
+    let from_files = CompiledProgram::read_dir(&dir, None).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    let at_load = mrsl_runtime::compile(source, "demo.mrsl").unwrap();
+    for mode in [Mode::Reference, Mode::Dynamic, Mode::Hierarchical] {
+        let expected = run(gpu, &program, &gbuffer, mode, false).unwrap().pixels;
+        assert!(run(gpu, &from_files, &gbuffer, mode, false).unwrap().pixels == expected, "{mode}: from files");
+        assert!(run(gpu, &at_load, &gbuffer, mode, false).unwrap().pixels == expected, "{mode}: compiled at load");
+    }
+    match mrsl_runtime::compile("fine out float4 color = float4(nope);", "bad.mrsl") {
+        Err(Error::Compile(text)) => assert!(text.contains("E0100") && text.contains("bad.mrsl"), "{text}"),
+        other => panic!("expected a compile error, got {:?}", other.map(|_| ())),
+    }
 }
 
 /// A mode whose kernels were not compiled is a typed error, not a panic.

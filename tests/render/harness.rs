@@ -2,7 +2,7 @@
 
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::scene::GBuffer;
-use mrsl_runtime::{Bindings, DispatchOptions, Error, Mode, Shader, Stats};
+use mrsl_runtime::{Bindings, CompiledProgram, DispatchOptions, Error, Mode, Shader, Stats};
 use std::sync::OnceLock;
 
 /// The shared device, or `None` when there is no adapter outside CI, after
@@ -57,7 +57,7 @@ pub fn compile(source: &str) -> mrsl::Program {
 /// values (a deterministic ramp) so that every example can run.
 pub fn run(
     gpu: &Gpu,
-    program: &mrsl::Program,
+    program: &CompiledProgram,
     gbuffer: &GBuffer,
     mode: Mode,
     force_refine: bool,

@@ -21,6 +21,7 @@ const GPU_TESTS: &[(&str, fn(&mrsl_lab::gpu::Gpu))] = &[
     ("errors::binding_mismatches_are_typed_errors", errors::binding_mismatches_are_typed_errors),
     ("errors::extra_channels_are_ignored", errors::extra_channels_are_ignored),
     ("errors::modes_without_kernels_are_unsupported", errors::modes_without_kernels_are_unsupported),
+    ("errors::precompiled_and_load_time_kernels_render_alike", errors::precompiled_and_load_time_kernels_render_alike),
     (
         "modes::forced_refinement_equals_reference_for_every_example",
         modes::forced_refinement_equals_reference_for_every_example,
