@@ -168,10 +168,8 @@ pub fn summarize_mode(points: &[Point], scene: &str, mode: &str) -> Option<ModeS
     if sweep.is_empty() {
         return None;
     }
-    let speedup = |q: f64| match time_at_quality(&sweep, q, |p| p.mssim) {
-        // A bound on the time (reached by the cheapest point) is a lower bound on the speedup.
-        t => t.map(|t| reference.time_ms() / t),
-    };
+    // A bound on the time (reached by the cheapest point) is a lower bound on the speedup.
+    let speedup = |q: f64| time_at_quality(&sweep, q, |p| p.mssim).map(|t| reference.time_ms() / t);
     let s990 = speedup(0.99);
     // The shaded fraction at MSSIM 0.99, interpolated along the same frontier.
     let front = frontier(&sweep, |p| p.mssim);

@@ -231,9 +231,10 @@ fn bench_generated(c: &mut Criterion) {
             bench.iter(|| mrsl::compile(black_box(source), black_box(&default)))
         });
 
-        // naga's share of `compile_default`: parsing and validating the five kernels.
+        // naga's share of `compile_default`: parsing and validating the nine kernels.
         let kernels: Vec<String> = mrsl::compile(&source, &default)
             .expect("generated program compiles")
+            .compiled
             .kernels
             .into_iter()
             .map(|k| k.wgsl)

@@ -371,12 +371,12 @@ impl Shader {
         for ch in &self.layout.channels {
             let t = bindings.channels.get(&ch.name).ok_or_else(|| Error::MissingChannel(ch.name.clone()))?;
             let need = ch.ty.components();
-            let fits = match (ch.sample_type, t.format().sample_type(None, None)) {
-                (SampleType::Uint, Some(wgpu::TextureSampleType::Uint)) => true,
-                (SampleType::Sint, Some(wgpu::TextureSampleType::Sint)) => true,
-                (SampleType::UnfilterableFloat, Some(wgpu::TextureSampleType::Float { .. })) => true,
-                _ => false,
-            } && t.format().components() as u32 >= need.min(4)
+            let fits = matches!(
+                (ch.sample_type, t.format().sample_type(None, None)),
+                (SampleType::Uint, Some(wgpu::TextureSampleType::Uint))
+                    | (SampleType::Sint, Some(wgpu::TextureSampleType::Sint))
+                    | (SampleType::UnfilterableFloat, Some(wgpu::TextureSampleType::Float { .. }))
+            ) && t.format().components() as u32 >= need.min(4)
                 && (need != 3 || t.format().components() == 4);
             if !fits {
                 return Err(Error::ChannelFormat {

@@ -16,8 +16,11 @@ mod sponza;
 pub use harness::*;
 use libtest_mimic::{Arguments, Trial};
 
+/// A test that needs a device.
+type GpuTest = (&'static str, fn(&mrsl_lab::gpu::Gpu));
+
 /// Tests that need a device.
-const GPU_TESTS: &[(&str, fn(&mrsl_lab::gpu::Gpu))] = &[
+const GPU_TESTS: &[GpuTest] = &[
     ("errors::binding_mismatches_are_typed_errors", errors::binding_mismatches_are_typed_errors),
     ("errors::extra_channels_are_ignored", errors::extra_channels_are_ignored),
     ("errors::modes_without_kernels_are_unsupported", errors::modes_without_kernels_are_unsupported),

@@ -101,7 +101,7 @@ pub fn sponza_coarse_modes_stay_close_to_the_reference(gpu: &Gpu) {
         // Independently of the runtime's formula: every B-th pixel along each
         // axis, plus the last pixel when the lattice misses it.
         let block = mode.block_size().unwrap();
-        let per_axis = |n: u32| u64::from(n.div_ceil(block) + u32::from((n - 1) % block != 0));
+        let per_axis = |n: u32| u64::from(n.div_ceil(block) + u32::from(!(n - 1).is_multiple_of(block)));
         let samples = per_axis(SIZE.0) * per_axis(SIZE.1);
         assert_eq!(out.stats.coarse_samples, samples);
         let mut shaded = 0u64;
