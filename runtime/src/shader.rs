@@ -303,56 +303,38 @@ impl Shader {
         if width > MAX_SIDE || height > MAX_SIDE {
             return Err(Error::BadSize { width, height, reason: format!("the largest supported side is {MAX_SIDE}") });
         }
-        if mode == Mode::Dynamic {
-            let (nx, ny) = geometry::sample_grid(bindings.size, geometry::DYNAMIC_INNER_BLOCK);
-            let words = u64::from(self.layout.interface.stride_words + geometry::DYNAMIC_TAG_WORDS);
-            let bytes = nx as u64 * ny as u64 * words * 4;
+        // Every buffer a mode allocates must fit one storage binding.
+        let fits = |what: &str, words: u64| {
+            let bytes = words * 4;
             if bytes > MAX_STORAGE_BINDING_BYTES {
-                return Err(Error::BadSize {
-                    width,
-                    height,
-                    reason: format!(
-                        "the 2x2 level would need {} MiB, more than a 128 MiB storage binding",
-                        bytes >> 20
-                    ),
-                });
+                let limit = MAX_STORAGE_BINDING_BYTES >> 20;
+                let reason = format!("{what} would need {} MiB, more than a {limit} MiB storage binding", bytes >> 20);
+                return Err(Error::BadSize { width, height, reason });
             }
+            Ok(())
+        };
+        let samples = |block| {
+            let (nx, ny) = geometry::sample_grid(bindings.size, block);
+            u64::from(nx) * u64::from(ny)
+        };
+        let pixels = u64::from(width) * u64::from(height);
+        if let Some(block) = mode.block_size() {
+            fits("the interface", samples(block) * u64::from(self.layout.interface.stride_words))?;
         }
-        if mode == Mode::Hierarchical {
-            // Work lists hold about 1.56 words per pixel; a level's shading
-            // dispatch covers at most 65535 workgroups of 64 lanes.
-            let pixels = width as u64 * height as u64;
-            if pixels * 2 * 4 > MAX_STORAGE_BINDING_BYTES
-                || pixels / 2 > 65535 * u64::from(geometry::WORK_LIST_WORKGROUP)
-            {
-                return Err(Error::BadSize { width, height, reason: "the hierarchical work lists would exceed the storage or dispatch limits (about 4 million pixels per level)".into() });
-            }
+        if mode == Mode::Dynamic {
+            let words = u64::from(self.layout.interface.stride_words + geometry::DYNAMIC_TAG_WORDS);
+            fits("the 2x2 level", samples(geometry::DYNAMIC_INNER_BLOCK) * words)?;
         }
         if matches!(mode, Mode::Hierarchical | Mode::Checkerboard) {
-            let bytes = width as u64 * height as u64 * self.layout.hierarchical.record_words as u64 * 4;
-            if bytes > MAX_STORAGE_BINDING_BYTES {
-                return Err(Error::BadSize {
-                    width,
-                    height,
-                    reason: format!(
-                        "the hierarchical records would need {} MiB, more than a 128 MiB storage binding",
-                        bytes >> 20
-                    ),
-                });
-            }
+            fits("the hierarchical records", pixels * u64::from(self.layout.hierarchical.record_words))?;
         }
-        if let Some(block) = mode.block_size() {
-            let (nx, ny) = geometry::sample_grid(bindings.size, block);
-            let bytes = nx as u64 * ny as u64 * self.layout.interface.stride_words as u64 * 4;
-            if bytes > MAX_STORAGE_BINDING_BYTES {
-                return Err(Error::BadSize {
-                    width,
-                    height,
-                    reason: format!(
-                        "the interface would need {} MiB, more than a 128 MiB storage binding",
-                        bytes >> 20
-                    ),
-                });
+        if mode == Mode::Hierarchical {
+            fits("the hierarchical work lists", geometry::work_list_words(bindings.size))?;
+            // The last level queues at most half the pixels; its indirect
+            // dispatch covers at most 65535 workgroups.
+            if pixels / 2 > 65535 * u64::from(geometry::WORK_LIST_WORKGROUP) {
+                let reason = "a hierarchical level would need more than 65535 workgroups".into();
+                return Err(Error::BadSize { width, height, reason });
             }
         }
         let check_size = |what: &'static str, name: &str, t: &wgpu::Texture| {

@@ -69,6 +69,16 @@ pub fn binding_mismatches_are_typed_errors(gpu: &Gpu) {
     // Empty target.
     bindings.size = (0, 8);
     assert!(matches!(dispatch(gpu, &mut shader, &bindings), Err(Error::BadSize { .. })));
+    // A target whose per-pixel records would not fit one storage binding,
+    // checked before any texture is looked at.
+    bindings.size = (16384, 16384);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    match shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, DispatchOptions::new(Mode::Hierarchical)) {
+        Err(Error::BadSize { reason, .. }) => {
+            assert!(reason.contains("hierarchical records") && reason.contains("128 MiB"), "{reason}")
+        }
+        other => panic!("expected a size error, got {other:?}"),
+    }
     bindings.size = (16, 8);
     // And with everything right, it runs.
     dispatch(gpu, &mut shader, &bindings).unwrap();
