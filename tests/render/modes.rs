@@ -38,7 +38,7 @@ pub fn forced_refinement_equals_reference_for_every_example(gpu: &Gpu) {
                 .max()
                 .unwrap();
             assert_eq!(worst, 0, "{name} {mode}: forced refinement differs from the reference by up to {worst} ulps");
-            for e in out.stats.effects.iter().filter(|e| e.rate == mrsl::syntax::ast::Rate::Coarse) {
+            for e in out.stats.effects.iter().filter(|e| e.rate == mrsl_abi::Rate::Coarse) {
                 assert_eq!(
                     e.pixel_evaluations,
                     75 * 43,
