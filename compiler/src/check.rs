@@ -7,6 +7,7 @@
 
 use crate::diagnostic::{Diagnostic, Label};
 use crate::syntax::ast::*;
+use crate::syntax::visit_expr;
 use crate::types::{self, Scalar, Type};
 use mrsl_abi::TextureFormat;
 use std::collections::{HashMap, HashSet};
@@ -812,7 +813,7 @@ impl<'a> Checker<'a> {
     /// evaluates such expressions when the shader is created).
     fn is_constant(&self, e: &Expr) -> bool {
         let mut constant = true;
-        crate::deriv::visit_expr(e, &mut |x| match &x.kind {
+        visit_expr(e, &mut |x| match &x.kind {
             ExprKind::Name(n) => constant &= matches!(self.globals.get(n), Some((Global::Const(_), _))),
             ExprKind::Call { callee, .. } => constant &= Type::from_name(&callee.name).is_some(),
             ExprKind::Index { .. } | ExprKind::Field { .. } | ExprKind::Ternary(..) => constant = false,

@@ -7,13 +7,14 @@
 //! point. See docs/language.md, "What the kernels do", for the contract.
 
 use crate::check::{Callee, Checked, EffectId, KeyCompare, LocalId, Symbol, UniformKind};
-use crate::deriv::{DerivInfo, visit_expr, visit_stmt_exprs};
+use crate::deriv::DerivInfo;
 use crate::graph::EffectGraph;
 use crate::interface::Interface;
 use crate::layout;
 use mrsl_abi::geometry::TILE;
 use mrsl_abi::{CONTROL_FIELDS, Layout, entry};
 use crate::syntax::ast::*;
+use crate::syntax::{visit_expr, visit_stmt_exprs};
 use crate::types::{Scalar, Type};
 use std::collections::{BTreeSet, HashMap};
 
