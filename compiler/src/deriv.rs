@@ -84,8 +84,9 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
         }
         for (statement, call) in calls {
             let ExprKind::Call { callee, args } = &call.kind else { continue };
+            let Some(Callee::Builtin(builtin)) = checked.callees.get(&call.id) else { continue };
             // A call with the wrong arity was already reported by the checker.
-            let Some(operand) = args.get(if callee.name == "sample" { 2 } else { 0 }) else { continue };
+            let Some(operand) = builtin.derivative_operand().and_then(|k| args.get(k)) else { continue };
             let mut walk = OperandWalk {
                 checked,
                 facts: &facts,
@@ -115,7 +116,7 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
 
 fn collect_derivative_calls<'a>(e: &'a Expr, checked: &Checked, out: &mut dyn FnMut(&'a Expr)) {
     visit_expr(e, &mut |x| {
-        if matches!(checked.callees.get(&x.id), Some(Callee::Builtin(b)) if crate::check::is_derivative(b)) {
+        if matches!(checked.callees.get(&x.id), Some(Callee::Builtin(b)) if b.is_derivative()) {
             out(x);
         }
     });
@@ -211,7 +212,7 @@ impl<'a> LocalFacts<'a> {
                 Some(Symbol::Local(l)) if self.is_invariant(*l) => {}
                 _ => invariant = false,
             },
-            ExprKind::Call { .. } if matches!(checked.callees.get(&x.id), Some(Callee::Builtin(b)) if crate::check::is_derivative(b)) => {
+            ExprKind::Call { .. } if matches!(checked.callees.get(&x.id), Some(Callee::Builtin(b)) if b.is_derivative()) => {
                 invariant = false
             }
             _ => {}

@@ -26,6 +26,7 @@
 //!
 //! The crate does no I/O and touches no GPU: everything here runs anywhere.
 
+pub mod builtins;
 pub mod check;
 pub mod deriv;
 pub mod diagnostic;

@@ -5,9 +5,10 @@
 
 use super::formats::{default_output_format, formats_for, output_format_fits};
 use super::{
-    BUILTINS, Checker, ConstId, ConstInfo, ConstValue, EffectId, EffectInfo, FunctionId, FunctionInfo, Global, InputId,
+    Checker, ConstId, ConstInfo, ConstValue, EffectId, EffectInfo, FunctionId, FunctionInfo, Global, InputId,
     InputInfo, KeyCompare, UniformId, UniformInfo, UniformKind, err,
 };
+use crate::builtins::Builtin;
 use crate::diagnostic::{Diagnostic, Label};
 use crate::syntax::ast::*;
 use crate::types::{Scalar, Type};
@@ -20,7 +21,7 @@ impl Checker<'_> {
             let name = item.name();
             // A reserved name is reported but still registered (unbound), so
             // that ids stay aligned with the items they index.
-            let reserved = BUILTINS.contains(&name.name.as_str()) || Type::from_name(&name.name).is_some();
+            let reserved = Builtin::from_name(&name.name).is_some() || Type::from_name(&name.name).is_some();
             if reserved {
                 self.error(err(
                     "E0103",

@@ -5,7 +5,8 @@
 use super::builtins::{BuiltinError, builtin_type};
 use super::names::{TYPE_NAMES, suggest};
 use super::typing::{binary_type, construct_check, unify};
-use super::{BUILTINS, Callee, Checker, Ctx, Global, LocalId, Symbol, err, is_derivative};
+use super::{Callee, Checker, Ctx, Global, LocalId, Symbol, err};
+use crate::builtins::Builtin;
 use crate::diagnostic::{Diagnostic, Label};
 use crate::syntax::ast::*;
 use crate::types::{self, Scalar, Type};
@@ -304,7 +305,10 @@ impl Checker<'_> {
 
     fn call(&mut self, e: &Expr, callee: &Ident, args: &[Expr]) -> Type {
         let name = callee.name.as_str();
-        if is_derivative(name) {
+        // Builtin names are reserved, so a builtin's name always means the builtin.
+        let builtin = Builtin::from_name(name);
+        let derivative = builtin.is_some_and(Builtin::is_derivative);
+        if derivative {
             match self.ctx {
                 Ctx::Effect(id) => {
                     if self.in_derivative {
@@ -317,7 +321,7 @@ impl Checker<'_> {
                 _ => {
                     self.error(
                         err("E0501", format!("`{name}` outside an effect body"), e.span, "derivatives need a sample position")
-                            .with_note(if name == "sample" {
+                            .with_note(if builtin == Some(Builtin::Sample) {
                                 "inside functions use `sample_level` or `sample_grad`, or pass the sampled value as an argument"
                             } else {
                                 "compute the derivative in the effect and pass it as an argument"
@@ -327,14 +331,14 @@ impl Checker<'_> {
             }
         }
         let was_in_derivative = self.in_derivative;
-        if is_derivative(name) {
+        if derivative {
             self.in_derivative = true;
         }
         let arg_types: Vec<Type> = args.iter().map(|a| self.expr(a)).collect();
         self.in_derivative = was_in_derivative;
         if arg_types.iter().any(|t| t.is_error()) {
             // Still resolve the callee so unknown functions are reported.
-            if Type::from_name(name).is_none() && !BUILTINS.contains(&name) && !self.globals.contains_key(name) {
+            if Type::from_name(name).is_none() && builtin.is_none() && !self.globals.contains_key(name) {
                 self.error(err("E0100", format!("unknown function `{name}`"), callee.span, "not found"));
             }
             return Type::Error;
@@ -400,7 +404,7 @@ impl Checker<'_> {
             }
             return ret;
         }
-        if let Some(builtin) = BUILTINS.iter().find(|b| **b == name) {
+        if let Some(builtin) = builtin {
             self.out.callees.insert(e.id, Callee::Builtin(builtin));
             return match builtin_type(builtin, &arg_types) {
                 Ok((ret, splat_to)) => {
@@ -442,7 +446,11 @@ impl Checker<'_> {
             .collect();
         if let Some(s) = suggest(
             name,
-            BUILTINS.iter().copied().chain(functions.iter().map(|s| s.as_str())).chain(TYPE_NAMES.iter().copied()),
+            Builtin::ALL
+                .iter()
+                .map(|b| b.name())
+                .chain(functions.iter().map(|s| s.as_str()))
+                .chain(TYPE_NAMES.iter().copied()),
         ) {
             d = d.with_note(format!("did you mean `{s}`?"));
         }

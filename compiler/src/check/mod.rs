@@ -11,6 +11,7 @@
 //! `typing`, `builtins` and `formats` are the rules those passes apply, and
 //! `names` makes the "did you mean" suggestions.
 
+use crate::builtins::Builtin;
 use crate::diagnostic::{Diagnostic, Label};
 use crate::syntax::ast::*;
 use crate::types::Type;
@@ -62,7 +63,7 @@ pub enum Symbol {
 /// What a call expression calls.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Callee {
-    Builtin(&'static str),
+    Builtin(Builtin),
     Function(FunctionId),
     /// A constructor or conversion to this type.
     Construct(Type),
@@ -199,69 +200,6 @@ impl Checked<'_> {
     }
 }
 
-/// Builtin functions, by name; see docs/language.md for their signatures.
-pub const BUILTINS: &[&str] = &[
-    "sin",
-    "cos",
-    "tan",
-    "asin",
-    "acos",
-    "atan",
-    "sinh",
-    "cosh",
-    "tanh",
-    "exp",
-    "exp2",
-    "log",
-    "log2",
-    "sqrt",
-    "inversesqrt",
-    "floor",
-    "ceil",
-    "fract",
-    "round",
-    "trunc",
-    "saturate",
-    "radians",
-    "degrees",
-    "abs",
-    "sign",
-    "pow",
-    "atan2",
-    "step",
-    "min",
-    "max",
-    "clamp",
-    "mix",
-    "lerp",
-    "smoothstep",
-    "dot",
-    "cross",
-    "normalize",
-    "length",
-    "distance",
-    "reflect",
-    "refract",
-    "faceforward",
-    "determinant",
-    "transpose",
-    "any",
-    "all",
-    "ddx",
-    "ddy",
-    "fwidth",
-    "sample",
-    "sample_level",
-    "sample_grad",
-    "load",
-    "texture_size",
-];
-
-/// Derivative builtins: they need the operand at the neighbouring sample.
-pub fn is_derivative(name: &str) -> bool {
-    matches!(name, "ddx" | "ddy" | "fwidth" | "sample")
-}
-
 /// Checks a parsed program. Returns the side tables and every diagnostic
 /// (errors and warnings); the caller decides whether errors stop compilation.
 pub fn check(program: &Program) -> (Checked<'_>, Vec<Diagnostic>) {
@@ -368,16 +306,9 @@ impl<'a> Checker<'a> {
     /// Declares a local in the innermost scope, reporting duplicates there.
     fn declare_local(&mut self, name: &Ident, ty: Type, is_param: bool) -> LocalId {
         let id = self.new_local(name, ty, is_param);
-        if self.globals.contains_key(&name.name) || BUILTINS.contains(&name.name.as_str()) {
-            // Shadowing a global is allowed (as in C), but a builtin is reserved.
-            if BUILTINS.contains(&name.name.as_str()) {
-                self.error(err(
-                    "E0103",
-                    format!("`{}` is a builtin function name", name.name),
-                    name.span,
-                    "reserved name",
-                ));
-            }
+        // Shadowing a global is allowed (as in C), but a builtin is reserved.
+        if Builtin::from_name(&name.name).is_some() {
+            self.error(err("E0103", format!("`{}` is a builtin function name", name.name), name.span, "reserved name"));
         }
         let scope = self.scopes.last_mut().expect("locals are declared inside a scope");
         if let Some(previous) = scope.insert(name.name.clone(), id) {
