@@ -31,7 +31,6 @@ use std::collections::{BTreeSet, HashMap, HashSet};
 #[derive(Debug, Clone)]
 pub struct DerivSite<'a> {
     pub effect: EffectId,
-    pub call: NodeId,
     /// The expression that is differentiated (for `sample`, the uv argument).
     pub operand: &'a Expr,
     /// Invariant locals the operand reads; passed as arguments.
@@ -104,7 +103,6 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
             info.site_of.insert(call.id, info.sites.len());
             info.sites.push(DerivSite {
                 effect: id,
-                call: call.id,
                 operand,
                 params: params.into_iter().collect(),
                 effects: effects.into_iter().collect(),
@@ -245,24 +243,24 @@ impl<'a> LocalFacts<'a> {
         };
         match &s.kind {
             StmtKind::Local { init, .. } => {
-                if let Some(local) = checked.local_decls.get(&s.id) {
-                    if varying_flow || init.as_ref().is_some_and(|e| !self.expr_invariant(e, checked)) {
-                        mark(self, *local);
-                    }
+                if let Some(local) = checked.local_decls.get(&s.id)
+                    && (varying_flow || init.as_ref().is_some_and(|e| !self.expr_invariant(e, checked)))
+                {
+                    mark(self, *local);
                 }
             }
             StmtKind::Assign { target, value, .. } => {
-                if let Some(local) = root_local(target, checked) {
-                    if varying_flow || !self.expr_invariant(value, checked) || !self.expr_invariant(target, checked) {
-                        mark(self, local);
-                    }
+                if let Some(local) = root_local(target, checked)
+                    && (varying_flow || !self.expr_invariant(value, checked) || !self.expr_invariant(target, checked))
+                {
+                    mark(self, local);
                 }
             }
             StmtKind::Step { target, .. } => {
-                if let Some(local) = root_local(target, checked) {
-                    if varying_flow {
-                        mark(self, local);
-                    }
+                if let Some(local) = root_local(target, checked)
+                    && varying_flow
+                {
+                    mark(self, local);
                 }
             }
             StmtKind::If { cond, then, otherwise } => {
@@ -340,18 +338,17 @@ fn collect_assignments<'a>(
             }
         }
         StmtKind::For { init, step, body, .. } => {
-            if let Some(i) = init {
-                if let (StmtKind::Local { init: Some(v), .. }, Some(local)) = (&i.kind, checked.local_decls.get(&i.id))
-                {
-                    out.push(Assignment {
-                        local: *local,
-                        value: Some(v),
-                        nested: true,
-                        declaration: true,
-                        for_init: true,
-                        statement,
-                    });
-                }
+            if let Some(i) = init
+                && let (StmtKind::Local { init: Some(v), .. }, Some(local)) = (&i.kind, checked.local_decls.get(&i.id))
+            {
+                out.push(Assignment {
+                    local: *local,
+                    value: Some(v),
+                    nested: true,
+                    declaration: true,
+                    for_init: true,
+                    statement,
+                });
             }
             if let Some(st) = step {
                 collect_assignments(st, checked, out, true, statement);
