@@ -50,7 +50,7 @@ impl Checker<'_> {
             match item {
                 Item::Input(d) => {
                     let ty = self.resolve_type(&d.ty);
-                    self.out.inputs.push(InputInfo { name: d.name.name.clone(), ty, key: None, span: d.span });
+                    self.out.inputs.push(InputInfo { name: d.name.name.clone(), ty, key: None });
                 }
                 Item::Uniform(d) => {
                     let ty = self.resolve_type(&d.ty);
@@ -59,7 +59,7 @@ impl Checker<'_> {
                         Type::Sampler => UniformKind::Sampler,
                         _ => UniformKind::Value { default: None },
                     };
-                    self.out.uniforms.push(UniformInfo { name: d.name.name.clone(), ty, kind, span: d.span });
+                    self.out.uniforms.push(UniformInfo { name: d.name.name.clone(), ty, kind });
                 }
                 Item::Const(d) => {
                     let ty = self.resolve_type(&d.ty);
@@ -82,7 +82,6 @@ impl Checker<'_> {
                         rate: d.rate,
                         ty,
                         item: index,
-                        span: d.span,
                         name_span: d.name.span,
                         deps: vec![],
                         has_refine: false,

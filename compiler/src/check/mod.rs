@@ -72,14 +72,15 @@ pub enum Callee {
 /// How a discontinuity-key channel is compared (part of the layout contract).
 pub use mrsl_abi::KeyCompare;
 
+/// A G-buffer input (`in`).
 #[derive(Debug, Clone)]
 pub struct InputInfo {
     pub name: String,
     pub ty: Type,
     pub key: Option<KeyCompare>,
-    pub span: Span,
 }
 
+/// What a uniform binds to: a value in the uniform block, or a resource.
 #[derive(Debug, Clone, PartialEq)]
 pub enum UniformKind {
     Value { default: Option<ConstValue> },
@@ -92,9 +93,9 @@ pub struct UniformInfo {
     pub name: String,
     pub ty: Type,
     pub kind: UniformKind,
-    pub span: Span,
 }
 
+/// A `const`; `item` indexes `Program::items`, as in the other infos.
 #[derive(Debug, Clone)]
 pub struct ConstInfo {
     pub name: String,
@@ -103,6 +104,7 @@ pub struct ConstInfo {
     pub item: usize,
 }
 
+/// A user function.
 #[derive(Debug, Clone)]
 pub struct FunctionInfo {
     pub name: String,
@@ -113,13 +115,13 @@ pub struct FunctionInfo {
     pub calls: Vec<FunctionId>,
 }
 
+/// An effect or output.
 #[derive(Debug, Clone)]
 pub struct EffectInfo {
     pub name: String,
     pub rate: Rate,
     pub ty: Type,
     pub item: usize,
-    pub span: Span,
     pub name_span: Span,
     /// Effects this one reads, with the first place it reads each.
     pub deps: Vec<(EffectId, Span)>,
@@ -133,6 +135,7 @@ pub struct EffectInfo {
     pub format: Option<TextureFormat>,
 }
 
+/// A local variable, a parameter, or a block effect's result.
 #[derive(Debug, Clone)]
 pub struct LocalInfo {
     pub name: String,
@@ -140,7 +143,6 @@ pub struct LocalInfo {
     pub span: Span,
     /// Assigned anywhere after its declaration (or, for parameters, at all).
     pub reassigned: bool,
-    pub is_param: bool,
 }
 
 /// A compile-time value: a scalar, vector or matrix of numbers.
@@ -194,9 +196,6 @@ impl Checked<'_> {
             Item::Const(c) => c,
             _ => unreachable!("const ids index const items"),
         }
-    }
-    pub fn effect_by_name(&self, name: &str) -> Option<EffectId> {
-        self.effects.iter().position(|e| e.name == name).map(|i| EffectId(i as u32))
     }
 }
 
@@ -297,15 +296,15 @@ impl<'a> Checker<'a> {
         }
     }
 
-    fn new_local(&mut self, name: &Ident, ty: Type, is_param: bool) -> LocalId {
+    fn new_local(&mut self, name: &Ident, ty: Type) -> LocalId {
         let id = LocalId(self.out.locals.len() as u32);
-        self.out.locals.push(LocalInfo { name: name.name.clone(), ty, span: name.span, reassigned: false, is_param });
+        self.out.locals.push(LocalInfo { name: name.name.clone(), ty, span: name.span, reassigned: false });
         id
     }
 
     /// Declares a local in the innermost scope, reporting duplicates there.
-    fn declare_local(&mut self, name: &Ident, ty: Type, is_param: bool) -> LocalId {
-        let id = self.new_local(name, ty, is_param);
+    fn declare_local(&mut self, name: &Ident, ty: Type) -> LocalId {
+        let id = self.new_local(name, ty);
         // Shadowing a global is allowed (as in C), but a builtin is reserved.
         if Builtin::from_name(&name.name).is_some() {
             self.error(err("E0103", format!("`{}` is a builtin function name", name.name), name.span, "reserved name"));

@@ -37,7 +37,7 @@ impl Checker<'_> {
             if matches!(ty, Type::Array(..)) {
                 self.error(err("E0104", "functions cannot take arrays", p.ty.span, "unsupported parameter type"));
             }
-            params.push(self.declare_local(&p.name, ty, true));
+            params.push(self.declare_local(&p.name, ty));
         }
         self.out.functions[id.index()].params = params;
         let ret = self.out.functions[id.index()].ret.clone();
@@ -74,7 +74,7 @@ impl Checker<'_> {
             }
             EffectBody::Block(block) => {
                 let ty = self.out.effects[id.index()].ty.clone();
-                let result = self.declare_local(&e.name, ty, false);
+                let result = self.declare_local(&e.name, ty);
                 self.out.locals[result.index()].reassigned = true;
                 self.out.effects[id.index()].result = Some(result);
                 self.block(block);
@@ -124,7 +124,7 @@ impl Checker<'_> {
                     let t = self.expr(init);
                     self.expect_type(&t, &declared, init.span, "initialiser");
                 }
-                let id = self.declare_local(name, declared, false);
+                let id = self.declare_local(name, declared);
                 self.out.local_decls.insert(s.id, id);
             }
             StmtKind::Assign { target, op, value } => {
