@@ -53,10 +53,7 @@ impl Checker<'_> {
                     f.name.span,
                     "not every path returns",
                 )
-                .with_label(Label::secondary(
-                    Span { start: f.body.span.end.saturating_sub(1), end: f.body.span.end },
-                    "can reach the end here",
-                )),
+                .with_label(Label::secondary(closing_brace(&f.body), "can reach the end here")),
             );
         }
         self.scopes.pop();
@@ -87,10 +84,7 @@ impl Checker<'_> {
                             e.name.span,
                             "declared here",
                         )
-                        .with_label(Label::secondary(
-                            Span { start: block.span.end.saturating_sub(1), end: block.span.end },
-                            "may reach the end unassigned",
-                        ))
+                        .with_label(Label::secondary(closing_brace(block), "may reach the end unassigned"))
                         .with_note(format!("assign `{} = ...;` on every path through the body", e.name.name)),
                     );
                 }
@@ -322,6 +316,11 @@ impl Checker<'_> {
             }
         }
     }
+}
+
+/// The closing brace of a block: where a path that falls through ends.
+fn closing_brace(block: &Block) -> Span {
+    Span { start: block.span.end.saturating_sub(1), end: block.span.end }
 }
 
 /// Whether every path through `block` that reaches its end assigns `name`.
