@@ -323,7 +323,7 @@ fn report(color: Color, diagnostics: &[Diagnostic], name: &str, source: &str) {
     };
     if colored {
         let mut stream = StandardStream::stderr(ColorChoice::Always);
-        let _ = mrsl::diagnostic::emit_colored(&mut stream, diagnostics, name, source);
+        let _ = mrsl::emit_colored(&mut stream, diagnostics, name, source);
     } else {
         eprint!("{}", mrsl::render_all(diagnostics, name, source));
     }

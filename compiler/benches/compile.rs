@@ -2,22 +2,23 @@
 //!
 //! Run with `cargo bench -p mrsl --bench compile`. Three groups:
 //!
-//! * `examples`: full [`mrsl::compile`] (default options: coarse + fine kernels
-//!   for block sizes 2 and 4, plus the reference kernel, each validated by naga)
-//!   of every `examples/*.mrsl`.
+//! * `examples`: full [`mrsl::compile`] (default options: the nine kernels,
+//!   coarse and fine for block sizes 2 and 4, reference, dynamic coarse and
+//!   fine, hierarchical and checkerboard, each validated by naga) of every
+//!   `examples/*.mrsl`.
 //! * `generated`: a generated program of N effects (N = 25 .. 400) mixing
 //!   refining coarse effects, chains, blocker/shadow pairs, fine effects and one
 //!   output, measured at four depths: `check` (front end only), `interface`
 //!   (slot allocation alone, on a pre-built checked program and graph),
-//!   `compile_b4` (one block size: 3 kernels), `compile_default` (5 kernels),
-//!   and `naga_validate` (naga parsing + validation of the 5 kernels alone, the
+//!   `compile_b4` (one block size: 7 kernels), `compile_default` (9 kernels),
+//!   and `naga_validate` (naga parsing + validation of the 9 kernels alone, the
 //!   part of `compile_default` that is not mrsl's own code).
-//! * `colouring`: [`mrsl::interface::colour`] alone on deterministic random
+//! * `colouring`: [`mrsl::internals::colour`] alone on deterministic random
 //!   graphs (~30% edge density) around the exact/heuristic cut-off
-//!   ([`mrsl::interface::EXACT_LIMIT`]).
+//!   ([`mrsl::internals::EXACT_LIMIT`]).
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use mrsl::check::EffectId;
+use mrsl::internals::EffectId;
 use std::hint::black_box;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -207,10 +208,10 @@ fn bench_generated(c: &mut Criterion) {
         });
 
         // The same sequence as `mrsl::compile`, stopped before allocation.
-        let program = mrsl::syntax::parse(&source).expect("generated program parses");
-        let (checked, _) = mrsl::check::check(&program);
-        let (graph, _) = mrsl::graph::build(&checked);
-        let interface = mrsl::interface::allocate(&checked, &graph);
+        let program = mrsl::internals::parse(&source).expect("generated program parses");
+        let (checked, _) = mrsl::internals::check_ast(&program);
+        let (graph, _) = mrsl::internals::build_graph(&checked);
+        let interface = mrsl::internals::allocate_interface(&checked, &graph);
         eprintln!(
             "generated/{n}: {} bytes of source, {} passed effects, {} interference edges, {} slots, stride {} words, exact: {}",
             source.len(),
@@ -221,7 +222,7 @@ fn bench_generated(c: &mut Criterion) {
             interface.exact
         );
         group.bench_function(BenchmarkId::new("interface", n), |bench| {
-            bench.iter(|| mrsl::interface::allocate(black_box(&checked), black_box(&graph)))
+            bench.iter(|| mrsl::internals::allocate_interface(black_box(&checked), black_box(&graph)))
         });
 
         group.bench_with_input(BenchmarkId::new("compile_b4", n), &source, |bench, source| {
@@ -279,11 +280,11 @@ fn bench_colouring(c: &mut Criterion) {
     configure(&mut group);
     for n in COLOUR_SIZES {
         let (nodes, sizes, edges) = random_graph(n, 0x2545_F491_4F6C_DD1D ^ n as u64);
-        let (classes, exact) = mrsl::interface::colour(&nodes, &sizes, &edges);
+        let (classes, exact) = mrsl::internals::colour(&nodes, &sizes, &edges);
         let width: u32 = classes.iter().map(|c| c.iter().map(|&k| sizes[k]).max().unwrap_or(0)).sum();
         eprintln!("colouring/{n}: {} edges, {} slots, {width} words, exact: {exact}", edges.len(), classes.len());
         group.bench_function(BenchmarkId::from_parameter(n), |bench| {
-            bench.iter(|| mrsl::interface::colour(black_box(&nodes), black_box(&sizes), black_box(&edges)))
+            bench.iter(|| mrsl::internals::colour(black_box(&nodes), black_box(&sizes), black_box(&edges)))
         });
     }
     group.finish();

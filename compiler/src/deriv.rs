@@ -24,13 +24,13 @@
 use crate::check::{Callee, Checked, EffectId, LocalId, Symbol};
 use crate::diagnostic::{Diagnostic, Label};
 use crate::syntax::ast::*;
+use crate::syntax::{visit_expr, visit_stmt_exprs};
 use std::collections::{BTreeSet, HashMap, HashSet};
 
 /// How one derivative site is recomputed at a neighbour.
 #[derive(Debug, Clone)]
 pub struct DerivSite<'a> {
     pub effect: EffectId,
-    pub call: NodeId,
     /// The expression that is differentiated (for `sample`, the uv argument).
     pub operand: &'a Expr,
     /// Invariant locals the operand reads; passed as arguments.
@@ -83,8 +83,9 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
         }
         for (statement, call) in calls {
             let ExprKind::Call { callee, args } = &call.kind else { continue };
+            let Some(Callee::Builtin(builtin)) = checked.callees.get(&call.id) else { continue };
             // A call with the wrong arity was already reported by the checker.
-            let Some(operand) = args.get(if callee.name == "sample" { 2 } else { 0 }) else { continue };
+            let Some(operand) = builtin.derivative_operand().and_then(|k| args.get(k)) else { continue };
             let mut walk = OperandWalk {
                 checked,
                 facts: &facts,
@@ -102,7 +103,6 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
             info.site_of.insert(call.id, info.sites.len());
             info.sites.push(DerivSite {
                 effect: id,
-                call: call.id,
                 operand,
                 params: params.into_iter().collect(),
                 effects: effects.into_iter().collect(),
@@ -114,68 +114,10 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
 
 fn collect_derivative_calls<'a>(e: &'a Expr, checked: &Checked, out: &mut dyn FnMut(&'a Expr)) {
     visit_expr(e, &mut |x| {
-        if matches!(checked.callees.get(&x.id), Some(Callee::Builtin(b)) if crate::check::is_derivative(b)) {
+        if matches!(checked.callees.get(&x.id), Some(Callee::Builtin(b)) if b.is_derivative()) {
             out(x);
         }
     });
-}
-
-/// Calls `f` on every top-level expression of a statement (recursively through sub-statements).
-pub fn visit_stmt_exprs<'a>(s: &'a Stmt, f: &mut dyn FnMut(&'a Expr)) {
-    match &s.kind {
-        StmtKind::Local { init, .. } => init.iter().for_each(|e| f(e)),
-        StmtKind::Assign { target, value, .. } => {
-            f(target);
-            f(value);
-        }
-        StmtKind::Step { target, .. } => f(target),
-        StmtKind::If { cond, then, otherwise } => {
-            f(cond);
-            visit_stmt_exprs(then, f);
-            if let Some(o) = otherwise {
-                visit_stmt_exprs(o, f);
-            }
-        }
-        StmtKind::For { init, cond, step, body } => {
-            if let Some(i) = init {
-                visit_stmt_exprs(i, f);
-            }
-            if let Some(c) = cond {
-                f(c);
-            }
-            if let Some(st) = step {
-                visit_stmt_exprs(st, f);
-            }
-            visit_stmt_exprs(body, f);
-        }
-        StmtKind::Block(b) => b.stmts.iter().for_each(|s| visit_stmt_exprs(s, f)),
-        StmtKind::Return(e) => e.iter().for_each(|e| f(e)),
-        StmtKind::Refine | StmtKind::Break | StmtKind::Continue => {}
-    }
-}
-
-/// Visits an expression and all its sub-expressions, parents first.
-pub fn visit_expr<'a>(e: &'a Expr, f: &mut dyn FnMut(&'a Expr)) {
-    f(e);
-    match &e.kind {
-        ExprKind::Unary(_, a) => visit_expr(a, f),
-        ExprKind::Binary(_, a, b) => {
-            visit_expr(a, f);
-            visit_expr(b, f);
-        }
-        ExprKind::Ternary(a, b, c) => {
-            visit_expr(a, f);
-            visit_expr(b, f);
-            visit_expr(c, f);
-        }
-        ExprKind::Call { args, .. } => args.iter().for_each(|a| visit_expr(a, f)),
-        ExprKind::Field { base, .. } => visit_expr(base, f),
-        ExprKind::Index { base, index } => {
-            visit_expr(base, f);
-            visit_expr(index, f);
-        }
-        _ => {}
-    }
 }
 
 /// One assignment to a local, as collected from an effect body.
@@ -268,7 +210,7 @@ impl<'a> LocalFacts<'a> {
                 Some(Symbol::Local(l)) if self.is_invariant(*l) => {}
                 _ => invariant = false,
             },
-            ExprKind::Call { .. } if matches!(checked.callees.get(&x.id), Some(Callee::Builtin(b)) if crate::check::is_derivative(b)) => {
+            ExprKind::Call { .. } if matches!(checked.callees.get(&x.id), Some(Callee::Builtin(b)) if b.is_derivative()) => {
                 invariant = false
             }
             _ => {}
@@ -301,24 +243,24 @@ impl<'a> LocalFacts<'a> {
         };
         match &s.kind {
             StmtKind::Local { init, .. } => {
-                if let Some(local) = checked.local_decls.get(&s.id) {
-                    if varying_flow || init.as_ref().is_some_and(|e| !self.expr_invariant(e, checked)) {
-                        mark(self, *local);
-                    }
+                if let Some(local) = checked.local_decls.get(&s.id)
+                    && (varying_flow || init.as_ref().is_some_and(|e| !self.expr_invariant(e, checked)))
+                {
+                    mark(self, *local);
                 }
             }
             StmtKind::Assign { target, value, .. } => {
-                if let Some(local) = root_local(target, checked) {
-                    if varying_flow || !self.expr_invariant(value, checked) || !self.expr_invariant(target, checked) {
-                        mark(self, local);
-                    }
+                if let Some(local) = root_local(target, checked)
+                    && (varying_flow || !self.expr_invariant(value, checked) || !self.expr_invariant(target, checked))
+                {
+                    mark(self, local);
                 }
             }
             StmtKind::Step { target, .. } => {
-                if let Some(local) = root_local(target, checked) {
-                    if varying_flow {
-                        mark(self, local);
-                    }
+                if let Some(local) = root_local(target, checked)
+                    && varying_flow
+                {
+                    mark(self, local);
                 }
             }
             StmtKind::If { cond, then, otherwise } => {
@@ -396,18 +338,17 @@ fn collect_assignments<'a>(
             }
         }
         StmtKind::For { init, step, body, .. } => {
-            if let Some(i) = init {
-                if let (StmtKind::Local { init: Some(v), .. }, Some(local)) = (&i.kind, checked.local_decls.get(&i.id))
-                {
-                    out.push(Assignment {
-                        local: *local,
-                        value: Some(v),
-                        nested: true,
-                        declaration: true,
-                        for_init: true,
-                        statement,
-                    });
-                }
+            if let Some(i) = init
+                && let (StmtKind::Local { init: Some(v), .. }, Some(local)) = (&i.kind, checked.local_decls.get(&i.id))
+            {
+                out.push(Assignment {
+                    local: *local,
+                    value: Some(v),
+                    nested: true,
+                    declaration: true,
+                    for_init: true,
+                    statement,
+                });
             }
             if let Some(st) = step {
                 collect_assignments(st, checked, out, true, statement);

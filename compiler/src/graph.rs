@@ -6,10 +6,11 @@ use crate::syntax::ast::{Rate, Span};
 use petgraph::algo::tarjan_scc;
 use petgraph::graph::{DiGraph, NodeIndex};
 
-/// Effects and outputs as nodes, uses as edges (from the used effect to its user).
+/// What the later stages need of the graph whose nodes are effects and
+/// outputs and whose edges are uses (from the used effect to its user); the
+/// graph itself is only needed while [`build`] checks it.
 #[derive(Debug)]
 pub struct EffectGraph {
-    pub graph: DiGraph<EffectId, Span>,
     /// Topological order, dependencies first; only effects that reach an output.
     pub order: Vec<EffectId>,
     /// For each effect, the effects that read it.
@@ -106,7 +107,7 @@ pub fn build(checked: &Checked) -> (EffectGraph, Vec<Diagnostic>) {
             .map(|nodes| nodes.into_iter().map(|n| graph[n]).filter(|e| live[e.index()]).collect())
             .unwrap_or_default()
     };
-    (EffectGraph { graph, order, users, live }, diagnostics)
+    (EffectGraph { order, users, live }, diagnostics)
 }
 
 /// A simple cycle through the nodes of one strongly connected component,

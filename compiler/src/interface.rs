@@ -47,10 +47,6 @@ impl PassCondition {
     pub fn possible(&self) -> bool {
         self.fine_user || !self.refining_users.is_empty()
     }
-    /// Evaluates the condition for given refine flags.
-    pub fn holds(&self, me: EffectId, refined: &dyn Fn(EffectId) -> bool) -> bool {
-        !(self.self_refines && refined(me)) && (self.fine_user || self.refining_users.iter().any(|u| refined(*u)))
-    }
 }
 
 /// One slot of the interface record.

@@ -26,18 +26,29 @@
 //!
 //! The crate does no I/O and touches no GPU: everything here runs anywhere.
 
-pub mod check;
+mod builtins;
+mod check;
 mod codegen;
-pub mod deriv;
-pub mod diagnostic;
-pub mod graph;
-pub mod interface;
-pub mod layout;
-pub mod syntax;
-pub mod types;
+mod deriv;
+mod diagnostic;
+mod graph;
+mod interface;
+mod layout;
+mod syntax;
+mod types;
 
-pub use diagnostic::{Diagnostic, Label, Severity, render_all};
+pub use diagnostic::{Diagnostic, Label, Severity, emit_colored, render_all};
 pub use mrsl_abi::{CompiledProgram, Kernel, KernelKind, Layout};
+
+/// The stages behind [`compile`], for the compiler's own benchmarks and tests
+/// only: not part of the API, and free to change with the stages.
+#[doc(hidden)]
+pub mod internals {
+    pub use crate::check::{EffectId, check as check_ast};
+    pub use crate::graph::build as build_graph;
+    pub use crate::interface::{EXACT_LIMIT, allocate as allocate_interface, colour};
+    pub use crate::syntax::parse;
+}
 
 /// Which kernels to generate, and for which block sizes.
 #[derive(Debug, Clone, PartialEq)]
@@ -71,9 +82,6 @@ impl Default for Options {
         }
     }
 }
-
-/// Block sizes the generated kernels support.
-pub const BLOCK_SIZES: [u32; 2] = [2, 4];
 
 /// A compiled program: kernels and layout (dereferences to the
 /// [`CompiledProgram`] the runtime takes), and the warnings found on the way.
@@ -111,6 +119,18 @@ pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnosti
         generate(source, options, checked, graph, deriv, diagnostics)
     })?
 }
+
+/// Parses and validates WGSL with naga, as WebGPU requires (no optional capabilities).
+pub fn validate_wgsl(wgsl: &str) -> Result<(), String> {
+    let module = naga::front::wgsl::parse_str(wgsl).map_err(|e| e.emit_to_string_with_path(wgsl, "generated.wgsl"))?;
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
+        .validate(&module)
+        .map_err(|e| e.emit_to_string_with_path(wgsl, "generated.wgsl"))?;
+    Ok(())
+}
+
+/// Block sizes the generated kernels support.
+const BLOCK_SIZES: [u32; 2] = [2, 4];
 
 /// Everything after the checks: interface, layout, kernels and their validation.
 fn generate(
@@ -209,13 +229,4 @@ fn front_end<R>(
 
 fn sort(diagnostics: &mut [Diagnostic]) {
     diagnostics.sort_by_key(|d| (d.span().map(|s| s.start).unwrap_or(u32::MAX), d.code));
-}
-
-/// Parses and validates WGSL with naga, as WebGPU requires (no optional capabilities).
-pub fn validate_wgsl(wgsl: &str) -> Result<(), String> {
-    let module = naga::front::wgsl::parse_str(wgsl).map_err(|e| e.emit_to_string_with_path(wgsl, "generated.wgsl"))?;
-    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
-        .validate(&module)
-        .map_err(|e| e.emit_to_string_with_path(wgsl, "generated.wgsl"))?;
-    Ok(())
 }

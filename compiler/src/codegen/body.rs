@@ -7,6 +7,7 @@
 //! are loaded and effects fetched there instead.
 
 use super::Writer;
+use crate::builtins::Builtin;
 use crate::check::{Callee, Checked, LocalId, Symbol, UniformKind};
 use crate::syntax::ast::*;
 use crate::types::{Scalar, Type};
@@ -277,32 +278,29 @@ impl Writer<'_, '_, '_> {
         match c.callees.get(&e.id) {
             Some(Callee::Construct(ty)) => format!("{}({})", ty.wgsl(), all()),
             Some(Callee::Function(_)) => format!("{}({})", wgsl_ident(&callee.name), all()),
-            Some(Callee::Builtin(name)) => match *name {
-                "ddx" | "ddy" | "fwidth" | "sample" => {
-                    let site_index = self.i.deriv.site_of[&e.id];
-                    let site = &self.i.deriv.sites[site_index];
-                    let mut call_args = vec!["mrsl_pos".to_string()];
-                    call_args.extend(site.params.iter().map(|p| local_name(c, *p)));
-                    let call_args = call_args.join(", ");
-                    let dx = format!("mrsl_ddx_{site_index}({call_args})");
-                    let dy = format!("mrsl_ddy_{site_index}({call_args})");
-                    match *name {
-                        "ddx" => dx,
-                        "ddy" => dy,
-                        "fwidth" => format!("(abs({dx}) + abs({dy}))"),
-                        _ => format!("textureSampleGrad({}, {}, {}, {dx}, {dy})", arg(0), arg(1), arg(2)),
-                    }
+            Some(Callee::Builtin(builtin)) if builtin.is_derivative() => {
+                let site_index = self.i.deriv.site_of[&e.id];
+                let site = &self.i.deriv.sites[site_index];
+                let mut call_args = vec!["mrsl_pos".to_string()];
+                call_args.extend(site.params.iter().map(|p| local_name(c, *p)));
+                let call_args = call_args.join(", ");
+                let dx = format!("mrsl_ddx_{site_index}({call_args})");
+                let dy = format!("mrsl_ddy_{site_index}({call_args})");
+                match builtin {
+                    Builtin::Ddx => dx,
+                    Builtin::Ddy => dy,
+                    Builtin::Fwidth => format!("(abs({dx}) + abs({dy}))"),
+                    _ => format!("{}({}, {}, {}, {dx}, {dy})", builtin.wgsl_name(), arg(0), arg(1), arg(2)),
                 }
-                "sample_level" => format!("textureSampleLevel({})", all()),
-                "sample_grad" => format!("textureSampleGrad({})", all()),
-                "load" if args.len() == 2 => format!("textureLoad({}, {}, 0)", arg(0), arg(1)),
-                "load" => format!("textureLoad({})", all()),
-                "texture_size" => format!("vec2<i32>(textureDimensions({}))", arg(0)),
-                "lerp" => format!("mix({})", all()),
-                "faceforward" => format!("faceForward({})", all()),
-                "inversesqrt" => format!("inverseSqrt({})", all()),
-                other => format!("{other}({})", all()),
-            },
+            }
+            // WGSL's `textureLoad` takes the mip level, and `textureDimensions` returns unsigned sizes.
+            Some(Callee::Builtin(Builtin::Load)) if args.len() == 2 => {
+                format!("{}({}, {}, 0)", Builtin::Load.wgsl_name(), arg(0), arg(1))
+            }
+            Some(Callee::Builtin(Builtin::TextureSize)) => {
+                format!("vec2<i32>({}({}))", Builtin::TextureSize.wgsl_name(), arg(0))
+            }
+            Some(Callee::Builtin(builtin)) => format!("{}({})", builtin.wgsl_name(), all()),
             None => format!("{}({})", wgsl_ident(&callee.name), all()),
         }
     }

@@ -10,8 +10,8 @@ use super::body::{Mode, float_literal, local_name, wgsl_ident};
 use super::words::bit;
 use super::writer::cut;
 use crate::check::{EffectId, KeyCompare, Symbol};
-use crate::deriv::{visit_expr, visit_stmt_exprs};
 use crate::syntax::ast::*;
+use crate::syntax::{visit_expr, visit_stmt_exprs};
 use mrsl_abi::{CONTROL_FIELDS, KernelKind};
 use std::collections::BTreeSet;
 

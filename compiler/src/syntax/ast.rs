@@ -86,14 +86,6 @@ impl Item {
             Item::Effect(d) => &d.name,
         }
     }
-    pub fn attrs(&self) -> &[Attribute] {
-        match self {
-            Item::Input(d) => &d.attrs,
-            Item::Uniform(d) => &d.attrs,
-            Item::Effect(d) => &d.attrs,
-            Item::Const(_) | Item::Function(_) => &[],
-        }
-    }
 }
 
 /// `in float3 normal;`: a G-buffer channel.

@@ -2,6 +2,9 @@
 
 pub mod ast;
 pub mod lexer;
+mod visit;
+
+pub use visit::{visit_expr, visit_stmt_exprs};
 
 use crate::diagnostic::{Diagnostic, Label};
 use ast::{IdGen, Program, Span};

@@ -183,7 +183,7 @@ fn refine_flags_pack_into_words() {
 /// on 300 random graphs of up to 8 passed effects with random widths.
 #[test]
 fn exact_colouring_matches_brute_force() {
-    use mrsl::check::EffectId;
+    use mrsl::internals::EffectId;
     let mut seed = 0x2545F4914F6CDD1Du64;
     let mut next = move || {
         // xorshift64: deterministic and dependency-free.
@@ -206,7 +206,7 @@ fn exact_colouring_matches_brute_force() {
         }
         let adjacent =
             |a: usize, b: usize| edges.iter().any(|&(x, y)| (x.0 as usize, y.0 as usize) == (a.min(b), a.max(b)));
-        let (classes, exact) = mrsl::interface::colour(&nodes, &sizes, &edges);
+        let (classes, exact) = mrsl::internals::colour(&nodes, &sizes, &edges);
         assert!(exact);
         let cost = |classes: &[Vec<usize>]| {
             classes.iter().map(|c| c.iter().map(|&k| sizes[k]).max().unwrap_or(0)).sum::<u32>()

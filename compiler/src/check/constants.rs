@@ -1,0 +1,169 @@
+//! Constant evaluation: the values of `const`s, uniform defaults, array
+//! lengths and loop bounds, and the range checks WGSL would otherwise make
+//! when the shader is created (so that such programs fail here, not in naga).
+
+use super::{Checker, ConstId, ConstValue, Ctx, Global, err};
+use crate::syntax::ast::*;
+use crate::syntax::visit_expr;
+use crate::types::{self, Scalar, Type};
+use std::collections::HashMap;
+
+impl Checker<'_> {
+    pub(super) fn const_value(&mut self, id: ConstId) -> Option<ConstValue> {
+        if let Some(v) = &self.out.consts[id.index()].value {
+            return Some(v.clone());
+        }
+        if !self.evaluating_consts.insert(id.0) {
+            let decl = self.out.const_decl(id);
+            self.error(err(
+                "E0301",
+                format!("constant `{}` is defined in terms of itself", decl.name.name),
+                decl.name.span,
+                "cyclic constant",
+            ));
+            return None;
+        }
+        let program = self.out.program;
+        let Item::Const(decl) = &program.items[self.out.consts[id.index()].item] else {
+            unreachable!("const ids index const items")
+        };
+        let ty = self.out.consts[id.index()].ty.clone();
+        let value = self.const_eval(&decl.value);
+        // Type-check the initialiser like any other expression, too.
+        let saved = std::mem::replace(&mut self.ctx, Ctx::Global);
+        self.scopes.push(HashMap::new());
+        let init_ty = self.expr(&decl.value);
+        self.scopes.pop();
+        self.ctx = saved;
+        self.expect_type(&init_ty, &ty, decl.value.span, "constant initialiser");
+        let value = match value {
+            Some(v) => Some(ConstValue { ty: ty.clone(), values: v.values }),
+            None => {
+                if !init_ty.is_error() {
+                    self.error(err(
+                        "E0115",
+                        "a constant must be initialised with a constant expression",
+                        decl.value.span,
+                        "not constant",
+                    ));
+                }
+                None
+            }
+        };
+        self.out.consts[id.index()].value = value.clone();
+        self.evaluating_consts.remove(&id.0);
+        value
+    }
+
+    /// Evaluates literals, constants, arithmetic and constructors at compile time.
+    pub(super) fn const_eval(&mut self, e: &Expr) -> Option<ConstValue> {
+        let scalar = |ty: Type, v: f64| Some(ConstValue { ty, values: vec![v] });
+        match &e.kind {
+            ExprKind::Int(v, IntSuffix::None) => scalar(Type::AbstractInt, *v as f64),
+            ExprKind::Int(v, IntSuffix::U) => scalar(types::UINT, *v as f64),
+            ExprKind::Int(v, IntSuffix::I) => scalar(types::INT, *v as f64),
+            ExprKind::Float(v) => scalar(Type::AbstractFloat, *v),
+            ExprKind::Bool(b) => scalar(types::BOOL, if *b { 1.0 } else { 0.0 }),
+            ExprKind::Name(name) => match self.globals.get(name) {
+                Some((Global::Const(id), _)) => {
+                    let id = *id;
+                    self.const_value(id)
+                }
+                _ => None,
+            },
+            ExprKind::Unary(UnaryOp::Neg, inner) => {
+                let v = self.const_eval(inner)?;
+                Some(ConstValue { ty: v.ty, values: v.values.iter().map(|x| -x).collect() })
+            }
+            ExprKind::Binary(op @ (BinaryOp::Add | BinaryOp::Sub | BinaryOp::Mul | BinaryOp::Div), a, b) => {
+                let a = self.const_eval(a)?;
+                let b = self.const_eval(b)?;
+                if a.values.len() != b.values.len() && a.values.len() != 1 && b.values.len() != 1 {
+                    return None;
+                }
+                if matches!(a.ty, Type::Matrix(_)) || matches!(b.ty, Type::Matrix(_)) {
+                    return None;
+                }
+                let ty = if a.values.len() >= b.values.len() { a.ty.clone() } else { b.ty.clone() };
+                let ty = match (&a.ty, &b.ty) {
+                    (Type::AbstractInt, Type::AbstractFloat) | (Type::AbstractFloat, Type::AbstractInt) => {
+                        Type::AbstractFloat
+                    }
+                    (x, y) if x.is_abstract() && !y.is_abstract() && b.values.len() >= a.values.len() => y.clone(),
+                    _ => ty,
+                };
+                let integer = matches!(ty.scalar(), Some(Scalar::Int | Scalar::Uint));
+                let n = a.values.len().max(b.values.len());
+                let mut values = Vec::with_capacity(n);
+                for i in 0..n {
+                    let x = a.values[if a.values.len() == 1 { 0 } else { i }];
+                    let y = b.values[if b.values.len() == 1 { 0 } else { i }];
+                    values.push(match op {
+                        BinaryOp::Add => x + y,
+                        BinaryOp::Sub => x - y,
+                        BinaryOp::Mul => x * y,
+                        _ if integer && y == 0.0 => return None,
+                        _ if integer => (x / y).trunc(),
+                        _ => x / y,
+                    });
+                }
+                Some(ConstValue { ty, values })
+            }
+            ExprKind::Call { callee, args } => {
+                let ty = Type::from_name(&callee.name)?;
+                let mut values = vec![];
+                for arg in args {
+                    values.extend(self.const_eval(arg)?.values);
+                }
+                let n = ty.components() as usize;
+                if values.len() == 1 && n > 1 && !matches!(ty, Type::Matrix(_)) {
+                    values = vec![values[0]; n];
+                }
+                if values.len() != n {
+                    return None;
+                }
+                if matches!(ty.scalar(), Some(Scalar::Int | Scalar::Uint)) {
+                    values = values.iter().map(|v| v.trunc()).collect();
+                }
+                Some(ConstValue { ty, values })
+            }
+            _ => None,
+        }
+    }
+
+    /// Whether an expression is made only of literals and constants (WGSL
+    /// evaluates such expressions when the shader is created).
+    pub(super) fn is_constant(&self, e: &Expr) -> bool {
+        let mut constant = true;
+        visit_expr(e, &mut |x| match &x.kind {
+            ExprKind::Name(n) => constant &= matches!(self.globals.get(n), Some((Global::Const(_), _))),
+            ExprKind::Call { callee, .. } => constant &= Type::from_name(&callee.name).is_some(),
+            ExprKind::Index { .. } | ExprKind::Field { .. } | ExprKind::Ternary(..) => constant = false,
+            _ => {}
+        });
+        constant
+    }
+
+    /// Reports a constant expression whose value does not fit its type (as
+    /// WGSL would at shader creation); returns whether it fits.
+    pub(super) fn constant_in_range(&mut self, e: &Expr, ty: &Type) -> bool {
+        let Some(value) = self.const_eval(e) else { return true };
+        let fits = |x: f64| match ty.scalar() {
+            _ if *ty == Type::AbstractInt => (i32::MIN as f64..=i32::MAX as f64).contains(&x),
+            Some(Scalar::Int) => (i32::MIN as f64..=i32::MAX as f64).contains(&x),
+            Some(Scalar::Uint) => (0.0..=u32::MAX as f64).contains(&x),
+            Some(Scalar::Float) => x.is_finite() && x.abs() <= f32::MAX as f64,
+            _ => true,
+        };
+        if value.values.iter().all(|x| fits(*x)) {
+            return true;
+        }
+        let what = if value.values.iter().any(|x| x.is_infinite() || x.is_nan()) {
+            "divides by zero or overflows"
+        } else {
+            "out of range"
+        };
+        self.error(err("E0205", format!("constant expression out of range for `{}`", ty.concretize()), e.span, what));
+        false
+    }
+}

@@ -1,0 +1,195 @@
+//! Static loop bounds. A GPU has no way to stop a runaway loop but its
+//! watchdog, so every `for` must have a shape whose trip count is known at
+//! compile time, and that count must be modest.
+
+use super::{Checker, err};
+use crate::diagnostic::Label;
+use crate::syntax::ast::*;
+use crate::types::{Scalar, Type};
+
+/// Loops may run at most this many times (a GPU watchdog would stop longer ones).
+const MAX_LOOP_TRIPS: u64 = 1 << 16;
+
+impl Checker<'_> {
+    /// Loops must have the form `for (T i = c0; i OP c1; i++ | i-- | i += c | i -= c)`
+    /// with constant `c`s, and must not assign `i` in the body, so that the
+    /// compiler (and the GPU's watchdog) can rely on a bounded trip count.
+    pub(super) fn check_static_bound(
+        &mut self,
+        s: &Stmt,
+        init: Option<&Stmt>,
+        cond: Option<&Expr>,
+        step: Option<&Stmt>,
+        body: &Stmt,
+    ) {
+        let var = match init.map(|i| &i.kind) {
+            Some(StmtKind::Local { name, init: Some(v), ty }) => {
+                if self.const_eval(v).is_none() {
+                    self.error(err("E0401", "loop has no static bound", v.span, "the start value must be a constant"));
+                    return;
+                }
+                if !matches!(Type::from_name(&ty.name), Some(Type::Scalar(Scalar::Int | Scalar::Uint))) {
+                    self.error(err(
+                        "E0401",
+                        "loop has no static bound",
+                        ty.span,
+                        "the loop variable must be an `int` or `uint`",
+                    ));
+                    return;
+                }
+                name.name.clone()
+            }
+            _ => {
+                self.error(
+                    err("E0401", "loop has no static bound", s.span, "expected `for (int i = START; i < END; i++)`")
+                        .with_note("the loop must declare its counter with a constant start value"),
+                );
+                return;
+            }
+        };
+        let is_var = |e: &Expr| matches!(&e.kind, ExprKind::Name(n) if *n == var);
+        let bound = match cond.map(|c| &c.kind) {
+            Some(ExprKind::Binary(BinaryOp::Lt | BinaryOp::Le | BinaryOp::Gt | BinaryOp::Ge | BinaryOp::Ne, a, b))
+                if is_var(a) =>
+            {
+                Some(b.as_ref())
+            }
+            Some(ExprKind::Binary(BinaryOp::Lt | BinaryOp::Le | BinaryOp::Gt | BinaryOp::Ge | BinaryOp::Ne, a, b))
+                if is_var(b) =>
+            {
+                Some(a.as_ref())
+            }
+            _ => None,
+        };
+        match bound {
+            Some(b) if self.const_eval(b).is_some() => {}
+            Some(b) => {
+                self.error(
+                    err("E0401", "loop has no static bound", b.span, "not a constant")
+                        .with_note("use a constant bound and test the dynamic limit inside: `for (int i = 0; i < 16; i++) { if (i >= count) break; ... }`"),
+                );
+                return;
+            }
+            None => {
+                let span = cond.map(|c| c.span).unwrap_or(s.span);
+                self.error(err(
+                    "E0401",
+                    "loop has no static bound",
+                    span,
+                    format!("expected `{var} < CONSTANT` (or <=, >, >=, !=)"),
+                ));
+                return;
+            }
+        }
+        let step_ok = match step.map(|st| &st.kind) {
+            Some(StmtKind::Step { target, .. }) => is_var(target),
+            Some(StmtKind::Assign { target, op: AssignOp::Add | AssignOp::Sub, value }) => {
+                is_var(target) && self.const_eval(value).is_some()
+            }
+            _ => false,
+        };
+        if !step_ok {
+            let span = step.map(|st| st.span).unwrap_or(s.span);
+            self.error(err(
+                "E0401",
+                "loop has no static bound",
+                span,
+                format!("expected `{var}++`, `{var}--` or `{var} += CONSTANT`"),
+            ));
+            return;
+        }
+        // The shape is right; now the trip count must be finite and modest.
+        let start = match init.map(|i| &i.kind) {
+            Some(StmtKind::Local { init: Some(v), .. }) => self.const_eval(v).map(|c| c.values[0]),
+            _ => None,
+        };
+        let (op, var_left, limit) = match cond.map(|c| &c.kind) {
+            Some(ExprKind::Binary(op, a, b)) => {
+                (*op, is_var(a), self.const_eval(if is_var(a) { b } else { a }).map(|c| c.values[0]))
+            }
+            _ => (BinaryOp::Lt, true, None),
+        };
+        let delta = match step.map(|st| &st.kind) {
+            Some(StmtKind::Step { increment, .. }) => Some(if *increment { 1.0 } else { -1.0 }),
+            Some(StmtKind::Assign { op: AssignOp::Add, value, .. }) => self.const_eval(value).map(|c| c.values[0]),
+            Some(StmtKind::Assign { op: AssignOp::Sub, value, .. }) => self.const_eval(value).map(|c| -c.values[0]),
+            _ => None,
+        };
+        if let (Some(mut i), Some(limit), Some(delta)) = (start, limit, delta) {
+            let holds = |i: f64| {
+                let (x, y) = if var_left { (i, limit) } else { (limit, i) };
+                match op {
+                    BinaryOp::Lt => x < y,
+                    BinaryOp::Le => x <= y,
+                    BinaryOp::Gt => x > y,
+                    BinaryOp::Ge => x >= y,
+                    _ => x != y,
+                }
+            };
+            let mut trips = 0u64;
+            while holds(i) && trips <= MAX_LOOP_TRIPS {
+                i += delta;
+                trips += 1;
+            }
+            if trips > MAX_LOOP_TRIPS {
+                self.error(
+                    err(
+                        "E0402",
+                        "loop does not terminate within the iteration limit",
+                        s.span,
+                        format!("runs more than {MAX_LOOP_TRIPS} times"),
+                    )
+                    .with_note("check the direction of the step against the condition"),
+                );
+                return;
+            }
+        }
+        if let Some(span) = stmt_assigns_name(body, &var) {
+            self.error(
+                err(
+                    "E0401",
+                    "loop has no static bound",
+                    span,
+                    format!("the loop variable `{var}` is assigned in the body"),
+                )
+                .with_label(Label::secondary(init.map(|i| i.span).unwrap_or(s.span), "declared here")),
+            );
+        }
+    }
+}
+
+/// The span of a statement in `s` that assigns `name` (its root variable), if any.
+fn stmt_assigns_name(s: &Stmt, name: &str) -> Option<Span> {
+    fn root(e: &Expr) -> Option<&str> {
+        match &e.kind {
+            ExprKind::Name(n) => Some(n),
+            ExprKind::Field { base, .. } | ExprKind::Index { base, .. } => root(base),
+            _ => None,
+        }
+    }
+    match &s.kind {
+        StmtKind::Assign { target, .. } | StmtKind::Step { target, .. } if root(target) == Some(name) => Some(s.span),
+        StmtKind::Local { name: n, .. } if n.name == name => None,
+        StmtKind::Block(b) => {
+            for s in &b.stmts {
+                // A declaration of the same name shadows the loop variable from here on.
+                if matches!(&s.kind, StmtKind::Local { name: n, .. } if n.name == name) {
+                    return None;
+                }
+                if let Some(span) = stmt_assigns_name(s, name) {
+                    return Some(span);
+                }
+            }
+            None
+        }
+        StmtKind::If { then, otherwise, .. } => {
+            stmt_assigns_name(then, name).or_else(|| otherwise.as_ref().and_then(|o| stmt_assigns_name(o, name)))
+        }
+        StmtKind::For { init, step, body, .. } => init
+            .as_ref()
+            .and_then(|i| stmt_assigns_name(i, name))
+            .or_else(|| step.as_ref().and_then(|i| stmt_assigns_name(i, name)))
+            .or_else(|| stmt_assigns_name(body, name)),
+        _ => None,
+    }
+}
