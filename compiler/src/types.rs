@@ -119,12 +119,12 @@ impl Type {
         if self == target || self.is_error() || target.is_error() {
             return true;
         }
-        match (self, target) {
-            (Type::AbstractInt, Type::Scalar(Scalar::Int | Scalar::Uint | Scalar::Float)) => true,
-            (Type::AbstractInt, Type::AbstractFloat) => true,
-            (Type::AbstractFloat, Type::Scalar(Scalar::Float)) => true,
-            _ => false,
-        }
+        matches!(
+            (self, target),
+            (Type::AbstractInt, Type::Scalar(Scalar::Int | Scalar::Uint | Scalar::Float))
+                | (Type::AbstractInt, Type::AbstractFloat)
+                | (Type::AbstractFloat, Type::Scalar(Scalar::Float))
+        )
     }
 
     /// The mrsl spelling, for diagnostics.

@@ -38,7 +38,10 @@ fn load(name: &str, width: u32, height: u32) -> Vec<[f32; 4]> {
         .collect()
 }
 
-fn cases() -> Vec<(Case, Vec<[f32; 4]>, Vec<[f32; 4]>)> {
+/// A fixture: its expected values, the test image and the reference image.
+type Fixture = (Case, Vec<[f32; 4]>, Vec<[f32; 4]>);
+
+fn cases() -> Vec<Fixture> {
     let expected: Expected = serde_json::from_slice(&std::fs::read(data("expected.json")).unwrap()).unwrap();
     assert_eq!(expected.cases.len(), 6);
     expected
