@@ -5,6 +5,7 @@
 //! to be guessed. It is written as JSON (`STEM.layout.json`) and read back
 //! into the same value ([`Layout::from_json`]).
 
+use crate::KernelKind;
 use crate::types::{SampleType, TextureFormat, ValueType};
 use serde::{Deserialize, Serialize};
 
@@ -60,6 +61,94 @@ impl Layout {
     pub fn stats_counters(&self) -> usize {
         self.stats.counters.len() + 1
     }
+
+    /// The bindings of the stage group ([`crate::GROUP_STAGE`]) that the
+    /// kernel of `kind` declares, in binding order: what the code generator
+    /// writes and what the runtime binds.
+    pub fn stage_bindings(&self, kind: KernelKind) -> Vec<StageBinding> {
+        use StageSlot as S;
+        let h = &self.hierarchical;
+        let buffer =
+            |slot, binding, read_only| StageBinding { binding, slot, resource: StageResource::Buffer { read_only } };
+        let mut bindings = match kind {
+            KernelKind::Coarse => vec![buffer(S::Interface, self.interface.binding, false)],
+            KernelKind::Fine => vec![buffer(S::Interface, self.interface.binding, true)],
+            // Reads the 4x4 level, writes the 2x2 level and counts its samples.
+            KernelKind::DynamicCoarse => vec![
+                buffer(S::Interface, self.interface.binding, true),
+                buffer(S::Interface2, self.interface2.binding, false),
+                buffer(S::Stats, self.stats.binding, false),
+            ],
+            KernelKind::DynamicFine => vec![
+                buffer(S::Interface, self.interface.binding, true),
+                buffer(S::Interface2, self.interface2.binding, true),
+            ],
+            KernelKind::Reference => vec![],
+            KernelKind::Hierarchical => vec![
+                buffer(S::Records, h.values_binding, false),
+                buffer(S::WorkLists, h.work_binding, false),
+                buffer(S::Queues, h.queue_binding, false),
+            ],
+            KernelKind::Checkerboard => vec![buffer(S::Records, h.values_binding, false)],
+        };
+        if !kind.is_coarse() {
+            bindings.extend(self.outputs.iter().enumerate().map(|(index, o)| StageBinding {
+                binding: o.binding,
+                slot: S::Output(index),
+                resource: StageResource::StorageTexture(o.format),
+            }));
+        }
+        let counts = kind.is_fine() || matches!(kind, KernelKind::Hierarchical | KernelKind::Checkerboard);
+        if counts && !self.stats.counters.is_empty() {
+            bindings.push(buffer(S::Stats, self.stats.binding, false));
+            bindings.push(StageBinding {
+                binding: self.rate_image.binding,
+                slot: S::RateImage,
+                resource: StageResource::StorageTexture(TextureFormat::Rg32Uint),
+            });
+        }
+        bindings.sort_by_key(|b| b.binding);
+        bindings
+    }
+}
+
+/// One binding of the stage group.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StageBinding {
+    pub binding: u32,
+    /// What the runtime binds there.
+    pub slot: StageSlot,
+    pub resource: StageResource,
+}
+
+/// The runtime-owned (or engine-owned, for outputs) resource a stage binding takes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StageSlot {
+    /// The coarse samples of the mode's block size (the dynamic mode's 4x4 level).
+    Interface,
+    /// The dynamic mode's 2x2 level (tagged records).
+    Interface2,
+    /// The statistics counters.
+    Stats,
+    /// The per-pixel refine mask.
+    RateImage,
+    /// Output `index` of [`Layout::outputs`].
+    Output(usize),
+    /// The hierarchical and checkerboard modes' per-pixel records.
+    Records,
+    /// The hierarchical work lists.
+    WorkLists,
+    /// The hierarchical queue counters.
+    Queues,
+}
+
+/// What a stage-group binding holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StageResource {
+    /// A storage buffer of `u32` words (atomic for the statistics and queues).
+    Buffer { read_only: bool },
+    /// A write-only storage texture (an output, or the rate image).
+    StorageTexture(TextureFormat),
 }
 
 /// Buffers of the hierarchical and checkerboard modes (group 2): a record per

@@ -31,7 +31,8 @@ pub use control::{CONTROL_FIELDS, Control, ControlField};
 pub use kernel::{KernelKind, entry};
 pub use layout::{
     Channel, ControlBlock, EffectLayout, Field, HierarchicalLayout, InterfaceLayout, KeyCompare, LAYOUT_FORMAT, Layout,
-    Output, Rate, Resample, ResourceBinding, ResourceKind, SlotLayout, StatsLayout, UniformBlock,
+    Output, Rate, Resample, ResourceBinding, ResourceKind, SlotLayout, StageBinding, StageResource, StageSlot,
+    StatsLayout, UniformBlock,
 };
 pub use program::{CompiledProgram, Kernel, ReadError};
 pub use types::{SampleType, Scalar, TextureFormat, ValueType};
@@ -50,3 +51,5 @@ pub const GROUP_ARGS: u32 = 3;
 pub const BINDING_CONTROL: u32 = 0;
 /// Binding of the user uniform block in [`GROUP_RESOURCES`].
 pub const BINDING_UNIFORMS: u32 = 1;
+/// Binding of the indirect dispatch arguments in [`GROUP_ARGS`].
+pub const BINDING_ARGS: u32 = 0;

@@ -5,7 +5,8 @@ use crate::error::Error;
 use crate::{Mode, Stats};
 use mrsl_abi::geometry::{self, HIERARCHICAL_LEVEL0, HIERARCHICAL_LEVELS, MAX_SIDE, MAX_STORAGE_BINDING_BYTES};
 use mrsl_abi::{
-    CompiledProgram, Control, GROUP_ARGS, KernelKind, Layout, SampleType, Scalar, TextureFormat, ValueType, entry,
+    BINDING_ARGS, CompiledProgram, Control, GROUP_ARGS, KernelKind, Layout, SampleType, Scalar, StageResource,
+    StageSlot, TextureFormat, ValueType, entry,
 };
 use std::collections::HashMap;
 
@@ -111,7 +112,7 @@ impl Shader {
         let args_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("mrsl hierarchical args"),
             entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
+                binding: BINDING_ARGS,
                 visibility: wgpu::ShaderStages::COMPUTE,
                 ty: wgpu::BindingType::Buffer {
                     ty: wgpu::BufferBindingType::Storage { read_only: false },
@@ -526,7 +527,7 @@ impl Shader {
         let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("mrsl hierarchical args"),
             layout: &self.args_group_layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffers.args.as_entire_binding() }],
+            entries: &[wgpu::BindGroupEntry { binding: BINDING_ARGS, resource: buffers.args.as_entire_binding() }],
         });
         let pipeline = |name: &'static str| &self.pipelines[&(KernelKind::Hierarchical, None, name)];
         {
@@ -572,10 +573,9 @@ impl Shader {
         pass.dispatch_workgroups(gx, gy, 1);
     }
 
-    /// Group 2 of the modes that keep a record per pixel (hierarchical, checkerboard):
-    /// the records (and for the hierarchical mode its work lists and queues), the
-    /// outputs, the statistics and the rate image; (re)creates the record
-    /// buffers and the rate image for `size` first.
+    /// Group 2 of the modes that keep a record per pixel (hierarchical,
+    /// checkerboard); (re)creates the record buffers and the rate image for
+    /// `size` first.
     fn record_stage(
         &mut self,
         device: &wgpu::Device,
@@ -585,17 +585,7 @@ impl Shader {
     ) -> wgpu::BindGroup {
         self.ensure_rate_image(device, size);
         self.ensure_hier_buffers(device, size);
-        let (buffers, _) = self.hier_buffers.as_ref().expect("created just above");
-        let l = &self.layout;
-        let hl = &l.hierarchical;
-        let mut entries =
-            vec![wgpu::BindGroupEntry { binding: hl.values_binding, resource: buffers.values.as_entire_binding() }];
-        if kind == KernelKind::Hierarchical {
-            entries.push(wgpu::BindGroupEntry { binding: hl.work_binding, resource: buffers.work.as_entire_binding() });
-            entries
-                .push(wgpu::BindGroupEntry { binding: hl.queue_binding, resource: buffers.queue.as_entire_binding() });
-        }
-        self.finish_stage_group(device, kind, entries, Some(views))
+        self.stage_group(device, kind, None, None, views)
     }
 
     fn ensure_hier_buffers(&mut self, device: &wgpu::Device, size: (u32, u32)) {
@@ -729,6 +719,10 @@ impl Shader {
         })
     }
 
+    /// Group 2 of the kernel of `kind`: every binding the layout says it
+    /// declares ([`Layout::stage_bindings`]), each bound to what its slot names.
+    /// `interface` and `inner` are the block modes' interface buffers; the
+    /// rate image and the record buffers must exist when the kernel uses them.
     fn stage_group(
         &self,
         device: &wgpu::Device,
@@ -738,48 +732,28 @@ impl Shader {
         outputs: &HashMap<&str, wgpu::TextureView>,
     ) -> wgpu::BindGroup {
         let l = &self.layout;
-        let mut entries = vec![];
-        if let (Some(buffer), true) = (interface, kind != KernelKind::Reference) {
-            entries.push(wgpu::BindGroupEntry { binding: l.interface.binding, resource: buffer.as_entire_binding() });
-        }
-        if let (Some(buffer), true) = (inner, matches!(kind, KernelKind::DynamicCoarse | KernelKind::DynamicFine)) {
-            entries.push(wgpu::BindGroupEntry { binding: l.interface2.binding, resource: buffer.as_entire_binding() });
-        }
-        if kind == KernelKind::DynamicCoarse {
-            entries.push(wgpu::BindGroupEntry { binding: l.stats.binding, resource: self.stats.as_entire_binding() });
-        }
-        let outputs = (!kind.is_coarse()).then_some(outputs);
-        self.finish_stage_group(device, kind, entries, outputs)
-    }
-
-    /// Adds the outputs (when given), the statistics and the rate image (for the
-    /// kernels that count) to a stage group's entries, and creates the group.
-    fn finish_stage_group(
-        &self,
-        device: &wgpu::Device,
-        kind: KernelKind,
-        entries: Vec<wgpu::BindGroupEntry<'_>>,
-        outputs: Option<&HashMap<&str, wgpu::TextureView>>,
-    ) -> wgpu::BindGroup {
-        let l = &self.layout;
         let rate_view = self.rate.as_ref().map(|(t, _)| t.create_view(&Default::default()));
-        // Rebound so the entries may also borrow the views made here.
-        let mut entries: Vec<wgpu::BindGroupEntry<'_>> = entries;
-        for o in outputs.map(|_| &l.outputs[..]).unwrap_or_default() {
-            let view = &outputs.expect("checked above")[o.name.as_str()];
-            entries
-                .push(wgpu::BindGroupEntry { binding: o.binding, resource: wgpu::BindingResource::TextureView(view) });
-        }
-        let counts = kind.is_fine() || matches!(kind, KernelKind::Hierarchical | KernelKind::Checkerboard);
-        if counts && !l.stats.counters.is_empty() {
-            entries.push(wgpu::BindGroupEntry { binding: l.stats.binding, resource: self.stats.as_entire_binding() });
-            if let Some(view) = &rate_view {
-                entries.push(wgpu::BindGroupEntry {
-                    binding: l.rate_image.binding,
-                    resource: wgpu::BindingResource::TextureView(view),
-                });
-            }
-        }
+        let records = self.hier_buffers.as_ref().map(|(b, _)| b);
+        let needed = "created by encode before the stage group";
+        let entries: Vec<wgpu::BindGroupEntry> = l
+            .stage_bindings(kind)
+            .into_iter()
+            .map(|b| wgpu::BindGroupEntry {
+                binding: b.binding,
+                resource: match b.slot {
+                    StageSlot::Interface => interface.expect(needed).as_entire_binding(),
+                    StageSlot::Interface2 => inner.expect(needed).as_entire_binding(),
+                    StageSlot::Stats => self.stats.as_entire_binding(),
+                    StageSlot::RateImage => wgpu::BindingResource::TextureView(rate_view.as_ref().expect(needed)),
+                    StageSlot::Output(index) => {
+                        wgpu::BindingResource::TextureView(&outputs[l.outputs[index].name.as_str()])
+                    }
+                    StageSlot::Records => records.expect(needed).values.as_entire_binding(),
+                    StageSlot::WorkLists => records.expect(needed).work.as_entire_binding(),
+                    StageSlot::Queues => records.expect(needed).queue.as_entire_binding(),
+                },
+            })
+            .collect();
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some(kind.name()),
             layout: &self.stage_layouts[&kind],
@@ -991,65 +965,26 @@ fn gbuffer_layout(device: &wgpu::Device, l: &Layout) -> wgpu::BindGroupLayout {
 }
 
 fn stage_layout(device: &wgpu::Device, l: &Layout, kind: KernelKind) -> wgpu::BindGroupLayout {
-    let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    };
-    let mut entries = vec![];
-    match kind {
-        KernelKind::Coarse => entries.push(storage(l.interface.binding, false)),
-        KernelKind::Fine => entries.push(storage(l.interface.binding, true)),
-        KernelKind::DynamicCoarse => {
-            entries.push(storage(l.interface.binding, true));
-            entries.push(storage(l.interface2.binding, false));
-            entries.push(storage(l.stats.binding, false));
-        }
-        KernelKind::DynamicFine => {
-            entries.push(storage(l.interface.binding, true));
-            entries.push(storage(l.interface2.binding, true));
-        }
-        KernelKind::Checkerboard => entries.push(storage(l.hierarchical.values_binding, false)),
-        KernelKind::Hierarchical => {
-            entries.push(storage(l.hierarchical.values_binding, false));
-            entries.push(storage(l.hierarchical.work_binding, false));
-            entries.push(storage(l.hierarchical.queue_binding, false));
-        }
-        KernelKind::Reference => {}
-    }
-    if !kind.is_coarse() {
-        for o in &l.outputs {
-            entries.push(wgpu::BindGroupLayoutEntry {
-                binding: o.binding,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::StorageTexture {
+    let entries: Vec<wgpu::BindGroupLayoutEntry> = l
+        .stage_bindings(kind)
+        .into_iter()
+        .map(|b| wgpu::BindGroupLayoutEntry {
+            binding: b.binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: match b.resource {
+                StageResource::Buffer { read_only } => wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                StageResource::StorageTexture(format) => wgpu::BindingType::StorageTexture {
                     access: wgpu::StorageTextureAccess::WriteOnly,
-                    format: wgpu_format(o.format),
+                    format: wgpu_format(format),
                     view_dimension: wgpu::TextureViewDimension::D2,
                 },
-                count: None,
-            });
-        }
-    }
-    if (kind.is_fine() || matches!(kind, KernelKind::Hierarchical | KernelKind::Checkerboard))
-        && !l.stats.counters.is_empty()
-    {
-        entries.push(storage(l.stats.binding, false));
-        entries.push(wgpu::BindGroupLayoutEntry {
-            binding: l.rate_image.binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format: wgpu::TextureFormat::Rg32Uint,
-                view_dimension: wgpu::TextureViewDimension::D2,
             },
             count: None,
-        });
-    }
+        })
+        .collect();
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(kind.name()), entries: &entries })
 }

@@ -88,6 +88,7 @@ impl Writer<'_, '_, '_> {
                 ("WORK_BINDING", &h.work_binding),
                 ("QUEUE_BINDING", &h.queue_binding),
                 ("ARGS_GROUP", &h.args_group),
+                ("ARGS_BINDING", &mrsl_abi::BINDING_ARGS),
             ],
         );
     }

@@ -73,3 +73,39 @@ fn foreign_or_broken_layouts_are_refused() {
     assert!(err.to_string().contains("no `format` field"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The stage group (group 2) each kernel declares is exactly the one the
+/// contract lists for its kind (`Layout::stage_bindings`), which is what the
+/// runtime builds its bind group layouts from: same binding numbers, same
+/// storage access, same storage-texture formats.
+#[test]
+fn kernels_declare_the_stage_bindings_of_the_contract() {
+    use mrsl_abi::{GROUP_STAGE, StageResource, TextureFormat};
+    let prefix = format!("@group({GROUP_STAGE}) @binding(");
+    for (stem, source) in examples() {
+        let program = mrsl::compile(&source, &Options::default()).unwrap();
+        for kernel in &program.kernels {
+            let mut declared: Vec<(u32, StageResource)> = kernel
+                .wgsl
+                .lines()
+                .filter_map(|line| line.strip_prefix(&prefix))
+                .map(|rest| {
+                    let (binding, decl) = rest.split_once(") ").unwrap();
+                    let resource = if decl.starts_with("var<storage, read>") {
+                        StageResource::Buffer { read_only: true }
+                    } else if decl.starts_with("var<storage, read_write>") {
+                        StageResource::Buffer { read_only: false }
+                    } else {
+                        let format = decl.split("texture_storage_2d<").nth(1).unwrap().split(',').next().unwrap();
+                        StageResource::StorageTexture(format.parse::<TextureFormat>().unwrap())
+                    };
+                    (binding.parse().unwrap(), resource)
+                })
+                .collect();
+            declared.sort_by_key(|(binding, _)| *binding);
+            let contract: Vec<(u32, StageResource)> =
+                program.layout.stage_bindings(kernel.kind).iter().map(|b| (b.binding, b.resource)).collect();
+            assert_eq!(declared, contract, "{stem}: {} kernel ({:?})", kernel.kind, kernel.block_size);
+        }
+    }
+}
