@@ -2,8 +2,9 @@
 //! kind of expression (the checker's constant test, the derivative analysis,
 //! the code generator's input scan).
 //!
-//! They live with the tree rather than with any one stage so that the stages
-//! depend on the syntax, never on each other.
+//! They live with the tree rather than with any one stage, so that no stage
+//! imports another for them: the checker does not depend on the derivative
+//! analysis, which only reads the checker's results.
 
 use super::ast::{Expr, ExprKind, Stmt, StmtKind};
 
