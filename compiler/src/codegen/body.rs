@@ -76,6 +76,9 @@ impl Writer<'_, '_, '_> {
     }
 
     pub(super) fn stmt(&mut self, s: &Stmt, indent: usize) {
+        if self.skipped.is_some_and(|skipped| skipped.contains(&s.id)) {
+            return;
+        }
         let c = self.checked();
         match &s.kind {
             StmtKind::Local { init, .. } => {

@@ -60,11 +60,12 @@ use crate::check::{Checked, EffectId};
 use crate::deriv::DerivInfo;
 use crate::graph::EffectGraph;
 use crate::interface::Interface;
+use crate::syntax::ast::NodeId;
 use crate::syntax::ast::{Rate, Span};
 use body::{Mode, wgsl_ident};
 use mrsl_abi::geometry::{DYNAMIC_INNER_BLOCK, DYNAMIC_OUTER_BLOCK, DYNAMIC_TAG_WORDS, HIERARCHICAL_LEVEL0};
 use mrsl_abi::{KernelKind, Layout};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use writer::{Code, Values};
 
 /// Everything the writer reads.
@@ -93,6 +94,12 @@ struct Writer<'i, 'a, 'b> {
     code: Code,
     /// Live coarse effects, numbered for refine masks, statistics counters and records.
     coarse_index: HashMap<EffectId, u32>,
+    /// While writing a value-only function (`mrsl_val_<effect>`): the body's
+    /// statements it leaves out.
+    skipped: Option<&'i HashSet<NodeId>>,
+    /// While writing the neighbour functions: effects are evaluated for their
+    /// value alone, with `mrsl_val_<effect>` where the effect can refine.
+    value_only: bool,
 }
 
 impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
@@ -105,7 +112,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             .enumerate()
             .map(|(k, e)| (*e, k as u32))
             .collect();
-        Writer { i, kind, block, code: Code::default(), coarse_index }
+        Writer { i, kind, block, code: Code::default(), coarse_index, skipped: None, value_only: false }
     }
 
     fn checked(&self) -> &'b Checked<'a> {
@@ -179,8 +186,12 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         for (k, _) in c.functions.iter().enumerate() {
             self.function(crate::check::FunctionId(k as u32));
         }
+        let value_only = self.value_only_effects();
         for e in self.kernel_effects() {
-            self.eval_function(e);
+            self.eval_function(e, false);
+            if value_only.contains(&e) {
+                self.eval_function(e, true);
+            }
         }
         self.derivative_helpers();
         self.neighbour_functions();
