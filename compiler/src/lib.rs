@@ -26,6 +26,7 @@
 //!
 //! The crate does no I/O and touches no GPU: everything here runs anywhere.
 
+mod budget;
 mod builtins;
 mod check;
 mod codegen;
@@ -44,10 +45,45 @@ pub use mrsl_abi::{CompiledProgram, Kernel, KernelKind, Layout};
 /// only: not part of the API, and free to change with the stages.
 #[doc(hidden)]
 pub mod internals {
+    pub use crate::budget::{MAX_EFFECT_OPERATIONS, MAX_PROGRAM_OPERATIONS};
     pub use crate::check::{EffectId, check as check_ast};
     pub use crate::graph::build as build_graph;
     pub use crate::interface::{EXACT_LIMIT, allocate as allocate_interface, colour};
     pub use crate::syntax::parse;
+
+    /// The operations of the program's fully inlined code, as the size
+    /// budget (E0701) counts them: the whole program's and its costliest
+    /// effect's; `None` if the program has errors before the budget is checked.
+    pub fn inlined_operations(source: &str) -> Option<(u64, u64)> {
+        let program = crate::syntax::parse(source).ok()?;
+        let (checked, diagnostics) = crate::check::check(&program);
+        let (graph, graph_diagnostics) = crate::graph::build(&checked);
+        let (deriv, deriv_diagnostics) = crate::deriv::analyse(&checked);
+        let errors = diagnostics.iter().chain(&graph_diagnostics).chain(&deriv_diagnostics).any(|d| d.is_error());
+        (!errors).then(|| {
+            let costs = crate::budget::costs(&checked, &graph, &deriv);
+            (costs.total, costs.effects.iter().map(|(_, cost)| *cost).max().unwrap_or(0))
+        })
+    }
+
+    /// A chain of `n` coarse effects `e0` .. `e{n-1}` (n >= 1), each reading
+    /// the previous one and refining where its own `fwidth` is large, and
+    /// one output reading the last: the program whose neighbour evaluations
+    /// once grew exponentially with `n` (see docs/performance.md).
+    pub fn derivative_chain(n: usize) -> String {
+        let mut source = String::from("in float3 normal;\nin float2 uv;\nuniform float t = 0.05;\n\n");
+        source.push_str(
+            "coarse effect float e0 {\n    e0 = saturate(dot(normal, float3(0.0, 1.0, 0.0)));\n    if (fwidth(e0) > t) refine;\n}\n",
+        );
+        for k in 1..n.max(1) {
+            source.push_str(&format!(
+                "coarse effect float e{k} {{\n    e{k} = e{} * 0.5 + uv.x * 0.25;\n    if (fwidth(e{k}) > t) refine;\n}}\n",
+                k - 1
+            ));
+        }
+        source.push_str(&format!("fine out float4 color = float4(float3(e{}), 1.0);\n", n.max(1) - 1));
+        source
+    }
 }
 
 /// Which kernels to generate, and for which block sizes.
@@ -220,6 +256,10 @@ fn front_end<R>(
     diagnostics.extend(graph_diagnostics);
     let (deriv, deriv_diagnostics) = deriv::analyse(&checked);
     diagnostics.extend(deriv_diagnostics);
+    // The size budget needs an acyclic, well-typed program.
+    if !diagnostics.iter().any(|d| d.is_error()) {
+        diagnostics.extend(budget::check(&checked, &graph, &deriv));
+    }
     sort(&mut diagnostics);
     if diagnostics.iter().any(|d| d.is_error()) {
         return Err(diagnostics);

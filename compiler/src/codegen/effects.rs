@@ -13,7 +13,7 @@ use crate::check::{EffectId, KeyCompare, Symbol};
 use crate::syntax::ast::*;
 use crate::syntax::{visit_expr, visit_stmt_exprs};
 use mrsl_abi::{CONTROL_FIELDS, KernelKind};
-use std::collections::{BTreeSet, HashSet};
+use std::collections::{BTreeSet, HashMap, HashSet};
 
 /// A discontinuity key: an input that, where its values at two positions
 /// differ, keeps them from sharing coarse values.
@@ -316,8 +316,16 @@ impl<'b> Writer<'_, '_, 'b> {
     /// are evaluated for their value alone.
     pub(super) fn neighbour_functions(&mut self) {
         let c = self.checked();
+        let mut resolvers = HashMap::new();
         for e in self.effects_at_neighbours() {
             let info = &c.effects[e.index()];
+            let chain = self.i.graph.closure(e, c);
+            let coarse = chain.iter().any(|x| c.effects[x.index()].rate == Rate::Coarse);
+            let resolver = if coarse && self.kind.is_fine() {
+                self.neighbour_resolvers(e, &chain, &mut resolvers)
+            } else {
+                String::new()
+            };
             self.line(
                 0,
                 format!(
@@ -327,9 +335,8 @@ impl<'b> Writer<'_, '_, 'b> {
                 ),
             );
             self.line(0, format!("fn mrsl_at_{}(mrsl_pos: vec2<i32>) -> {} {{", info.name, info.ty.wgsl()));
-            let chain = self.i.graph.closure(e, c);
-            if chain.iter().any(|x| c.effects[x.index()].rate == Rate::Coarse) {
-                self.resolve_preamble(1);
+            if coarse {
+                self.resolve_preamble(1, &resolver);
             }
             self.value_only = true;
             self.effect_chain(&chain, 1);
