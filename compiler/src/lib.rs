@@ -87,6 +87,15 @@ pub mod internals {
 }
 
 /// Which kernels to generate, and for which block sizes.
+///
+/// [`compile`] generates and validates only the kernels these options ask
+/// for ([`Options::kernels`]). The default asks for all nine: coarse and
+/// fine for blocks 2 and 4, the reference, the dynamic mode's coarse (2x2)
+/// and fine (4x4) kernels, the hierarchical and the checkerboard kernel.
+/// A caller that runs fewer modes asks for their kernels alone, which takes
+/// a fraction of the time: `Options { block_sizes: vec![4], coarse: true,
+/// fine: true, ..Options::none() }` for the coarse 4x4 mode (the runtime's
+/// `compile_modes` does this from its modes).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Options {
     /// Coarse block sizes to generate coarse and fine kernels for (2 and/or 4).
@@ -115,6 +124,58 @@ impl Default for Options {
             hierarchical: true,
             checkerboard: true,
             file_name: "program.mrsl".into(),
+        }
+    }
+}
+
+impl Options {
+    /// The kernels [`compile`] generates with these options, in generation
+    /// order: per block size the coarse and fine kernels, then the
+    /// reference, the dynamic mode's (its 4x4 level is the ordinary 4x4
+    /// coarse kernel, added if not asked for already), the hierarchical and
+    /// the checkerboard kernel. The block size is `None` for the kinds that
+    /// exist once per program.
+    pub fn kernels(&self) -> Vec<(KernelKind, Option<u32>)> {
+        let mut wanted = vec![];
+        for &b in &self.block_sizes {
+            if self.coarse {
+                wanted.push((KernelKind::Coarse, Some(b)));
+            }
+            if self.fine {
+                wanted.push((KernelKind::Fine, Some(b)));
+            }
+        }
+        if self.reference {
+            wanted.push((KernelKind::Reference, None));
+        }
+        if self.dynamic {
+            let (outer, inner) = (mrsl_abi::geometry::DYNAMIC_OUTER_BLOCK, mrsl_abi::geometry::DYNAMIC_INNER_BLOCK);
+            if !wanted.contains(&(KernelKind::Coarse, Some(outer))) {
+                wanted.push((KernelKind::Coarse, Some(outer)));
+            }
+            wanted.push((KernelKind::DynamicCoarse, Some(inner)));
+            wanted.push((KernelKind::DynamicFine, Some(outer)));
+        }
+        if self.hierarchical {
+            wanted.push((KernelKind::Hierarchical, None));
+        }
+        if self.checkerboard {
+            wanted.push((KernelKind::Checkerboard, None));
+        }
+        wanted
+    }
+
+    /// Options that ask for no kernel at all; set the flags of the kernels wanted.
+    pub fn none() -> Options {
+        Options {
+            block_sizes: vec![],
+            coarse: false,
+            fine: false,
+            reference: false,
+            dynamic: false,
+            hierarchical: false,
+            checkerboard: false,
+            ..Options::default()
         }
     }
 }
@@ -189,32 +250,7 @@ fn generate(
         source,
     };
     let mut kernels = vec![];
-    let mut wanted = vec![];
-    for &b in &options.block_sizes {
-        if options.coarse {
-            wanted.push((KernelKind::Coarse, Some(b)));
-        }
-        if options.fine {
-            wanted.push((KernelKind::Fine, Some(b)));
-        }
-    }
-    if options.reference {
-        wanted.push((KernelKind::Reference, None));
-    }
-    if options.dynamic {
-        // The 4x4 level is the ordinary 4x4 coarse kernel.
-        if !wanted.contains(&(KernelKind::Coarse, Some(4))) {
-            wanted.push((KernelKind::Coarse, Some(4)));
-        }
-        wanted.push((KernelKind::DynamicCoarse, Some(2)));
-        wanted.push((KernelKind::DynamicFine, Some(4)));
-    }
-    if options.hierarchical {
-        wanted.push((KernelKind::Hierarchical, None));
-    }
-    if options.checkerboard {
-        wanted.push((KernelKind::Checkerboard, None));
-    }
+    let wanted = options.kernels();
     let texts: Vec<(KernelKind, Option<u32>, String)> = wanted
         .into_iter()
         .map(|(kind, block)| (kind, block, codegen::write_string(&inputs, kind, block.unwrap_or(1))))
