@@ -163,8 +163,21 @@ fn generate(n: usize) -> String {
             _ => e.name.clone(),
         })
         .collect();
-    src.push_str(&format!("fine out float4 color = float4({}, 1.0);\n", leaves.join(" + ")));
+    src.push_str(&format!("fine out float4 color = float4({}, 1.0);\n", balanced_sum(&leaves)));
     src
+}
+
+/// `terms` summed as a balanced tree, `((a + b) + (c + d))`, so that the
+/// expression nests only logarithmically deep however many leaves there are.
+fn balanced_sum(terms: &[String]) -> String {
+    match terms {
+        [] => "float3(0.0)".to_string(),
+        [one] => one.clone(),
+        _ => {
+            let (left, right) = terms.split_at(terms.len() / 2);
+            format!("({} + {})", balanced_sum(left), balanced_sum(right))
+        }
+    }
 }
 
 fn options_b4() -> mrsl::Options {

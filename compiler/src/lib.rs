@@ -248,6 +248,7 @@ fn generate(
         layout: &layout,
         file_name: &options.file_name,
         source,
+        cache: codegen::Cache::new(source),
     };
     let mut kernels = vec![];
     let wanted = options.kernels();

@@ -255,15 +255,24 @@ impl<'b> Writer<'_, '_, 'b> {
     // ---- Derivatives and values at other positions ------------------------------
 
     fn live_sites(&self) -> Vec<usize> {
-        let effects = self.kernel_effects();
-        (0..self.i.deriv.sites.len()).filter(|&k| effects.contains(&self.i.deriv.sites[k].effect)).collect()
+        let mut computed = vec![false; self.checked().effects.len()];
+        for e in self.kernel_effects() {
+            computed[e.index()] = true;
+        }
+        (0..self.i.deriv.sites.len()).filter(|&k| computed[self.i.deriv.sites[k].effect.index()]).collect()
     }
 
     /// `mrsl_d<k>` (the operand of derivative site k at a position) and its
     /// differences across the position's quad, `mrsl_ddx_<k>` and `mrsl_ddy_<k>`.
     pub(super) fn derivative_helpers(&mut self) {
-        let c = self.checked();
         for k in self.live_sites() {
+            self.cached(super::Piece::Derivative(k), |w| w.derivative_helper(k));
+        }
+    }
+
+    fn derivative_helper(&mut self, k: usize) {
+        let c = self.checked();
+        {
             let site = &self.i.deriv.sites[k];
             let ty = c.ty(site.operand).concretize();
             let mut params = vec!["mrsl_pos: vec2<i32>".to_string()];
