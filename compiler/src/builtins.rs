@@ -248,6 +248,31 @@ impl Builtin {
         self.derivative_operand().is_some()
     }
 
+    /// Where the builtin is defined on constant arguments, as WGSL's constant
+    /// evaluation (naga's) checks it when the shader is created: `None` for
+    /// builtins without such a check, else whether the components `x` (and
+    /// `y`, the second argument's, for `pow`) are inside the domain, and the
+    /// domain in words.
+    pub fn constant_domain(self) -> Option<(fn(f64, f64) -> bool, &'static str)> {
+        use Builtin::*;
+        Some(match self {
+            Asin | Acos => (|x, _| x.abs() <= 1.0, "-1 <= x <= 1"),
+            Log | Log2 => (|x, _| x > 0.0, "x > 0"),
+            Sqrt => (|x, _| x >= 0.0, "x >= 0"),
+            InverseSqrt => (|x, _| x > 0.0, "x > 0"),
+            Pow => (
+                |x, y| {
+                    !(x < 0.0
+                        || (x == 1.0 && y.is_infinite())
+                        || (x.is_infinite() && y == 0.0)
+                        || (x == 0.0 && y <= 0.0))
+                },
+                "x >= 0, and y > 0 where x = 0",
+            ),
+            _ => return None,
+        })
+    }
+
     /// The WGSL function a call becomes. The derivatives name WGSL's own,
     /// which exist in fragment shaders only: in our compute kernels codegen
     /// takes differences instead, and writes `sample` as `textureSampleGrad`

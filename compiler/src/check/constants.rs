@@ -3,6 +3,7 @@
 //! when the shader is created (so that such programs fail here, not in naga).
 
 use super::{Checker, ConstId, ConstValue, Ctx, Global, err};
+use crate::builtins::Builtin;
 use crate::syntax::ast::*;
 use crate::syntax::visit_expr;
 use crate::types::{self, Scalar, Type};
@@ -165,5 +166,34 @@ impl Checker<'_> {
         };
         self.error(err("E0205", format!("constant expression out of range for `{}`", ty.concretize()), e.span, what));
         false
+    }
+
+    /// Reports a builtin call on constant arguments outside the builtin's
+    /// domain (`log(-1)`, `sqrt(-1)`, `pow(-1, 2)`): WGSL evaluates such a
+    /// call when the shader is created and rejects it there.
+    pub(super) fn constant_arguments_in_domain(&mut self, builtin: Builtin, call: &Expr, args: &[Expr]) {
+        let Some((inside, domain)) = builtin.constant_domain() else { return };
+        let Some(x) = args.first().and_then(|a| self.const_eval(a)) else { return };
+        let y = match args.get(1) {
+            Some(a) => match self.const_eval(a) {
+                Some(y) => y.values,
+                None => return,
+            },
+            None => vec![0.0],
+        };
+        let at = |values: &[f64], i: usize| values[if values.len() == 1 { 0 } else { i.min(values.len() - 1) }];
+        let n = x.values.len().max(y.len());
+        let Some(bad) = (0..n).find(|&i| !inside(at(&x.values, i), at(&y, i))) else { return };
+        let shown = if args.len() == 2 {
+            format!("x = {}, y = {}", at(&x.values, bad), at(&y, bad))
+        } else {
+            format!("x = {}", at(&x.values, bad))
+        };
+        let name = builtin.name();
+        self.error(
+            err("E0213", format!("`{name}` of constant arguments outside its domain"), call.span, shown)
+                .with_note(format!("`{name}` is defined for {domain}"))
+                .with_note("WGSL evaluates calls on constants when the shader is created, and rejects this one"),
+        );
     }
 }
