@@ -18,7 +18,11 @@ macro_rules! builtins {
             $($variant,)*
         }
 
-        impl Builtin {
+        /// Whether constant components `x` (and `y`, for two-argument builtins) lie
+/// inside a builtin's domain.
+pub type Domain = fn(f64, f64) -> bool;
+
+impl Builtin {
             /// Every builtin.
             pub const ALL: &[Builtin] = &[$(Builtin::$variant,)*];
 
@@ -253,7 +257,7 @@ impl Builtin {
     /// builtins without such a check, else whether the components `x` (and
     /// `y`, the second argument's, for `pow`) are inside the domain, and the
     /// domain in words.
-    pub fn constant_domain(self) -> Option<(fn(f64, f64) -> bool, &'static str)> {
+    pub fn constant_domain(self) -> Option<(Domain, &'static str)> {
         use Builtin::*;
         Some(match self {
             Asin | Acos => (|x, _| x.abs() <= 1.0, "-1 <= x <= 1"),
