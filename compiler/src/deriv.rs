@@ -90,6 +90,9 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
                 checked,
                 facts: &facts,
                 callee,
+                call: call.span,
+                body: &body,
+                rate: effect.rate,
                 statement,
                 params: BTreeSet::new(),
                 effects: BTreeSet::new(),
@@ -366,6 +369,10 @@ struct OperandWalk<'w, 'a> {
     checked: &'w Checked<'a>,
     facts: &'w LocalFacts<'a>,
     callee: &'w Ident,
+    /// The derivative call, and the effect body and rate it is in (for diagnostics).
+    call: Span,
+    body: &'w [&'a Stmt],
+    rate: Rate,
     /// Top-level statement holding the derivative.
     statement: usize,
     params: BTreeSet<LocalId>,
@@ -399,8 +406,7 @@ impl OperandWalk<'_, '_> {
         let facts = self.facts;
         if facts.is_invariant(local) {
             if through.is_some() && !facts.is_stable(local) {
-                let via = through.map(|l| self.checked.locals[l.index()].name.clone()).unwrap_or_default();
-                self.error(local, span, name, format!("`{name}` is assigned again after `{via}` is computed from it, so its value at the neighbour is not known"));
+                self.error(local, span, name, Why::Stale);
                 return;
             }
             self.params.insert(local);
@@ -408,7 +414,7 @@ impl OperandWalk<'_, '_> {
         }
         match facts.definitions.get(&local) {
             Some((_, Some(defined_at))) if *defined_at >= self.statement => {
-                self.error(local, span, name, format!("`{name}` is differentiated before it is assigned"));
+                self.error(local, span, name, Why::Before);
             }
             Some((definition, _)) => {
                 if self.visiting.contains(&local) {
@@ -418,28 +424,152 @@ impl OperandWalk<'_, '_> {
                 self.expr(definition, Some(local));
                 self.visiting.pop();
             }
-            None => self.error(
-                local,
-                span,
-                name,
-                format!("`{name}` is assigned more than once or inside a branch or loop, so it cannot be recomputed at the neighbouring sample"),
-            ),
+            None => self.error(local, span, name, Why::Unstable),
         }
     }
 
-    fn error(&mut self, local: LocalId, span: Span, name: &str, why: String) {
+    fn error(&mut self, local: LocalId, span: Span, name: &str, why: Why) {
         if !self.reported.insert(local) {
             return;
         }
+        const NOTE: &str = "a derivative re-evaluates its operand at the neighbouring sample: differentiate locals \
+                            that are assigned exactly once, where they are declared, or the expression they are built from";
         let decl = self.checked.locals[local.index()].span;
-        self.diagnostics.push(
-            Diagnostic::error("E0503", format!("`{}` cannot differentiate `{name}`", self.callee.name))
-                .with_label(Label::primary(span, why))
-                .with_label(Label::secondary(decl, "declared here"))
-                .with_note(
-                    "a derivative re-evaluates its operand at the neighbouring sample: differentiate locals that are \
-                     assigned exactly once, where they are declared, or the expression they are built from",
-                ),
+        let unstable = format!(
+            "`{name}` is assigned more than once or inside a branch or loop, so it cannot be recomputed at the neighbouring sample"
         );
+        // Reached through an inlined definition: `span` is in that definition,
+        // away from the derivative, so the derivative is the primary label
+        // and the labels below it trace the operand to `name`.
+        let (Some(&first), Some(&through)) = (self.visiting.first(), self.visiting.last()) else {
+            let why = match why {
+                Why::Before => format!("`{name}` is differentiated before it is assigned"),
+                Why::Stale | Why::Unstable => unstable,
+            };
+            self.diagnostics.push(
+                Diagnostic::error("E0503", format!("`{}` cannot differentiate `{name}`", self.callee.name))
+                    .with_label(Label::primary(span, why))
+                    .with_label(Label::secondary(decl, "declared here"))
+                    .with_note(NOTE),
+            );
+            return;
+        };
+        let operand = &self.checked.locals[first.index()].name;
+        let via = &self.checked.locals[through.index()].name;
+        let callee = &self.callee.name;
+        let site = match why {
+            Why::Before => None,
+            Why::Stale | Why::Unstable => assignment_site(self.body, self.checked, local),
+        };
+        let used = match (why, site) {
+            (Why::Before, _) => {
+                format!("`{via}` is computed from `{name}`, which is assigned only after the derivative")
+            }
+            (Why::Stale, _) => format!(
+                "`{via}` is computed from `{name}`, which is assigned more than once, so its value at the neighbouring \
+                 sample is not known"
+            ),
+            (Why::Unstable, Some(_)) => {
+                format!("`{via}` is computed from `{name}`, which cannot be recomputed at the neighbouring sample")
+            }
+            (Why::Unstable, None) => format!("`{via}` is computed from `{name}`: {unstable}"),
+        };
+        let mut d = Diagnostic::error("E0503", format!("`{callee}` cannot differentiate `{operand}`"))
+            .with_label(Label::primary(
+                self.call,
+                format!("`{callee}` re-evaluates `{operand}` at the neighbouring sample"),
+            ))
+            .with_label(Label::secondary(span, used));
+        d = match site {
+            Some((at, nesting)) => d.with_label(Label::secondary(
+                at,
+                match nesting {
+                    Nesting::Loop => format!("`{name}` is assigned inside a loop"),
+                    Nesting::Branch => format!("`{name}` is assigned inside a branch"),
+                    Nesting::Again => format!("`{name}` is assigned again here"),
+                },
+            )),
+            None => d.with_label(Label::secondary(decl, "declared here")),
+        };
+        d = d.with_note(NOTE);
+        if let (Why::Unstable, Some((_, Nesting::Loop | Nesting::Branch))) = (why, site) {
+            let rate = match self.rate {
+                Rate::Coarse => "coarse effect",
+                Rate::Fine | Rate::Out => "fine effect",
+            };
+            let ty = &self.checked.locals[local.index()].ty;
+            d = d.with_note(format!(
+                "help: or build `{name}` in an effect of its own, `{rate} {ty} {name}_effect {{ ... }}`, and read \
+                 that: an effect is recomputed at the neighbouring sample however it is built"
+            ));
+        }
+        self.diagnostics.push(d);
     }
+}
+
+/// Why a local in a derivative operand cannot be recomputed at a neighbour.
+#[derive(Clone, Copy)]
+enum Why {
+    /// Invariant, but assigned again: an inlined definition may have read another value.
+    Stale,
+    /// Its single assignment comes after the derivative.
+    Before,
+    /// Neither invariant nor single-definition.
+    Unstable,
+}
+
+/// Why an assignment makes a local impossible to recompute at a neighbour.
+#[derive(Clone, Copy, PartialEq)]
+enum Nesting {
+    Loop,
+    Branch,
+    /// A second assignment at the top level of the body.
+    Again,
+}
+
+/// For diagnostics: the assignment to `local` that stops it from being
+/// recomputed at a neighbour, the first one inside a loop, else inside a
+/// branch, else the second one.
+fn assignment_site(body: &[&Stmt], checked: &Checked, local: LocalId) -> Option<(Span, Nesting)> {
+    fn walk(
+        s: &Stmt,
+        checked: &Checked,
+        local: LocalId,
+        nesting: Option<Nesting>,
+        out: &mut Vec<(Span, Option<Nesting>)>,
+    ) {
+        match &s.kind {
+            StmtKind::Local { init: Some(_), .. } if checked.local_decls.get(&s.id) == Some(&local) => {
+                out.push((s.span, nesting))
+            }
+            StmtKind::Assign { target, .. } | StmtKind::Step { target, .. }
+                if root_local(target, checked) == Some(local) =>
+            {
+                out.push((s.span, nesting))
+            }
+            StmtKind::If { then, otherwise, .. } => {
+                let inner = nesting.or(Some(Nesting::Branch));
+                walk(then, checked, local, inner, out);
+                if let Some(o) = otherwise {
+                    walk(o, checked, local, inner, out);
+                }
+            }
+            StmtKind::For { step, body, .. } => {
+                if let Some(st) = step {
+                    walk(st, checked, local, Some(Nesting::Loop), out);
+                }
+                walk(body, checked, local, Some(Nesting::Loop), out);
+            }
+            StmtKind::Block(b) => b.stmts.iter().for_each(|s| walk(s, checked, local, nesting, out)),
+            _ => {}
+        }
+    }
+    let mut sites = vec![];
+    for s in body {
+        walk(s, checked, local, None, &mut sites);
+    }
+    let find = |n: Nesting| sites.iter().find(|(_, k)| *k == Some(n)).map(|(span, _)| (*span, n));
+    find(Nesting::Loop)
+        .or_else(|| find(Nesting::Branch))
+        .or_else(|| sites.get(1).map(|(span, _)| (*span, Nesting::Again)))
 }

@@ -3,7 +3,7 @@
 //! constructors, user functions and builtins.
 
 use super::builtins::{BuiltinError, builtin_type};
-use super::names::{TYPE_NAMES, suggest};
+use super::names::{TYPE_NAMES, suggest, well_known_uniform};
 use super::typing::{binary_type, construct_check, unify};
 use super::{Callee, Checker, Ctx, Global, LocalId, Symbol, err};
 use crate::builtins::{Builtin, Rule};
@@ -161,6 +161,8 @@ impl Checker<'_> {
                 self.globals.keys().cloned().chain(self.scopes.iter().flat_map(|s| s.keys().cloned())).collect();
             if let Some(s) = suggest(name, candidates.iter().map(|s| s.as_str())) {
                 d = d.with_note(format!("did you mean `{s}`?"));
+            } else if let Some(ty) = well_known_uniform(name).filter(|_| self.ctx != Ctx::Global) {
+                d = d.with_note(format!("help: declare it: `uniform {ty} {name};`"));
             }
             self.error(d);
             return Type::Error;
