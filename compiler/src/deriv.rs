@@ -96,11 +96,13 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
                 statement,
                 params: BTreeSet::new(),
                 effects: BTreeSet::new(),
-                visiting: vec![],
+                visiting: HashSet::new(),
+                path: vec![],
+                walked: HashSet::new(),
                 reported: HashSet::new(),
                 diagnostics: &mut diagnostics,
             };
-            walk.expr(operand, None);
+            walk.expr(operand);
             let (params, effects) = (walk.params, walk.effects);
             info.effects_at_neighbours.extend(effects.iter().copied());
             info.site_of.insert(call.id, info.sites.len());
@@ -364,7 +366,9 @@ fn collect_assignments<'a>(
 }
 
 /// Walks a derivative operand, inlining single definitions and collecting
-/// the invariant locals and effects it needs.
+/// the invariant locals and effects it needs. The definitions are followed
+/// depth-first with an explicit stack, each once: a chain of any length
+/// neither recurses nor, when locals are read more than once, repeats work.
 struct OperandWalk<'w, 'a> {
     checked: &'w Checked<'a>,
     facts: &'w LocalFacts<'a>,
@@ -377,54 +381,96 @@ struct OperandWalk<'w, 'a> {
     statement: usize,
     params: BTreeSet<LocalId>,
     effects: BTreeSet<EffectId>,
-    visiting: Vec<LocalId>,
+    /// Single-definition locals whose definition is being walked: the current path.
+    visiting: HashSet<LocalId>,
+    /// The same path in order, for diagnostics: the operand's own local first.
+    path: Vec<LocalId>,
+    /// Single-definition locals whose definition has been walked.
+    walked: HashSet<LocalId>,
     reported: HashSet<LocalId>,
     diagnostics: &'w mut Vec<Diagnostic>,
 }
 
-impl OperandWalk<'_, '_> {
-    /// `through`: the single-definition local whose definition is being walked.
-    fn expr(&mut self, e: &Expr, through: Option<LocalId>) {
+/// A name read by an expression being walked: its span, text and symbol.
+type NameRead = (Span, String, Option<Symbol>);
+
+impl<'a> OperandWalk<'_, 'a> {
+    /// Walks the operand `e`, then the definitions it leads to.
+    fn expr(&mut self, e: &'a Expr) {
+        // Each frame: the local whose definition it walks (none for the
+        // operand), the names that definition reads, and the next to visit.
+        let mut stack: Vec<(Option<LocalId>, Vec<NameRead>, usize)> = vec![(None, self.names(e), 0)];
+        while let Some((through, names, next)) = stack.last_mut() {
+            let Some((span, name, symbol)) = names.get(*next).cloned() else {
+                if let Some(done) = *through {
+                    self.visiting.remove(&done);
+                    self.path.pop();
+                    self.walked.insert(done);
+                }
+                stack.pop();
+                continue;
+            };
+            *next += 1;
+            let through = *through;
+            match symbol {
+                Some(Symbol::Effect(id)) => {
+                    self.effects.insert(id);
+                }
+                Some(Symbol::Local(local)) => {
+                    if let Some(definition) = self.local(local, span, &name, through) {
+                        self.visiting.insert(local);
+                        self.path.push(local);
+                        stack.push((Some(local), self.names(definition), 0));
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// The names `e` reads, in source order.
+    fn names(&self, e: &'a Expr) -> Vec<NameRead> {
         let mut names = vec![];
         visit_expr(e, &mut |x| {
             if let ExprKind::Name(name) = &x.kind {
                 names.push((x.span, name.clone(), self.checked.symbols.get(&x.id).copied()));
             }
         });
-        for (span, name, symbol) in names {
-            match symbol {
-                Some(Symbol::Effect(id)) => {
-                    self.effects.insert(id);
-                }
-                Some(Symbol::Local(local)) => self.local(local, span, &name, through),
-                _ => {}
-            }
-        }
+        names
     }
 
-    fn local(&mut self, local: LocalId, span: Span, name: &str, through: Option<LocalId>) {
+    /// Checks a local the operand reads (`through`: the single-definition
+    /// local whose definition reads it); returns its definition when that
+    /// must be walked next.
+    fn local(&mut self, local: LocalId, span: Span, name: &str, through: Option<LocalId>) -> Option<&'a Expr> {
         let facts = self.facts;
         if facts.is_invariant(local) {
             if through.is_some() && !facts.is_stable(local) {
                 self.error(local, span, name, Why::Stale);
-                return;
+                return None;
             }
             self.params.insert(local);
-            return;
+            return None;
         }
         match facts.definitions.get(&local) {
             Some((_, Some(defined_at))) if *defined_at >= self.statement => {
                 self.error(local, span, name, Why::Before);
+                None
             }
-            Some((definition, _)) => {
-                if self.visiting.contains(&local) {
-                    return;
-                }
-                self.visiting.push(local);
-                self.expr(definition, Some(local));
-                self.visiting.pop();
+            // Read again through its own definition: a definition that reads
+            // the local it assigns (`a = a + x;`), directly or through others,
+            // reads the value from before the assignment, which inlining
+            // cannot give (and would never finish).
+            Some(_) if self.visiting.contains(&local) => {
+                self.error(local, span, name, Why::SelfRead);
+                None
             }
-            None => self.error(local, span, name, Why::Unstable),
+            Some(_) if self.walked.contains(&local) => None,
+            Some((definition, _)) => Some(*definition),
+            None => {
+                self.error(local, span, name, Why::Unstable);
+                None
+            }
         }
     }
 
@@ -441,9 +487,10 @@ impl OperandWalk<'_, '_> {
         // Reached through an inlined definition: `span` is in that definition,
         // away from the derivative, so the derivative is the primary label
         // and the labels below it trace the operand to `name`.
-        let (Some(&first), Some(&through)) = (self.visiting.first(), self.visiting.last()) else {
+        let (Some(&first), Some(&through)) = (self.path.first(), self.path.last()) else {
             let why = match why {
                 Why::Before => format!("`{name}` is differentiated before it is assigned"),
+                Why::SelfRead => format!("`{name}` is read by its own definition, before it is assigned"),
                 Why::Stale | Why::Unstable => unstable,
             };
             self.diagnostics.push(
@@ -458,12 +505,18 @@ impl OperandWalk<'_, '_> {
         let via = &self.checked.locals[through.index()].name;
         let callee = &self.callee.name;
         let site = match why {
-            Why::Before => None,
+            Why::Before | Why::SelfRead => None,
             Why::Stale | Why::Unstable => assignment_site(self.body, self.checked, local),
         };
         let used = match (why, site) {
             (Why::Before, _) => {
                 format!("`{via}` is computed from `{name}`, which is assigned only after the derivative")
+            }
+            (Why::SelfRead, _) if via == name => {
+                format!("`{name}` is read by its own definition, before it is assigned")
+            }
+            (Why::SelfRead, _) => {
+                format!("`{via}` is computed from `{name}`, which reads `{via}` before it is assigned")
             }
             (Why::Stale, _) => format!(
                 "`{via}` is computed from `{name}`, which is assigned more than once, so its value at the neighbouring \
@@ -516,6 +569,9 @@ enum Why {
     Before,
     /// Neither invariant nor single-definition.
     Unstable,
+    /// Read by its own definition, directly or through others (`a = a + x;`):
+    /// the value from before the assignment, which inlining cannot give.
+    SelfRead,
 }
 
 /// Why an assignment makes a local impossible to recompute at a neighbour.

@@ -10,9 +10,57 @@ use crate::types::{self, Scalar, Type};
 use std::collections::HashMap;
 
 impl Checker<'_> {
+    /// The value of a constant, evaluated once (a failure, too, is reported
+    /// once). The constants it reads are evaluated first, deepest first and
+    /// without recursion, so that a chain of constants of any length, in any
+    /// declaration order, is evaluated in constant stack space.
     pub(super) fn const_value(&mut self, id: ConstId) -> Option<ConstValue> {
-        if let Some(v) = &self.out.consts[id.index()].value {
-            return Some(v.clone());
+        if self.evaluated_consts.contains(&id.0) || self.evaluating_consts.contains(&id.0) {
+            return self.evaluate_const(id);
+        }
+        // Depth-first over the constants each initialiser names; a constant
+        // is evaluated when those it names are. A constant met again on the
+        // current path is left to `evaluate_const`, which reports the cycle.
+        let mut stack = vec![(id, self.consts_named(id))];
+        self.evaluating_consts.insert(id.0);
+        while let Some((c, named)) = stack.last_mut() {
+            match named.pop() {
+                Some(next) => {
+                    if !self.evaluated_consts.contains(&next.0) && self.evaluating_consts.insert(next.0) {
+                        let named = self.consts_named(next);
+                        stack.push((next, named));
+                    }
+                }
+                None => {
+                    let c = *c;
+                    stack.pop();
+                    self.evaluating_consts.remove(&c.0);
+                    self.evaluate_const(c);
+                }
+            }
+        }
+        self.out.consts[id.index()].value.clone()
+    }
+
+    /// The constants the initialiser of `id` names, last first.
+    fn consts_named(&self, id: ConstId) -> Vec<ConstId> {
+        let mut named = vec![];
+        visit_expr(&self.out.const_decl(id).value, &mut |x| {
+            if let ExprKind::Name(name) = &x.kind
+                && let Some((Global::Const(c), _)) = self.globals.get(name)
+            {
+                named.push(*c);
+            }
+        });
+        named.reverse();
+        named
+    }
+
+    /// Evaluates one constant whose named constants are evaluated already
+    /// (see [`Checker::const_value`]), or returns its value if it is.
+    fn evaluate_const(&mut self, id: ConstId) -> Option<ConstValue> {
+        if self.evaluated_consts.contains(&id.0) {
+            return self.out.consts[id.index()].value.clone();
         }
         if !self.evaluating_consts.insert(id.0) {
             let decl = self.out.const_decl(id);
@@ -53,6 +101,7 @@ impl Checker<'_> {
         };
         self.out.consts[id.index()].value = value.clone();
         self.evaluating_consts.remove(&id.0);
+        self.evaluated_consts.insert(id.0);
         value
     }
 
