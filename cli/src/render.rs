@@ -56,10 +56,7 @@ pub fn compile_program(
     modes: &[Mode],
 ) -> Result<(String, mrsl::Program), String> {
     let (name, source) = match path {
-        Some(path) => (
-            path.display().to_string(),
-            std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?,
-        ),
+        Some(path) => (path.display().to_string(), crate::read_source(path)?),
         None => (format!("{} (built in)", builtin.0), builtin.1.to_string()),
     };
     let options = Options { file_name: name.clone(), ..mrsl_runtime::compile_options(modes) };

@@ -38,6 +38,7 @@ use crate::deriv::DerivInfo;
 use crate::diagnostic::{Diagnostic, Label};
 use crate::graph::EffectGraph;
 use crate::syntax::ast::*;
+use crate::syntax::visit_expr;
 use std::collections::{HashMap, HashSet};
 
 /// The most operations one effect's evaluation may take, fully inlined
@@ -63,6 +64,43 @@ pub struct Costs {
 /// Counts the operations of the fully inlined code of every live effect.
 pub fn costs(checked: &Checked, graph: &EffectGraph, deriv: &DerivInfo) -> Costs {
     let mut counter = Counter { checked, deriv, memo: HashMap::new() };
+    // The counter memoises, and recurses only into what is not counted yet.
+    // Counting the links of every chain first, callees and dependencies before
+    // their users, keeps that recursion to one expression's depth (which the
+    // nesting limits bound): chains of functions, effects and inlined
+    // definitions can be thousands of links long.
+    let functions =
+        postorder(checked.functions.len(), |f| checked.functions[f].calls.iter().map(|c| c.index()).collect());
+    for f in functions {
+        counter.function(FunctionId(f as u32));
+    }
+    let mut locals: Vec<LocalId> = deriv.definitions.keys().copied().collect();
+    locals.sort_by_key(|l| l.index());
+    let local_index: HashMap<LocalId, usize> = locals.iter().enumerate().map(|(k, l)| (*l, k)).collect();
+    let definitions = postorder(locals.len(), |k| {
+        let mut read = vec![];
+        visit_expr(deriv.definitions[&locals[k]], &mut |x| {
+            if let Some(Symbol::Local(l)) = checked.symbols.get(&x.id)
+                && let Some(&j) = local_index.get(l)
+            {
+                read.push(j);
+            }
+        });
+        read
+    });
+    for k in definitions {
+        let l = locals[k];
+        let definition = deriv.definitions[&l];
+        counter.memo(Key::Definition(l), |c| c.expr(definition, At::Neighbour(&[])));
+    }
+    let effects =
+        postorder(checked.effects.len(), |e| checked.effects[e].deps.iter().map(|(d, _)| d.index()).collect());
+    for e in effects {
+        let e = EffectId(e as u32);
+        counter.effect(e, true);
+        counter.effect(e, false);
+        counter.at(e);
+    }
     let effects: Vec<(EffectId, u64)> = graph.order.iter().map(|&e| (e, counter.effect(e, false))).collect();
     let total = effects.iter().fold(0u64, |sum, (_, cost)| sum.saturating_add(*cost));
     Costs { effects, total }
@@ -134,6 +172,33 @@ fn neighbour_effects(deriv: &DerivInfo, e: EffectId) -> Vec<EffectId> {
         }
     }
     out
+}
+
+/// The nodes `0..n` in an order where every node comes after the nodes
+/// `successors` gives for it (cycles broken anywhere), found without recursion.
+fn postorder(n: usize, successors: impl Fn(usize) -> Vec<usize>) -> Vec<usize> {
+    let mut order = Vec::with_capacity(n);
+    let mut seen = vec![false; n];
+    for root in 0..n {
+        if std::mem::replace(&mut seen[root], true) {
+            continue;
+        }
+        // (node, its successors, how many of them have been visited)
+        let mut stack = vec![(root, successors(root), 0usize)];
+        while let Some((node, next, k)) = stack.last_mut() {
+            if let Some(&s) = next.get(*k) {
+                *k += 1;
+                if s < n && !std::mem::replace(&mut seen[s], true) {
+                    let after = successors(s);
+                    stack.push((s, after, 0));
+                }
+            } else {
+                order.push(*node);
+                stack.pop();
+            }
+        }
+    }
+    order
 }
 
 /// `1234567` as `1,234,567`.
