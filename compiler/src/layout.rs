@@ -162,6 +162,11 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface) -> L
                 resample: (e.rate == Rate::Coarse)
                     .then(|| if uses_nearest(checked, id) { Resample::Nearest } else { Resample::Bilinear }),
                 depends_on: e.deps.iter().map(|(d, _)| name(d)).collect(),
+                keys: if e.rate == Rate::Coarse && graph.live[i] {
+                    graph.keys[i].iter().map(|k| checked.inputs[k.index()].name.clone()).collect()
+                } else {
+                    vec![]
+                },
                 pass_condition: condition,
             }
         })
