@@ -23,6 +23,12 @@ pub struct Point {
     pub coarse_fraction: f64,
     /// Median wall time of submit-to-idle over the runs.
     pub wall_ms: f64,
+    /// Median over the runs of the wall time divided by that of the
+    /// reference run paired with it (1 for the reference itself).
+    pub relative_time: f64,
+    /// The scene's reference time (its median wall time) that
+    /// [`Point::time_ms`] scales `relative_time` by.
+    pub reference_ms: f64,
     /// Median GPU time of the shading passes (timestamp span), if the device has timestamps.
     pub gpu_ms: Option<f64>,
     /// Medians of the per-pass timestamps ([`mrsl_runtime::Timings`]): the
@@ -38,12 +44,14 @@ pub struct Point {
 }
 
 impl Point {
-    /// The time speedups are computed from: the wall time from submission to
-    /// idle, which holds only mrsl's passes and their clears and copies. (The
+    /// The time speedups are computed from: the paired ratio to the
+    /// reference times the reference's wall time (from submission to idle,
+    /// which holds only mrsl's passes and their clears and copies), so that
+    /// a speedup is the inverse of the median per-pair ratio. (The
     /// timestamp span is reported beside it, but on lavapipe it misses part of
     /// the block modes' work: see docs/evaluation.md.)
     pub fn time_ms(&self) -> f64 {
-        self.wall_ms
+        self.relative_time * self.reference_ms
     }
 }
 
@@ -278,7 +286,7 @@ pub fn markdown(setup: &str, points: &[Point], frames: &[ControllerFrame]) -> St
             "Speedup is reference time / mode time, interpolated along each mode's quality/time frontier; \
              `*` marks a bound (the sweep's cheapest point already exceeds the quality: the speedup is at least this). \
              Efficiency = speedup / (1 / coarse shading rate) at MSSIM 0.99. \
-             Times are medians of wall time.\n"
+             Times are paired with reference runs: speedup = 1 / median(mode time / reference time) over the pairs.\n"
         );
         let _ = writeln!(
             out,
@@ -318,14 +326,14 @@ pub fn markdown(setup: &str, points: &[Point], frames: &[ControllerFrame]) -> St
         let _ = writeln!(out, "\n### Every point\n");
         let _ = writeln!(
             out,
-            "| mode | knob | value | forced | shaded | coarse rate | wall ms | GPU ms | RMSE | PSNR dB | MSSIM | FLIP |"
+            "| mode | knob | value | forced | shaded | coarse rate | wall ms | paired speedup | RMSE | PSNR dB | MSSIM | FLIP |"
         );
         let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|");
         for p in points.iter().filter(|p| p.scene == scene) {
             let value = if p.value.is_nan() { "-".to_string() } else { format!("{:.3e}", p.value) };
             let _ = writeln!(
                 out,
-                "| {} | {} | {} | {} | {:.1}% | {:.1}% | {:.1} | {} | {:.5} | {:.2} | {:.5} | {:.5} |",
+                "| {} | {} | {} | {} | {:.1}% | {:.1}% | {:.1} | {:.2} | {:.5} | {:.2} | {:.5} | {:.5} |",
                 p.mode,
                 p.knob,
                 value,
@@ -333,7 +341,7 @@ pub fn markdown(setup: &str, points: &[Point], frames: &[ControllerFrame]) -> St
                 100.0 * p.shaded_fraction,
                 100.0 * p.coarse_fraction,
                 p.wall_ms,
-                dash(p.gpu_ms, 1),
+                1.0 / p.relative_time,
                 p.rmse,
                 p.psnr,
                 p.mssim,
@@ -516,6 +524,8 @@ mod tests {
             shaded_fraction: fraction,
             coarse_fraction: fraction,
             wall_ms: time,
+            relative_time: time / 100.0,
+            reference_ms: 100.0,
             gpu_ms: None,
             coarse_pass_ms: None,
             fine_pass_ms: None,
@@ -581,7 +591,7 @@ mod tests {
         let text = csv(&pts).unwrap();
         assert_eq!(text.lines().count(), 4);
         assert!(text.starts_with(
-            "scene,mode,knob,value,forced,shaded_fraction,coarse_fraction,wall_ms,gpu_ms,coarse_pass_ms,fine_pass_ms,rmse,psnr,mssim,flip"
+            "scene,mode,knob,value,forced,shaded_fraction,coarse_fraction,wall_ms,relative_time,reference_ms,gpu_ms,coarse_pass_ms,fine_pass_ms,rmse,psnr,mssim,flip"
         ));
         let md = markdown("setup", &pts, &[]);
         // MSSIM 0.99 at 46.7 ms: 100 / 46.7.
