@@ -343,4 +343,10 @@ pub struct EffectLayout {
     pub keys: Vec<String>,
     /// When the effect is passed, as a formula over refine flags `r_X`.
     pub pass_condition: Option<String>,
+    /// The compiler's cost model for a live effect: the operations one
+    /// evaluation executes (expression nodes and statements, inlined calls
+    /// and derivative neighbour evaluations included, loop bodies times their
+    /// static trip counts, texture reads weighted 4). Times the evaluations
+    /// a mode makes, a platform-independent measure of shading work.
+    pub operations: Option<u64>,
 }

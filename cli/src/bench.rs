@@ -147,6 +147,24 @@ impl Bench<'_> {
     }
 }
 
+/// The shading operations of one frame by the compiler's cost model (the
+/// layout's `operations` per evaluation, times the evaluations the
+/// statistics count), and those of the reference, which evaluates every
+/// effect once per pixel.
+fn shading_operations(program: &mrsl::Program, stats: &Stats) -> (f64, f64) {
+    let pixels = f64::from(stats.width) * f64::from(stats.height);
+    let mut mode = 0.0;
+    let mut reference = 0.0;
+    for e in &stats.effects {
+        let Some(ops) = program.layout.effects.iter().find(|l| l.name == e.name).and_then(|l| l.operations) else {
+            continue;
+        };
+        mode += ops as f64 * (e.coarse_evaluations + e.pixel_evaluations) as f64;
+        reference += ops as f64 * pixels;
+    }
+    (mode, reference)
+}
+
 /// The program's uniform `name`, if it declares one.
 fn uniform<'p>(program: &'p mrsl::Program, name: &str) -> Option<&'p mrsl_abi::Field> {
     program.layout.uniforms.as_ref()?.fields.iter().find(|f| f.name == name)
@@ -258,6 +276,10 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
                 coarse_fraction: m.stats.coarse_shaded_fraction,
                 wall_ms: m.wall_ms,
                 relative_time: m.relative,
+                fewer_operations: {
+                    let (ops, reference) = shading_operations(&program, &m.stats);
+                    reference / ops
+                },
                 // Set below, once the scene's reference is measured.
                 reference_ms: f64::NAN,
                 gpu_ms: m.gpu_ms,
