@@ -76,10 +76,14 @@ fn no_instrumentation(w: &str) -> Option<String> {
     })
 }
 
-/// No coarse effect is evaluated per pixel: every one is resampled.
+/// No coarse effect is evaluated per pixel: every one is resampled (and
+/// in the compacted kernel, no pixel is listed for evaluation).
 fn nothing_refined(w: &str) -> Option<String> {
     edit_lines(w, |l| {
         let t = l.trim_start();
+        if t.starts_with("if (mrsl_is_refined(mrsl_b, ") && t.contains("mrsl_cq[") {
+            return Some(String::new());
+        }
         (t.starts_with("if (mrsl_is_refined(mrsl_b, ") && t.ends_with(")) {"))
             .then(|| format!("{}if (false) {{", indent(l)))
     })
@@ -113,9 +117,12 @@ fn no_resampling(w: &str) -> Option<String> {
 
 /// Everything the fine pass does per pixel.
 fn no_fine_work(w: &str) -> Option<String> {
-    edit_lines(w, |l| {
-        (l.trim_start() == "if (all(mrsl_pos < mrsl_grid())) {")
-            .then(|| format!("{}if (false && all(mrsl_pos < mrsl_grid())) {{", indent(l)))
+    edit_lines(w, |l| match l.trim_start() {
+        "if (all(mrsl_pos < mrsl_grid())) {" => {
+            Some(format!("{}if (false && all(mrsl_pos < mrsl_grid())) {{", indent(l)))
+        }
+        "let mrsl_in = all(mrsl_pos < mrsl_grid());" => Some(format!("{}let mrsl_in = false;", indent(l))),
+        _ => None,
     })
 }
 
@@ -181,6 +188,18 @@ pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>, String> {
     let full: &CompiledProgram = &program;
     let fine = full.kernel(KernelKind::Fine, block).ok_or("the program has no fine kernel")?;
     let mut programs: Vec<(&str, &str, CompiledProgram)> = vec![("full", "nothing", full.clone())];
+    // The same program compiled with the fine pass compacted (`Options::compact`).
+    let source = match &args.program {
+        Some(path) => crate::read_source(path)?,
+        None => WORKLOAD_PROGRAM.to_string(),
+    };
+    let options = mrsl::Options { compact: true, file_name: name.clone(), ..mrsl_runtime::compile_options(&modes) };
+    let compacted = mrsl::compile(&source, &options).map_err(|d| mrsl::render_all(&d, &name, &source))?;
+    programs.push((
+        "compacted (added)",
+        "nothing; adds the workgroup compaction: refined pixels re-evaluate together on consecutive lanes",
+        compacted.compiled.clone(),
+    ));
     let mut skipped = vec![];
     for v in &VARIANTS {
         match apply(v, &fine.wgsl) {
@@ -293,6 +312,15 @@ mod tests {
                 let edited = apply(v, fine).unwrap_or_else(|| panic!("{}: no line to edit", v.name));
                 assert_ne!(&edited, fine, "{}", v.name);
                 mrsl::validate_wgsl(&edited).unwrap_or_else(|e| panic!("{} (block {block}): {e}", v.name));
+            }
+            // The compacted kernel takes the edits that apply to it too.
+            let compacted =
+                mrsl::compile(WORKLOAD_PROGRAM, &mrsl::Options { compact: true, ..Default::default() }).unwrap();
+            let fine = &compacted.kernel(KernelKind::Fine, block).unwrap().wgsl;
+            for edit in [nothing_refined, no_fine_work, no_instrumentation] {
+                let edited = edit(fine).expect("the compacted kernel has the lines");
+                assert!(!edited.contains("mrsl_cq[0u + atomicAdd") || edit != nothing_refined as Edit);
+                mrsl::validate_wgsl(&edited).unwrap();
             }
         }
     }

@@ -114,6 +114,15 @@ pub struct Options {
     pub checkerboard: bool,
     /// Name written in the header comment of every generated kernel.
     pub file_name: String,
+    /// Compact the block modes' fine pass: the pixels of a workgroup that
+    /// re-evaluate a coarse effect do so together, on consecutive lanes,
+    /// exchanging values through workgroup memory (one barrier per coarse
+    /// effect). The images are the same bit for bit. Off by default: on
+    /// lavapipe, where a barrier switches every invocation's coroutine, it
+    /// made the Sponza workload's fine pass slower (docs/evaluation.md,
+    /// `mrslc bench --ablation`); on GPUs, whose barriers are cheap, it is
+    /// the layout He et al. describe, but it has not been measured on one.
+    pub compact: bool,
 }
 
 impl Default for Options {
@@ -127,6 +136,7 @@ impl Default for Options {
             hierarchical: true,
             checkerboard: true,
             file_name: "program.mrsl".into(),
+            compact: false,
         }
     }
 }
@@ -253,6 +263,7 @@ fn generate(
         deriv,
         layout: &layout,
         file_name: &options.file_name,
+        compact: options.compact,
         source,
         cache: codegen::Cache::new(source),
     };

@@ -406,3 +406,31 @@ pub fn derivative_chains_render_in_every_mode(gpu: &Gpu) {
         }
     }
 }
+
+/// The compacted fine pass (`Options::compact`) evaluates the same
+/// functions at the same pixels as the plain one, only on other lanes, so
+/// its images and statistics equal the plain pass's bit for bit, adaptive
+/// and forced, for every example, at both block sizes and at a size whose
+/// tiles the image cuts (75x43).
+pub fn compacted_fine_pass_equals_the_plain_one(gpu: &Gpu) {
+    let gbuffer = Scene::Demo.render(75, 43);
+    for (name, source) in examples() {
+        // The block modes' kernels alone: pipeline creation dominates on lavapipe.
+        let options = mrsl::Options { coarse: true, fine: true, block_sizes: vec![2, 4], ..mrsl::Options::none() };
+        let plain = mrsl::compile(&source, &options).unwrap();
+        let compacted = mrsl::compile(&source, &mrsl::Options { compact: true, ..options }).unwrap();
+        for block in [2, 4] {
+            let (a, b) = (plain.kernel(mrsl::KernelKind::Fine, block), compacted.kernel(mrsl::KernelKind::Fine, block));
+            assert!(b.unwrap().wgsl.contains("mrsl_cq_n"), "{name}: the fine kernel (block {block}) is not compacted");
+            assert_ne!(a.unwrap().wgsl, b.unwrap().wgsl);
+        }
+        for mode in [Mode::Coarse2x2, Mode::Coarse4x4] {
+            for forced in [false, true] {
+                let want = run(gpu, &plain, &gbuffer, mode, forced).unwrap();
+                let got = run(gpu, &compacted, &gbuffer, mode, forced).unwrap();
+                assert!(got.pixels == want.pixels, "{name} {mode} (forced: {forced}): the images differ");
+                assert_eq!(got.stats.effects, want.stats.effects, "{name} {mode} (forced: {forced})");
+            }
+        }
+    }
+}

@@ -404,6 +404,9 @@ impl Writer<'_, '_, '_> {
     pub(super) fn pixel_entry(&mut self) {
         // The reference kernel has no blocks; it lays its tiles out in 2x2 ones.
         self.tile_pixel_blocks(if self.kind.is_fine() { self.block } else { 2 });
+        if self.compacts() {
+            return self.compacted_fine_entry();
+        }
         let counted = self.counts_stats();
         let coarse = self.coarse_live().len();
         self.pixel_main(

@@ -48,6 +48,7 @@
 mod block;
 mod body;
 mod checkerboard;
+mod compact;
 mod dynamic;
 mod effects;
 mod hierarchical;
@@ -77,6 +78,8 @@ pub(crate) struct Inputs<'a, 'b> {
     pub deriv: &'b DerivInfo<'a>,
     pub layout: &'b Layout,
     pub file_name: &'b str,
+    /// `Options::compact`.
+    pub compact: bool,
     pub source: &'b str,
     /// What the kernels of one compile share: build it once with
     /// [`Cache::new`] and write every kernel with the same inputs.

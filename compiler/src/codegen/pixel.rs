@@ -121,7 +121,7 @@ impl Writer<'_, '_, '_> {
         self.line(2, format!("if ({condition}) {{ atomicAdd(&mrsl_wg_stats[{k}], 1u); }}"));
     }
 
-    fn output_stores(&mut self, order: &[EffectId], indent: usize) {
+    pub(super) fn output_stores(&mut self, order: &[EffectId], indent: usize) {
         let c = self.checked();
         for e in order {
             let info = &c.effects[e.index()];

@@ -1,0 +1,163 @@
+//! The compacted fine pass of the block modes (`fine_main` of the `Fine`
+//! kernels): He et al.'s "fine shading SIMD packets" within a workgroup.
+//!
+//! Where a block is refined, only some pixels of a workgroup re-evaluate a
+//! coarse effect, and a SIMD machine runs the expensive evaluation with the
+//! other lanes idle. Here every pixel first resolves its block and appends
+//! itself to a workgroup list per coarse effect it refines; then, effect by
+//! effect in dependency order, the first lanes of the workgroup evaluate the
+//! effect for the listed pixels, densely, and leave the values in workgroup
+//! memory; last, every pixel takes each coarse value from there or resamples
+//! it, and evaluates its fine effects and outputs as before.
+//!
+//! An effect evaluated for another pixel is evaluated exactly as that pixel
+//! would: at its position, with its dependencies at their rates there (from
+//! the workgroup memory where refined, resampled from its block otherwise),
+//! by the same `mrsl_eval_<effect>` every kernel shares, and derivatives
+//! recompute their neighbours from positions. So forced refinement still
+//! equals the reference bit for bit.
+//!
+//! The lists and values take workgroup memory in proportion to the number
+//! of coarse effects; a program whose share would not fit
+//! [`MAX_COMPACTION_BYTES`] keeps the uncompacted entry point.
+
+use super::Writer;
+use crate::check::EffectId;
+use crate::syntax::ast::Rate;
+use crate::types::Type;
+use mrsl_abi::geometry::PIXEL_WORKGROUP;
+
+/// The workgroup memory the compaction may use: WebGPU guarantees 16,384
+/// bytes per workgroup; the rest is left to the statistics counters.
+pub(super) const MAX_COMPACTION_BYTES: u32 = 12 * 1024;
+
+/// The bytes one element of an array of `ty` takes in workgroup memory (its
+/// array stride in WGSL).
+fn stride(ty: &Type) -> u32 {
+    match ty {
+        Type::Vector(_, 2) => 8,
+        Type::Vector(_, _) => 16,
+        Type::Matrix(cols) => 16 * u32::from(*cols),
+        _ => 4,
+    }
+}
+
+impl Writer<'_, '_, '_> {
+    /// The workgroup memory the compacted entry point needs.
+    fn compaction_bytes(&self) -> u32 {
+        let coarse = self.coarse_live();
+        let k = coarse.len() as u32;
+        let block = 16 + 16 + 4 + 4 * k.div_ceil(32);
+        let values: u32 = coarse.iter().map(|&e| stride(&self.checked().effects[e.index()].ty)).sum();
+        4 * k + 4 * k * PIXEL_WORKGROUP + PIXEL_WORKGROUP * (block.div_ceil(16) * 16 + values)
+    }
+
+    /// Whether the fine entry point is compacted: a `Fine` kernel with live
+    /// coarse effects whose lists and values fit the workgroup memory.
+    pub(super) fn compacts(&self) -> bool {
+        self.i.compact
+            && self.kind == mrsl_abi::KernelKind::Fine
+            && !self.coarse_live().is_empty()
+            && self.compaction_bytes() <= MAX_COMPACTION_BYTES
+    }
+
+    /// `fine_main`, compacted (see the module documentation).
+    pub(super) fn compacted_fine_entry(&mut self) {
+        let coarse = self.coarse_live();
+        let wg = PIXEL_WORKGROUP;
+        let k = coarse.len();
+        self.line(0, "// Compaction: per coarse effect, the workgroup's pixels that re-evaluate it (local");
+        self.line(0, "// indices), each pixel's block, and the values evaluated for them.");
+        self.line(0, format!("var<workgroup> mrsl_cq_n: array<atomic<u32>, {k}>;"));
+        self.line(0, format!("var<workgroup> mrsl_cq: array<u32, {}>;", k as u32 * wg));
+        self.line(0, format!("var<workgroup> mrsl_cb: array<MrslBlock, {wg}>;"));
+        for &e in &coarse {
+            let info = &self.checked().effects[e.index()];
+            self.line(0, format!("var<workgroup> mrsl_cv_{}: array<{}, {wg}>;", info.name, info.ty.wgsl()));
+        }
+        self.line(0, "");
+        let [x, y, z] = self.kind.workgroup_size();
+        self.line(0, format!("@compute @workgroup_size({x}, {y}, {z})"));
+        self.line(
+            0,
+            format!(
+                "fn {}(@builtin(workgroup_id) mrsl_wg: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {{",
+                self.kind.main_entry_point()
+            ),
+        );
+        self.line(1, "let mrsl_pos = mrsl_tile_pixel(mrsl_wg.xy, mrsl_li);");
+        self.line(1, "let mrsl_in = all(mrsl_pos < mrsl_grid());");
+        // 1. Resolve, count, and list the pixel for each coarse effect it re-evaluates.
+        self.line(1, "if (mrsl_in) {");
+        self.resolve_preamble(2, "");
+        self.line(2, "mrsl_cb[mrsl_li] = mrsl_b;");
+        self.template(2, include_str!("templates/rate.wgsl"), &[("LAST", &"mrsl_b"), ("FROM_INNER", &"0u")]);
+        for j in 0..k {
+            self.count_refined(j, &format!("mrsl_is_refined(mrsl_last, {j}u)"));
+        }
+        for &e in &coarse {
+            let j = self.coarse_index[&e];
+            self.line(
+                2,
+                format!(
+                    "if (mrsl_is_refined(mrsl_b, {j}u)) {{ mrsl_cq[{}u + atomicAdd(&mrsl_cq_n[{j}], 1u)] = mrsl_li; }}",
+                    j * wg
+                ),
+            );
+        }
+        self.line(1, "}");
+        self.line(1, "workgroupBarrier();");
+        // 2. Each coarse effect, dependencies first, by the first lanes for the listed pixels.
+        for &e in &coarse {
+            let j = self.coarse_index[&e];
+            let name = self.checked().effects[e.index()].name.clone();
+            self.line(1, format!("// `{name}` where it is re-evaluated, one lane per listed pixel"));
+            self.line(1, format!("if (mrsl_li < atomicLoad(&mrsl_cq_n[{j}])) {{"));
+            self.line(2, format!("let mrsl_q = mrsl_cq[{}u + mrsl_li];", j * wg));
+            self.line(2, "let mrsl_pos = mrsl_tile_pixel(mrsl_wg.xy, mrsl_q);");
+            self.line(2, "let mrsl_b = mrsl_cb[mrsl_q];");
+            for (d, _) in self.checked().effects[e.index()].deps.clone() {
+                self.compacted_value(d, 2, "mrsl_q");
+            }
+            self.evaluate(e, 2, "let ");
+            self.line(2, format!("mrsl_cv_{name}[mrsl_q] = {};", self.effect_name(e)));
+            self.line(1, "}");
+            self.line(1, "workgroupBarrier();");
+        }
+        // 3. Per pixel: coarse values from the workgroup or resampled, then the fine effects.
+        self.line(1, "if (mrsl_in) {");
+        self.line(2, "let mrsl_b = mrsl_cb[mrsl_li];");
+        let order = self.i.graph.order.clone();
+        for &e in &order {
+            if self.checked().effects[e.index()].rate == Rate::Coarse {
+                self.compacted_value(e, 2, "mrsl_li");
+            } else {
+                self.evaluate(e, 2, "let ");
+            }
+        }
+        self.output_stores(&order, 2);
+        self.line(1, "}");
+        self.template(
+            0,
+            include_str!("templates/stats_flush.wgsl"),
+            &[("COUNTERS", &k), ("WORKGROUP", &PIXEL_WORKGROUP)],
+        );
+        self.line(0, "}");
+    }
+
+    /// Coarse effect `e` at the pixel of local index `lane`: from the
+    /// workgroup memory where the pixel re-evaluated it, else resampled
+    /// (when it is passed; where it is not, the resolve refined it).
+    fn compacted_value(&mut self, e: EffectId, indent: usize, lane: &str) {
+        let info = &self.checked().effects[e.index()];
+        let (j, var) = (self.coarse_index[&e], self.effect_name(e));
+        self.line(indent, format!("var {var}: {};", info.ty.wgsl()));
+        self.line(indent, format!("if (mrsl_is_refined(mrsl_b, {j}u)) {{"));
+        self.line(indent + 1, format!("{var} = mrsl_cv_{}[{lane}];", info.name));
+        if self.i.interface.is_passed(e) {
+            self.line(indent, "} else {");
+            self.line(indent + 1, format!("{var} = mrsl_resample_{}(mrsl_b);", info.name));
+        }
+        self.line(indent, "}");
+    }
+}
