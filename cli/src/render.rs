@@ -528,3 +528,49 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
     }
     Ok((w, h))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn modes_are_a_comma_list_or_all() {
+        assert_eq!(parse_modes("coarse4x4"), Ok(ModeList(vec![Mode::Coarse4x4])));
+        assert_eq!(
+            parse_modes("hierarchical, reference"),
+            Ok(ModeList(vec![Mode::Hierarchical, Mode::Reference])),
+            "in the order given"
+        );
+        assert_eq!(parse_modes("all"), Ok(ModeList(Mode::ALL.to_vec())));
+        // Each mode once, where it first appears.
+        assert_eq!(
+            parse_modes("dynamic,all,dynamic"),
+            Ok(ModeList(vec![
+                Mode::Dynamic,
+                Mode::Reference,
+                Mode::Coarse2x2,
+                Mode::Coarse4x4,
+                Mode::Hierarchical,
+                Mode::Checkerboard
+            ]))
+        );
+    }
+
+    #[test]
+    fn unknown_modes_are_named_together() {
+        assert_eq!(
+            parse_modes("reference,coarse8x8"),
+            Err("unknown mode `coarse8x8` (expected a comma-separated list of reference, coarse2x2, coarse4x4, \
+                 dynamic, hierarchical, checkerboard, or all)"
+                .into())
+        );
+        let e = parse_modes("fast,reference,,slow").unwrap_err();
+        assert!(e.starts_with("unknown modes `fast`, ``, `slow` (expected"), "{e}");
+    }
+
+    #[test]
+    fn outputs_named_after_a_path_take_the_suffix_before_the_extension() {
+        assert_eq!(with_suffix(Path::new("out/heat.png"), ".dynamic"), PathBuf::from("out/heat.dynamic.png"));
+        assert_eq!(with_suffix(Path::new("heat.png"), ""), PathBuf::from("heat.png"));
+    }
+}

@@ -143,7 +143,7 @@ impl fmt::Display for Mismatch {
     "{} sets `{}` as {} but the program declares `uniform {} {}`, which has no default: give it one, rename it, or provide a {}",
     .0.source, .0.name, .0.offered, .0.declared, .0.name, .0.declared
 )]
-pub struct UniformTypeError(pub Mismatch);
+pub struct UniformTypeError(pub Box<Mismatch>);
 
 /// What to do with one offered uniform.
 #[derive(Debug, Clone, PartialEq)]
@@ -164,7 +164,7 @@ pub fn check(layout: &Layout, source: &str, name: &str, offered: &Offered) -> Re
     }
     let mismatch =
         Mismatch { source: source.into(), name: name.into(), offered: offered.clone(), declared: declared.type_name() };
-    if declared.has_default() { Ok(Verdict::Skip(mismatch)) } else { Err(UniformTypeError(mismatch)) }
+    if declared.has_default() { Ok(Verdict::Skip(mismatch)) } else { Err(UniformTypeError(Box::new(mismatch))) }
 }
 
 /// What a scene did with a program's uniforms.
