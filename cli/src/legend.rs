@@ -134,8 +134,7 @@ fn ticks(root: &Area, (x0, x1): (i32, i32), y: i32, labels: &[(f32, &str)]) -> D
     for &(t, label) in labels {
         let x = x0 + (t * (x1 - x0 - 1) as f32).round() as i32;
         root.draw(&PathElement::new([(x, y), (x, y + 3)], BLACK))?;
-        let anchor = x.clamp(x0 + 8, x1 - 12);
-        root.draw(&Text::new(label.to_string(), (anchor, y + 3), font.clone()))?;
+        root.draw(&Text::new(label.to_string(), (x, y + 3), font.clone()))?;
     }
     Ok(())
 }
