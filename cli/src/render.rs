@@ -84,8 +84,6 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
     }
     let (name, program) = compile_program(args.program.as_deref(), ("demo.mrsl", DEMO_PROGRAM), &modes)?;
     progress(&format!("compiled {name}: {} kernels", program.kernels.len()), start);
-    std::fs::create_dir_all(&args.out_dir).map_err(|e| format!("cannot create {}: {e}", args.out_dir.display()))?;
-    let in_out = |file: String| args.out_dir.join(file);
 
     let start = Instant::now();
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
@@ -104,6 +102,9 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
     }
     let resources = Resources::new(&gpu, &program, size, textures);
     resources.note_fallbacks();
+    // Created only now, so that a run that fails before rendering leaves nothing behind.
+    std::fs::create_dir_all(&args.out_dir).map_err(|e| format!("cannot create {}: {e}", args.out_dir.display()))?;
+    let in_out = |file: String| args.out_dir.join(file);
     let outputs = &resources.outputs;
     let bindings = resources.bindings(&program, &channels);
 
