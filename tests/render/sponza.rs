@@ -497,7 +497,7 @@ show_checker = false
     assert_eq!(key_of("mesh = \"a.obj\"\n[camera]\neye = [1, 2, 3]\ntarget = [0, 0, 0]\nfov = 200"), "camera.fov");
     assert_eq!(key_of("mesh = \"a.obj\"\n[camera]\neye = [1, 2, 3]\ntarget = [1, 2, 3]"), "camera");
     assert_eq!(key_of("mesh = \"a.obj\"\n[camera]\nposition = [1, 2, 3]"), "camera.position");
-    assert_eq!(key_of("mesh = \"a.obj\"\n[uniforms]\ncolor = \"red\""), "uniforms.color");
+    assert_eq!(key_of("mesh = \"a.obj\"\n[uniforms]\ncolor = [1, \"red\"]"), "uniforms.color");
     assert_eq!(key_of("mesh = \"a.obj\"\nlights = 3"), "lights");
     match SceneFile::parse("mesh = ", &path) {
         Err(e @ SceneFileError::Syntax { .. }) => assert!(e.to_string().contains("scene.toml"), "{e}"),
