@@ -10,7 +10,7 @@ use crate::types::{SampleType, TextureFormat, ValueType};
 use serde::{Deserialize, Serialize};
 
 /// The layout format this crate reads and writes (the `format` field).
-pub const LAYOUT_FORMAT: &str = "mrsl-layout/1";
+pub const LAYOUT_FORMAT: &str = "mrsl-layout/2";
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Layout {
@@ -337,6 +337,16 @@ pub struct EffectLayout {
     pub slot: Option<usize>,
     pub resample: Option<Resample>,
     pub depends_on: Vec<String>,
+    /// For a live coarse effect, the discontinuity keys whose discontinuities
+    /// refine it: the key channels it reads, directly or through the effects
+    /// it reads (empty otherwise).
+    pub keys: Vec<String>,
     /// When the effect is passed, as a formula over refine flags `r_X`.
     pub pass_condition: Option<String>,
+    /// The compiler's cost model for a live effect: the operations one
+    /// evaluation executes (expression nodes and statements, inlined calls
+    /// and derivative neighbour evaluations included, loop bodies times their
+    /// static trip counts, texture reads weighted 4). Times the evaluations
+    /// a mode makes, a platform-independent measure of shading work.
+    pub operations: Option<u64>,
 }

@@ -58,6 +58,9 @@ struct Bench<'a> {
 struct Measured {
     stats: Stats,
     wall_ms: f64,
+    /// The median over the runs of this configuration's wall time divided by
+    /// that of the reference run paired with it (1 for the reference itself).
+    relative: f64,
     /// Medians of the timestamp span, the coarse passes and the fine pass.
     gpu_ms: Option<f64>,
     coarse_pass_ms: Option<f64>,
@@ -65,37 +68,74 @@ struct Measured {
 }
 
 impl Bench<'_> {
-    /// Runs `options` once to warm up, then `runs` times; medians.
-    fn measure(&mut self, bindings: &Bindings, options: DispatchOptions) -> Result<Measured, String> {
+    /// One run of `options`, from encoding to idle: its wall time in ms.
+    fn time_once(&mut self, bindings: &Bindings, options: DispatchOptions) -> Result<f64, String> {
+        let device = &self.gpu.device;
+        let start = Instant::now();
+        let mut encoder = device.create_command_encoder(&Default::default());
+        self.shader.encode(device, &self.gpu.queue, &mut encoder, bindings, options).map_err(|e| e.to_string())?;
+        self.gpu.queue.submit([encoder.finish()]);
+        device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| e.to_string())?;
+        Ok(start.elapsed().as_secs_f64() * 1e3)
+    }
+
+    /// Runs `options` once to warm up, then `runs` times, each run paired
+    /// with a run of `reference` (when given) in alternating order (reference
+    /// first, then second, ...), so that a slow moment of a shared machine
+    /// weighs on both members of a pair: the time that counts is the median
+    /// of the per-pair ratios, not a ratio of medians taken at different
+    /// moments. The statistics come from the last run of `options`.
+    fn measure(
+        &mut self,
+        bindings: &Bindings,
+        options: DispatchOptions,
+        reference: Option<DispatchOptions>,
+    ) -> Result<Measured, String> {
         let device = &self.gpu.device;
         let mut walls = vec![];
+        let mut ratios = vec![];
         let mut gpus = vec![];
         let mut coarse = vec![];
         let mut fine = vec![];
-        let mut last = None;
-        for run in 0..=self.runs {
-            let start = Instant::now();
-            let mut encoder = device.create_command_encoder(&Default::default());
-            self.shader.encode(device, &self.gpu.queue, &mut encoder, bindings, options).map_err(|e| e.to_string())?;
-            self.gpu.queue.submit([encoder.finish()]);
-            device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| e.to_string())?;
-            let wall = start.elapsed().as_secs_f64() * 1e3;
-            let stats = self.shader.read_stats(device).map_err(|e| e.to_string())?;
-            if run > 0 {
-                walls.push(wall);
-                if let Some(t) = stats.timings {
-                    gpus.push(t.total_ms);
-                    coarse.push(t.coarse_ms + t.coarse2_ms);
-                    fine.push(t.fine_ms);
-                }
-            }
-            last = Some(stats);
+        self.time_once(bindings, options)?;
+        if let Some(r) = reference {
+            self.time_once(bindings, r)?;
         }
-        let stats = last.ok_or("no run")?;
+        for run in 0..self.runs {
+            let (wall, paired) = match reference {
+                Some(r) if run % 2 == 0 => {
+                    let t_ref = self.time_once(bindings, r)?;
+                    (self.time_once(bindings, options)?, t_ref)
+                }
+                Some(r) => {
+                    let t = self.time_once(bindings, options)?;
+                    (t, self.time_once(bindings, r)?)
+                }
+                None => {
+                    let t = self.time_once(bindings, options)?;
+                    (t, t)
+                }
+            };
+            walls.push(wall);
+            ratios.push(wall / paired);
+        }
+        // The statistics (and the timestamps) of one more run of `options`
+        // alone: the reference runs in between overwrote them.
+        let wall = self.time_once(bindings, options)?;
+        let stats = self.shader.read_stats(device).map_err(|e| e.to_string())?;
+        if reference.is_none() {
+            walls.push(wall);
+        }
+        if let Some(t) = stats.timings {
+            gpus.push(t.total_ms);
+            coarse.push(t.coarse_ms + t.coarse2_ms);
+            fine.push(t.fine_ms);
+        }
         let timed = !gpus.is_empty();
         Ok(Measured {
             stats,
             wall_ms: median(walls),
+            relative: if reference.is_some() { median(ratios) } else { 1.0 },
             gpu_ms: timed.then(|| median(gpus)),
             coarse_pass_ms: timed.then(|| median(coarse)),
             fine_pass_ms: timed.then(|| median(fine)),
@@ -105,6 +145,24 @@ impl Bench<'_> {
     fn set(&mut self, name: &str, value: f64) -> Result<(), String> {
         self.shader.set_uniform(name, &[value]).map_err(|e| e.to_string())
     }
+}
+
+/// The shading operations of one frame by the compiler's cost model (the
+/// layout's `operations` per evaluation, times the evaluations the
+/// statistics count), and those of the reference, which evaluates every
+/// effect once per pixel.
+fn shading_operations(program: &mrsl::Program, stats: &Stats) -> (f64, f64) {
+    let pixels = f64::from(stats.width) * f64::from(stats.height);
+    let mut mode = 0.0;
+    let mut reference = 0.0;
+    for e in &stats.effects {
+        let Some(ops) = program.layout.effects.iter().find(|l| l.name == e.name).and_then(|l| l.operations) else {
+            continue;
+        };
+        mode += ops as f64 * (e.coarse_evaluations + e.pixel_evaluations) as f64;
+        reference += ops as f64 * pixels;
+    }
+    (mode, reference)
 }
 
 /// The program's uniform `name`, if it declares one.
@@ -197,7 +255,8 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
             if let (Mode::Hierarchical, Some(s)) = (mode, value) {
                 options.similarity = s as f32;
             }
-            let m = bench.measure(&bindings, options)?;
+            let paired = (mode != Mode::Reference || forced).then(|| DispatchOptions::new(Mode::Reference));
+            let m = bench.measure(&bindings, options, paired)?;
             let pixels = gpu.read_rgba32f(first_output).map_err(|e| e.to_string())?;
             let metrics = match &reference {
                 None => {
@@ -217,6 +276,13 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
                 shaded_fraction: m.stats.shaded_fraction,
                 coarse_fraction: m.stats.coarse_shaded_fraction,
                 wall_ms: m.wall_ms,
+                relative_time: m.relative,
+                fewer_operations: {
+                    let (ops, reference) = shading_operations(&program, &m.stats);
+                    reference / ops
+                },
+                // Set below, once the scene's reference is measured.
+                reference_ms: f64::NAN,
                 gpu_ms: m.gpu_ms,
                 coarse_pass_ms: m.coarse_pass_ms,
                 fine_pass_ms: m.fine_pass_ms,
@@ -228,13 +294,24 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
             bar.inc(1);
         }
         bar.finish_with_message("done");
+        // Every point's time is its paired ratio times one reference time.
+        let reference_ms = points
+            .iter()
+            .find(|p| &p.scene == scene_name && p.mode == Mode::Reference.to_string() && !p.forced)
+            .map(|p| p.wall_ms)
+            .unwrap_or(f64::NAN);
+        for p in points.iter_mut().filter(|p| &p.scene == scene_name) {
+            p.reference_ms = reference_ms;
+        }
         if args.path_frames > 0 && scene.mesh.is_some() && args.modes.contains(&Mode::Hierarchical) {
             frames = controller_run(&gpu, &program, &mut scene, args)?;
         }
     }
 
     let setup = format!(
-        "Program `{name}`; scenes {}; {}x{}; device {device_name}; {} timed runs per point after one warm-up, medians. \
+        "Program `{name}`; scenes {}; {}x{}; device {device_name}; {} timed runs per point after one warm-up, each \
+         paired with a reference run (alternately before and after it); times are the median of the per-pair ratios \
+         times the reference's median wall time, so speedups are those medians' inverses. \
          Block and dynamic modes sweep the uniform `{}` over {:?}; the hierarchical mode sweeps `similarity` over {:?} \
          with `{}` off. Quality against the reference image of the same program: RMSE, PSNR, MSSIM (Wang 2004), FLIP.",
         args.scenes.join(", "),
@@ -333,7 +410,7 @@ fn controller_run(
         let bindings = resources.bindings(program, &channels);
         let threshold = controller.threshold();
         let options = DispatchOptions { similarity: threshold as f32, ..DispatchOptions::new(Mode::Hierarchical) };
-        let m = bench.measure(&bindings, options)?;
+        let m = bench.measure(&bindings, options, None)?;
         frames.push(ControllerFrame {
             frame: i,
             mode: Mode::Hierarchical.to_string(),

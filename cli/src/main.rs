@@ -7,6 +7,7 @@ use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+mod ablation;
 mod bench;
 mod legend;
 mod render;
@@ -66,7 +67,7 @@ enum Command {
     /// the dynamic-threshold controller along a camera path.
     ///
     /// With no arguments: examples/sponza_lights.mrsl (built in) over Sponza
-    /// at 960x540, every mode; writes bench.md, bench.csv, controller.csv,
+    /// at 1920x1080, every mode; writes bench.md, bench.csv, controller.csv,
     /// quality_vs_time.sponza.png and controller.png into out/
     /// (docs/evaluation.md explains every figure).
     Bench(Bench),
@@ -80,7 +81,7 @@ struct Bench {
     #[arg(long = "scene", default_values = ["sponza"])]
     scenes: Vec<String>,
     /// Image size, WIDTHxHEIGHT.
-    #[arg(long, value_parser = render::parse_size, default_value = "960x540")]
+    #[arg(long, value_parser = render::parse_size, default_value = "1920x1080")]
     size: (u32, u32),
     /// Modes, comma-separated (reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard), or all.
     #[arg(long, alias = "mode", value_parser = render::parse_modes, default_value = "all")]
@@ -94,8 +95,9 @@ struct Bench {
     /// The hierarchical mode's similarity thresholds (comma-separated).
     #[arg(long, value_delimiter = ',', default_values_t = [1e-6, 1e-5, 1e-4, 3e-4, 1e-3, 3e-3, 1e-2])]
     similarities: Vec<f64>,
-    /// Timed runs per point (after one warm-up); the median is reported.
-    #[arg(long, default_value_t = 3)]
+    /// Timed runs per point (after one warm-up), each paired with a reference
+    /// run; the median of the per-pair ratios is reported.
+    #[arg(long, default_value_t = 5)]
     runs: usize,
     /// Output directory (created if missing).
     #[arg(short, long = "out", alias = "out-dir", default_value = "out")]
@@ -106,6 +108,11 @@ struct Bench {
     /// The controller's target shaded fraction.
     #[arg(long, default_value_t = 0.5)]
     target_fraction: f64,
+    /// Instead of the sweep: time the fine pass of the block mode given by
+    /// --modes (coarse4x4 unless given) with one part removed at a time,
+    /// paired with the full kernel, on the first scene (writes ablation.md).
+    #[arg(long)]
+    ablation: bool,
 }
 
 #[derive(clap::Args)]
@@ -221,6 +228,22 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
         }
         Command::Bench(b) => {
             let modes = b.modes.0.clone();
+            if b.ablation {
+                let mode = match modes.as_slice() {
+                    [mode] => *mode,
+                    _ if modes == mrsl_runtime::Mode::ALL => mrsl_runtime::Mode::Coarse4x4,
+                    _ => return Err("--ablation takes one block mode in --modes (coarse2x2 or coarse4x4)".into()),
+                };
+                let args = ablation::AblationArgs {
+                    program: b.program.clone(),
+                    scene: b.scenes.first().cloned().unwrap_or_else(|| "sponza".into()),
+                    size: b.size,
+                    mode,
+                    runs: b.runs,
+                    out_dir: b.out_dir.clone(),
+                };
+                return Ok(written(ablation::ablation(&args)));
+            }
             if !(b.target_fraction > 0.0 && b.target_fraction <= 1.0) {
                 return Err(format!("--target-fraction must be in (0, 1], not {}", b.target_fraction));
             }

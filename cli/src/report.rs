@@ -23,6 +23,16 @@ pub struct Point {
     pub coarse_fraction: f64,
     /// Median wall time of submit-to-idle over the runs.
     pub wall_ms: f64,
+    /// Median over the runs of the wall time divided by that of the
+    /// reference run paired with it (1 for the reference itself).
+    pub relative_time: f64,
+    /// The scene's reference time (its median wall time) that
+    /// [`Point::time_ms`] scales `relative_time` by.
+    pub reference_ms: f64,
+    /// The reference's shading operations over this point's, by the
+    /// compiler's cost model (the layout's `operations` per evaluation times
+    /// the evaluations counted): how many times fewer operations it shades.
+    pub fewer_operations: f64,
     /// Median GPU time of the shading passes (timestamp span), if the device has timestamps.
     pub gpu_ms: Option<f64>,
     /// Medians of the per-pass timestamps ([`mrsl_runtime::Timings`]): the
@@ -38,12 +48,14 @@ pub struct Point {
 }
 
 impl Point {
-    /// The time speedups are computed from: the wall time from submission to
-    /// idle, which holds only mrsl's passes and their clears and copies. (The
+    /// The time speedups are computed from: the paired ratio to the
+    /// reference times the reference's wall time (from submission to idle,
+    /// which holds only mrsl's passes and their clears and copies), so that
+    /// a speedup is the inverse of the median per-pair ratio. (The
     /// timestamp span is reported beside it, but on lavapipe it misses part of
     /// the block modes' work: see docs/evaluation.md.)
     pub fn time_ms(&self) -> f64 {
-        self.wall_ms
+        self.relative_time * self.reference_ms
     }
 }
 
@@ -157,6 +169,8 @@ pub struct ModeSummary {
     pub at_rates: [(Figure, Figure); 3],
     /// Forced-refine time / reference time.
     pub worst_case_overhead: Option<f64>,
+    /// Reference shading operations / the mode's at MSSIM 0.99 (cost model).
+    pub fewer_operations_990: Figure,
 }
 
 /// The shading rates of DACS's Table 1.
@@ -185,6 +199,11 @@ pub fn summarize_mode(points: &[Point], scene: &str, mode: &str) -> Option<ModeS
             }
         }
     };
+    let operations: Vec<(f64, f64)> = front.iter().map(|p| (p.mssim, p.fewer_operations)).collect();
+    let fewer_operations_990 = match s990 {
+        Figure::Missing => Figure::Missing,
+        _ => interpolate(&operations, 0.99),
+    };
     let at_rates =
         RATES.map(|r| (metric_at_fraction(&sweep, r, |p| p.psnr), metric_at_fraction(&sweep, r, |p| p.mssim)));
     let worst = points
@@ -198,6 +217,7 @@ pub fn summarize_mode(points: &[Point], scene: &str, mode: &str) -> Option<ModeS
         efficiency_990: efficiency,
         at_rates,
         worst_case_overhead: worst,
+        fewer_operations_990,
     })
 }
 
@@ -276,24 +296,27 @@ pub fn markdown(setup: &str, points: &[Point], frames: &[ControllerFrame]) -> St
         let _ = writeln!(
             out,
             "Speedup is reference time / mode time, interpolated along each mode's quality/time frontier; \
+             fewer shading operations is the reference's / the mode's by the compiler's cost model (operations per \
+             evaluation times evaluations, docs/evaluation.md), along the same frontier; \
              `*` marks a bound (the sweep's cheapest point already exceeds the quality: the speedup is at least this). \
              Efficiency = speedup / (1 / coarse shading rate) at MSSIM 0.99. \
-             Times are medians of wall time.\n"
+             Times are paired with reference runs: speedup = 1 / median(mode time / reference time) over the pairs.\n"
         );
         let _ = writeln!(
             out,
-            "| mode | speedup @ MSSIM 0.99 | speedup @ MSSIM 0.993 | efficiency @ 0.99 | worst case (forced) / reference |"
+            "| mode | speedup @ MSSIM 0.99 | speedup @ MSSIM 0.993 | efficiency @ 0.99 | fewer shading operations @ 0.99 | worst case (forced) / reference |"
         );
-        let _ = writeln!(out, "|---|---|---|---|---|");
+        let _ = writeln!(out, "|---|---|---|---|---|---|");
         let summaries: Vec<ModeSummary> = modes.iter().filter_map(|m| summarize_mode(points, scene, m)).collect();
         for s in &summaries {
             let _ = writeln!(
                 out,
-                "| {} | {} | {} | {} | {} |",
+                "| {} | {} | {} | {} | {} | {} |",
                 s.mode,
                 s.speedup_mssim_990.show(2),
                 s.speedup_mssim_993.show(2),
                 s.efficiency_990.show(2),
+                s.fewer_operations_990.show(2),
                 dash(s.worst_case_overhead, 2)
             );
         }
@@ -318,14 +341,14 @@ pub fn markdown(setup: &str, points: &[Point], frames: &[ControllerFrame]) -> St
         let _ = writeln!(out, "\n### Every point\n");
         let _ = writeln!(
             out,
-            "| mode | knob | value | forced | shaded | coarse rate | wall ms | GPU ms | RMSE | PSNR dB | MSSIM | FLIP |"
+            "| mode | knob | value | forced | shaded | coarse rate | wall ms | paired speedup | fewer ops | RMSE | PSNR dB | MSSIM | FLIP |"
         );
-        let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+        let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
         for p in points.iter().filter(|p| p.scene == scene) {
             let value = if p.value.is_nan() { "-".to_string() } else { format!("{:.3e}", p.value) };
             let _ = writeln!(
                 out,
-                "| {} | {} | {} | {} | {:.1}% | {:.1}% | {:.1} | {} | {:.5} | {:.2} | {:.5} | {:.5} |",
+                "| {} | {} | {} | {} | {:.1}% | {:.1}% | {:.1} | {:.2} | {:.2} | {:.5} | {:.2} | {:.5} | {:.5} |",
                 p.mode,
                 p.knob,
                 value,
@@ -333,7 +356,8 @@ pub fn markdown(setup: &str, points: &[Point], frames: &[ControllerFrame]) -> St
                 100.0 * p.shaded_fraction,
                 100.0 * p.coarse_fraction,
                 p.wall_ms,
-                dash(p.gpu_ms, 1),
+                1.0 / p.relative_time,
+                p.fewer_operations,
                 p.rmse,
                 p.psnr,
                 p.mssim,
@@ -516,6 +540,9 @@ mod tests {
             shaded_fraction: fraction,
             coarse_fraction: fraction,
             wall_ms: time,
+            relative_time: time / 100.0,
+            reference_ms: 100.0,
+            fewer_operations: 1.0 / fraction,
             gpu_ms: None,
             coarse_pass_ms: None,
             fine_pass_ms: None,
@@ -559,6 +586,8 @@ mod tests {
         let m50 = s.at_rates[1].1.value().unwrap();
         assert!((m50 - 0.992).abs() < 1e-12, "{m50}");
         assert!((s.worst_case_overhead.unwrap() - 1.1).abs() < 1e-12);
+        // 40% of the operations shaded at MSSIM 0.99: 2.5 times fewer.
+        assert!((s.fewer_operations_990.value().unwrap() - 2.5).abs() < 1e-12);
     }
 
     #[test]
@@ -581,7 +610,7 @@ mod tests {
         let text = csv(&pts).unwrap();
         assert_eq!(text.lines().count(), 4);
         assert!(text.starts_with(
-            "scene,mode,knob,value,forced,shaded_fraction,coarse_fraction,wall_ms,gpu_ms,coarse_pass_ms,fine_pass_ms,rmse,psnr,mssim,flip"
+            "scene,mode,knob,value,forced,shaded_fraction,coarse_fraction,wall_ms,relative_time,reference_ms,fewer_operations,gpu_ms,coarse_pass_ms,fine_pass_ms,rmse,psnr,mssim,flip"
         ));
         let md = markdown("setup", &pts, &[]);
         // MSSIM 0.99 at 46.7 ms: 100 / 46.7.

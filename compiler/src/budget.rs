@@ -63,7 +63,28 @@ pub struct Costs {
 
 /// Counts the operations of the fully inlined code of every live effect.
 pub fn costs(checked: &Checked, graph: &EffectGraph, deriv: &DerivInfo) -> Costs {
-    let mut counter = Counter { checked, deriv, memo: HashMap::new() };
+    count(checked, graph, deriv, false)
+}
+
+/// What a texture read counts in the cost model: a fetch with filtering
+/// costs several arithmetic operations' worth of issue slots and far more
+/// latency; 4 is a round figure, the same for every mode, so it moves the
+/// model's totals but hardly its ratios between modes.
+pub const TEXTURE_READ_OPERATIONS: u64 = 4;
+
+/// The cost model: the operations one evaluation of each live effect
+/// executes, as [`costs`] counts them but with every `for` loop's body
+/// counted once per iteration of its static trip count (a loop guarded by a
+/// uniform, like `if (i < light_count)`, counts its full static bound) and
+/// every texture read weighted by [`TEXTURE_READ_OPERATIONS`]. Multiplied
+/// by the evaluations a mode makes, it gives a platform-independent figure
+/// of shading work.
+pub fn evaluation_costs(checked: &Checked, graph: &EffectGraph, deriv: &DerivInfo) -> Costs {
+    count(checked, graph, deriv, true)
+}
+
+fn count(checked: &Checked, graph: &EffectGraph, deriv: &DerivInfo, executed: bool) -> Costs {
+    let mut counter = Counter { checked, deriv, memo: HashMap::new(), executed };
     // The counter memoises, and recurses only into what is not counted yet.
     // Counting the links of every chain first, callees and dependencies before
     // their users, keeps that recursion to one expression's depth (which the
@@ -244,6 +265,9 @@ struct Counter<'c, 'a> {
     checked: &'c Checked<'a>,
     deriv: &'c DerivInfo<'a>,
     memo: HashMap<Key, Option<u64>>,
+    /// Count what executes (loop bodies times their trips, texture reads
+    /// weighted) rather than what is written.
+    executed: bool,
 }
 
 impl Counter<'_, '_> {
@@ -323,13 +347,18 @@ impl Counter<'_, '_> {
                 }
             }
             StmtKind::For { init, cond, step, body } => {
-                for header in [init, step].into_iter().flatten() {
-                    parts.push(self.stmt(header, None));
+                let trips = if self.executed { self.checked.loop_trips.get(&s.id).copied().unwrap_or(1) } else { 1 };
+                if let Some(i) = init {
+                    parts.push(self.stmt(i, None));
+                }
+                let mut iteration = self.stmt(body, skips);
+                if let Some(st) = step {
+                    iteration = iteration.saturating_add(self.stmt(st, None));
                 }
                 if let Some(c) = cond {
-                    parts.push(self.expr(c, At::Body));
+                    iteration = iteration.saturating_add(self.expr(c, At::Body));
                 }
-                parts.push(self.stmt(body, skips));
+                parts.push(iteration.saturating_mul(trips));
             }
             StmtKind::Block(b) => parts.push(self.stmts(&b.stmts, skips)),
             StmtKind::Return(None) | StmtKind::Refine | StmtKind::Break | StmtKind::Continue => {}
@@ -379,9 +408,17 @@ impl Counter<'_, '_> {
                                 add(self.expr(a, at));
                             }
                         }
+                        if self.executed && matches!(b, Builtin::Sample) {
+                            add(TEXTURE_READ_OPERATIONS);
+                        }
                         return cost;
                     }
                     Some(Callee::Function(f)) => add(self.function(*f)),
+                    Some(Callee::Builtin(Builtin::Load | Builtin::SampleLevel | Builtin::SampleGrad))
+                        if self.executed =>
+                    {
+                        add(TEXTURE_READ_OPERATIONS)
+                    }
                     _ => {}
                 }
                 for a in args {

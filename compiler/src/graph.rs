@@ -1,11 +1,12 @@
 //! The effect dependency graph: rate rules, cycles, and the order effects are computed in.
 
-use crate::check::{Checked, EffectId};
+use crate::check::{Checked, EffectId, InputId, Symbol};
 use crate::diagnostic::{Diagnostic, Label};
-use crate::syntax::ast::{Rate, Span};
+use crate::syntax::ast::{EffectBody, Rate, Span};
+use crate::syntax::{visit_expr, visit_stmt_exprs};
 use petgraph::algo::kosaraju_scc;
 use petgraph::graph::{DiGraph, NodeIndex};
-use std::collections::HashSet;
+use std::collections::{BTreeSet, HashSet};
 
 /// What the later stages need of the graph whose nodes are effects and
 /// outputs and whose edges are uses (from the used effect to its user); the
@@ -18,6 +19,12 @@ pub struct EffectGraph {
     pub users: Vec<Vec<EffectId>>,
     /// Whether an output (transitively) needs the effect.
     pub live: Vec<bool>,
+    /// For each live effect, the discontinuity keys it reads, directly or
+    /// through the effects it reads (ascending; empty for dead effects). A
+    /// discontinuity in one of these keys refines the effect, and only these
+    /// do: an effect that never reads `material` is continuous across a
+    /// material edge, so interpolating it there is exact to first order.
+    pub keys: Vec<Vec<InputId>>,
 }
 
 impl EffectGraph {
@@ -110,7 +117,80 @@ pub fn build(checked: &Checked) -> (EffectGraph, Vec<Diagnostic>) {
             .map(|nodes| nodes.into_iter().map(|n| graph[n]).filter(|e| live[e.index()]).collect())
             .unwrap_or_default()
     };
-    (EffectGraph { order, users, live }, diagnostics)
+    let keys = keys_read(checked, &order);
+    if !cyclic {
+        diagnostics.extend(idle_keys(checked, &order, &keys));
+    }
+    (EffectGraph { order, users, live, keys }, diagnostics)
+}
+
+/// W0002 for each discontinuity key that no live coarse effect reads: it
+/// refines nothing, which is almost always a mistake (since keys refine
+/// only their readers, a `@key` on a material id no coarse effect reads
+/// no longer guards the lighting at silhouettes).
+fn idle_keys(checked: &Checked, order: &[EffectId], keys: &[Vec<InputId>]) -> Vec<Diagnostic> {
+    let read: BTreeSet<InputId> = order
+        .iter()
+        .filter(|e| checked.effects[e.index()].rate == Rate::Coarse)
+        .flat_map(|e| keys[e.index()].iter().copied())
+        .collect();
+    let mut out = vec![];
+    for (k, info) in checked.inputs.iter().enumerate() {
+        if info.key.is_none() || read.contains(&InputId(k as u32)) {
+            continue;
+        }
+        let Some(decl) = checked.program.items.iter().find_map(|item| match item {
+            crate::syntax::ast::Item::Input(d) if d.name.name == info.name => Some(d),
+            _ => None,
+        }) else {
+            continue;
+        };
+        let attr = decl.attrs.iter().find(|a| a.name.name == "key").map(|a| a.span).unwrap_or(decl.name.span);
+        out.push(
+            Diagnostic::warning("W0002", format!("the discontinuity key `{}` refines nothing", info.name))
+                .with_label(Label::primary(attr, format!("no coarse effect reads `{}`", info.name)))
+                .with_note(
+                    "a discontinuity in a key refines only the coarse effects that read it, directly or through \
+                     other effects; fine effects are evaluated per pixel anyway",
+                )
+                .with_note(format!(
+                    "remove `@key`, or key the channels the coarse effects read (e.g. `@key(0.5) in float3 position;` \
+                     and `@key(0.4) in float3 normal;` for geometric edges) instead of `{}`",
+                    info.name
+                )),
+        );
+    }
+    out
+}
+
+/// The discontinuity keys each effect of `order` reads, directly or through
+/// the effects it reads; `order` has dependencies first, so each effect's
+/// dependencies are complete when it is reached.
+fn keys_read(checked: &Checked, order: &[EffectId]) -> Vec<Vec<InputId>> {
+    let mut keys: Vec<BTreeSet<InputId>> = vec![BTreeSet::new(); checked.effects.len()];
+    for &e in order {
+        let mut read = BTreeSet::new();
+        let mut note = |x: &crate::syntax::ast::Expr| {
+            if let Some(Symbol::Input(i)) = checked.symbols.get(&x.id)
+                && checked.inputs[i.index()].key.is_some()
+            {
+                read.insert(*i);
+            }
+        };
+        match &checked.effect_decl(e).body {
+            EffectBody::Expr(x) => visit_expr(x, &mut note),
+            EffectBody::Block(b) => {
+                for s in &b.stmts {
+                    visit_stmt_exprs(s, &mut |x| visit_expr(x, &mut note));
+                }
+            }
+        }
+        for (d, _) in &checked.effects[e.index()].deps {
+            read.extend(keys[d.index()].iter().copied());
+        }
+        keys[e.index()] = read;
+    }
+    keys.into_iter().map(|k| k.into_iter().collect()).collect()
 }
 
 /// A simple cycle through the nodes of one strongly connected component,

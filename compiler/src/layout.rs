@@ -2,7 +2,8 @@
 //! program: binding numbers, uniform offsets, channel formats, interface
 //! slots, statistics counters and the hierarchical records.
 
-use crate::check::{Checked, UniformKind};
+use crate::budget::Costs;
+use crate::check::{Checked, EffectId, UniformKind};
 use crate::graph::EffectGraph;
 use crate::interface::Interface;
 use crate::syntax::ast::Rate;
@@ -13,6 +14,7 @@ use mrsl_abi::{
     Resample, ResourceBinding, ResourceKind, SampleType, SlotLayout, StatsLayout, TextureFormat, UniformBlock,
     ValueType,
 };
+use std::collections::HashMap;
 
 /// The layout's type of a checked value type (checked programs only declare value types where the layout has them).
 fn value_type(ty: &Type) -> ValueType {
@@ -36,7 +38,8 @@ pub fn channel_format(ty: &Type) -> (TextureFormat, SampleType) {
     (format, SampleType::of(format.scalar()))
 }
 
-pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface) -> Layout {
+pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface, costs: &Costs) -> Layout {
+    let operations: HashMap<EffectId, u64> = costs.effects.iter().copied().collect();
     let control = ControlBlock {
         group: GROUP_RESOURCES,
         binding: BINDING_CONTROL,
@@ -162,7 +165,13 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface) -> L
                 resample: (e.rate == Rate::Coarse)
                     .then(|| if uses_nearest(checked, id) { Resample::Nearest } else { Resample::Bilinear }),
                 depends_on: e.deps.iter().map(|(d, _)| name(d)).collect(),
+                keys: if e.rate == Rate::Coarse && graph.live[i] {
+                    graph.keys[i].iter().map(|k| checked.inputs[k.index()].name.clone()).collect()
+                } else {
+                    vec![]
+                },
                 pass_condition: condition,
+                operations: operations.get(&id).copied(),
             }
         })
         .collect();

@@ -244,7 +244,8 @@ fn generate(
     diagnostics: Vec<Diagnostic>,
 ) -> Result<Program, Vec<Diagnostic>> {
     let interface = interface::allocate(checked, graph);
-    let layout = layout::build(checked, graph, &interface);
+    let costs = budget::evaluation_costs(checked, graph, deriv);
+    let layout = layout::build(checked, graph, &interface, &costs);
     let inputs = codegen::Inputs {
         checked,
         graph,

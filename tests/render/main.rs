@@ -38,6 +38,7 @@ const GPU_TESTS: &[GpuTest] = &[
     ),
     ("modes::derivative_chains_render_in_every_mode", modes::derivative_chains_render_in_every_mode),
     ("modes::steps_keep_their_edges", modes::steps_keep_their_edges),
+    ("modes::keys_refine_only_the_effects_that_read_them", modes::keys_refine_only_the_effects_that_read_them),
     ("modes::silhouettes_are_never_blended", modes::silhouettes_are_never_blended),
     ("modes::odd_sizes_cover_every_pixel", modes::odd_sizes_cover_every_pixel),
     (

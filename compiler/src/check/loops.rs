@@ -131,6 +131,9 @@ impl Checker<'_> {
                 i += delta;
                 trips += 1;
             }
+            if trips <= MAX_LOOP_TRIPS {
+                self.out.loop_trips.insert(s.id, trips);
+            }
             if trips > MAX_LOOP_TRIPS {
                 self.error(
                     err(

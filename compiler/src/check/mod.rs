@@ -173,6 +173,9 @@ pub struct Checked<'a> {
     pub splats: HashMap<NodeId, Type>,
     /// Derivative sites (`ddx`, `ddy`, `fwidth`, `sample` calls), in order.
     pub derivative_calls: Vec<(EffectId, NodeId)>,
+    /// The static trip count of every `for` statement whose bounds the
+    /// loop check evaluated (the cost model multiplies its body by it).
+    pub loop_trips: HashMap<NodeId, u64>,
 }
 
 impl Checked<'_> {
@@ -269,6 +272,7 @@ impl<'a> Checker<'a> {
                 local_decls: HashMap::new(),
                 splats: HashMap::new(),
                 derivative_calls: vec![],
+                loop_trips: HashMap::new(),
             },
             diagnostics: vec![],
             globals: HashMap::new(),

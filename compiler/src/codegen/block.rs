@@ -194,7 +194,7 @@ impl Writer<'_, '_, '_> {
         if level.parent {
             self.stale_corners(buf, stride);
         }
-        for key in self.keys() {
+        for key in self.keys_of(&coarse) {
             let name = key.name;
             let mut tests: Vec<String> = ["k00", "k10", "k01", "k11"]
                 .iter()
@@ -220,7 +220,7 @@ impl Writer<'_, '_, '_> {
         for &e in coarse.iter().rev() {
             let info = &c.effects[e.index()];
             let k = self.coarse_index[&e];
-            let mut terms = vec!["disc".to_string()];
+            let mut terms = vec![self.discontinuity(e)];
             if let Some(b) = iface.refine_bit[e.index()] {
                 let (word, mask) = bit(b);
                 let words: Vec<String> = (0..4).map(|ci| format!("f{ci}_{word}")).collect();

@@ -49,8 +49,11 @@ impl Writer<'_, '_, '_> {
 
         let [head, note, end] = cut(include_str!("templates/taps.wgsl"), &["IN_IMAGE", "PAIRS"]);
         self.template(0, head, &[("TAPS", &taps)]);
+        // The taps serve every coarse effect together, so a tap is rejected
+        // across any key a coarse effect reads (this baseline does not
+        // reconstruct per effect).
         let tap_tests: Vec<String> = self
-            .keys()
+            .keys_of(&coarse)
             .iter()
             .map(|key| {
                 let load = |at: &str| format!("mrsl_load_{}({at})", key.name);

@@ -62,7 +62,9 @@ impl Writer<'_, '_, '_> {
             self.line(3, format!("refined = refined || mrsl_parent[s * {}u + {w}u] != 0u;", iface.stride));
         }
         self.template(0, flags, &[]);
-        for key in self.keys() {
+        // Conservative: the inner samples are needed where any coarse effect
+        // may be refined at the outer level, so every key a coarse effect reads.
+        for key in self.keys_of(&self.coarse_live()) {
             self.template(
                 0,
                 include_str!("templates/parent_key.wgsl"),

@@ -9,7 +9,7 @@ use super::Writer;
 use super::body::{Mode, float_literal, local_name, wgsl_ident};
 use super::words::bit;
 use super::writer::cut;
-use crate::check::{EffectId, KeyCompare, Symbol};
+use crate::check::{EffectId, InputId, KeyCompare, Symbol};
 use crate::syntax::ast::*;
 use crate::syntax::{visit_expr, visit_stmt_exprs};
 use mrsl_abi::{CONTROL_FIELDS, KernelKind};
@@ -50,13 +50,30 @@ impl Key<'_> {
 }
 
 impl<'b> Writer<'_, '_, 'b> {
-    /// The program's discontinuity keys, in declaration order.
-    pub(super) fn keys(&self) -> Vec<Key<'b>> {
+    /// The discontinuity keys that refine any of `effects` (those they read,
+    /// directly or through other effects: `EffectGraph::keys`), in
+    /// declaration order. A key no coarse effect reads is never loaded.
+    pub(super) fn keys_of(&self, effects: &[EffectId]) -> Vec<Key<'b>> {
         let c = self.checked();
-        c.inputs
-            .iter()
-            .filter_map(|x| x.key.map(|compare| Key { name: &x.name, compare, scalar: x.ty.components() == 1 }))
+        let read: BTreeSet<InputId> =
+            effects.iter().flat_map(|e| self.i.graph.keys[e.index()].iter().copied()).collect();
+        read.into_iter()
+            .map(|i| {
+                let x = &c.inputs[i.index()];
+                let compare = x.key.expect("EffectGraph::keys holds key channels only");
+                Key { name: &x.name, compare, scalar: x.ty.components() == 1 }
+            })
             .collect()
+    }
+
+    /// `disc || disc_<key>...`: true where effect `e` is refined by a
+    /// discontinuity: `disc` (forced refinement and what the kernel adds)
+    /// or one of the keys `e` reads, each tested into `disc_<key>`.
+    pub(super) fn discontinuity(&self, e: EffectId) -> String {
+        let c = self.checked();
+        let mut terms = vec!["disc".to_string()];
+        terms.extend(self.i.graph.keys[e.index()].iter().map(|i| format!("disc_{}", c.inputs[i.index()].name)));
+        terms.join(" || ")
     }
 
     /// Every binding the kernel uses, where the layout puts it: the control

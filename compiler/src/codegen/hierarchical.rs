@@ -229,7 +229,7 @@ impl Writer<'_, '_, '_> {
         self.template(0, head, &[]);
         self.neighbour_pairs("n", &[], note, ["pair_a", "pair_b"]);
         self.template(0, pairs, &[]);
-        for key in self.keys() {
+        for key in self.keys_of(&self.coarse_live()) {
             let name = key.name;
             let differs = key.differs(&format!("k_{name}"), &format!("mrsl_load_{name}(q[k])"));
             self.template(0, include_str!("templates/classify_key.wgsl"), &[("NAME", &name), ("DIFFERS", &differs)]);
@@ -243,7 +243,7 @@ impl Writer<'_, '_, '_> {
             let info = &c.effects[e.index()];
             let (word, mask) = bit(self.coarse_index[&e]);
             self.template(0, head_effect, &[("NAME", &info.name)]);
-            let mut need = vec!["disc".to_string()];
+            let mut need = vec![self.discontinuity(e)];
             if let Some(b) = iface.refine_bit[e.index()] {
                 // The program's own predicate, as evaluated at the neighbours.
                 let (word, mask) = bit(b);

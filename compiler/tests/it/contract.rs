@@ -48,9 +48,9 @@ fn compiled_programs_read_back_from_their_files_unchanged() {
 fn foreign_or_broken_layouts_are_refused() {
     let program = mrsl::compile(&examples()[0].1, &Options::default()).unwrap();
     let json = program.layout.to_json();
-    let other_version = json.replacen("mrsl-layout/1", "mrsl-layout/2", 1);
+    let other_version = json.replacen("mrsl-layout/2", "mrsl-layout/1", 1);
     let message = Layout::from_json(&other_version).unwrap_err();
-    assert!(message.contains("mrsl-layout/2") && message.contains("mrsl-layout/1"), "{message}");
+    assert!(message.contains("mrsl-layout/1") && message.contains("mrsl-layout/2"), "{message}");
     // A format the runtime could only guess at is an error, not rgba32float.
     let first_format = program.layout.channels[0].format.name();
     let bad_format = json.replacen(&format!("\"format\": \"{first_format}\""), "\"format\": \"bgra8unorm\"", 1);
@@ -108,4 +108,37 @@ fn kernels_declare_the_stage_bindings_of_the_contract() {
             assert_eq!(declared, contract, "{stem}: {} kernel ({:?})", kernel.kind, kernel.block_size);
         }
     }
+}
+
+/// The layout's cost model counts what one evaluation executes: a loop's
+/// body once per iteration of its static trip count, a texture read as 4,
+/// and a derivative as its operand evaluated again at the neighbours.
+#[test]
+fn the_cost_model_counts_loop_trips_texture_reads_and_neighbour_evaluations() {
+    let ops = |body: &str| {
+        let source = format!(
+            "in float3 normal;\nuniform texture2d t;\nuniform sampler s;\ncoarse effect float e {{\n    float acc = 0.0;\n{body}\n    e = acc;\n}}\nfine out float4 color = float4(e);\n"
+        );
+        let program = mrsl::compile(&source, &Options::default()).unwrap_or_else(|d| panic!("{d:?}"));
+        program.layout.effects.iter().find(|x| x.name == "e").unwrap().operations.unwrap()
+    };
+    let none = ops("");
+    let once = ops("    acc += normal.x;");
+    let step = once - none;
+    assert!(step > 0);
+    // Eight trips of the same statement, plus the loop's own condition and step per trip.
+    let looped = ops("    for (int i = 0; i < 8; i++) { acc += normal.x; }");
+    assert!(looped >= none + 8 * step && looped <= none + 8 * (step + 8), "{none} {step} {looped}");
+    let sixteen = ops("    for (int i = 0; i < 16; i++) { acc += normal.x; }");
+    assert_eq!(
+        sixteen - none,
+        2 * (looped - none) - (ops("    for (int i = 0; i < 0; i++) { acc += normal.x; }") - none)
+    );
+    // A texture read adds its weight over the same call shape without a texture.
+    let loaded = ops("    acc += sample_level(t, s, normal.xy, 0.0).x;");
+    let plain = ops("    acc += max(normal.x, normal.y);");
+    assert!(loaded > plain, "{loaded} {plain}");
+    // A derivative evaluates its operand twice more per difference.
+    let derivative = ops("    acc += ddx(normal.x * normal.y);");
+    assert!(derivative > once + 4, "{derivative} {once}");
 }

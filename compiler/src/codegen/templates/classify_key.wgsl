@@ -1,4 +1,5 @@
     let k_{{NAME}} = mrsl_load_{{NAME}}(p);
+    var disc_{{NAME}} = false;
     for (var k = 0; k < 4; k++) {
-        disc = disc || (ok[k] && {{DIFFERS}});
+        disc_{{NAME}} = disc_{{NAME}} || (ok[k] && {{DIFFERS}});
     }

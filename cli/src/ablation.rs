@@ -1,0 +1,301 @@
+//! `mrslc bench --ablation`: where a block mode's time goes.
+//!
+//! The fine kernel of a block mode (coarse 2x2 or 4x4) is rebuilt with one
+//! part removed at a time, by editing the generated WGSL line by line, and
+//! each variant is timed against the full kernel and the reference in
+//! interleaved rounds (the order rotates every round). A variant's figure is
+//! the median over the rounds of its time divided by the full kernel's time
+//! in the same round, so the shared machine's slow moments weigh on both.
+//!
+//! The edits match the lines the code generator writes (its templates in
+//! `compiler/src/codegen/templates/`); a variant whose lines the program's
+//! kernel does not have (a program without keys has no key tests) is left
+//! out and says so. The variants only drop work: their images are wrong by
+//! design and are never compared.
+
+use crate::bench::WORKLOAD_PROGRAM;
+use crate::render::{Resources, bind_scene, compile_program};
+use indicatif::{ProgressBar, ProgressStyle};
+use mrsl_abi::{CompiledProgram, KernelKind};
+use mrsl_lab::gpu::Gpu;
+use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
+
+pub struct AblationArgs {
+    pub program: Option<PathBuf>,
+    pub scene: String,
+    pub size: (u32, u32),
+    pub mode: Mode,
+    pub runs: usize,
+    pub out_dir: PathBuf,
+}
+
+/// An edit of the fine kernel's lines (`None` when the kernel has none of
+/// the lines it edits).
+type Edit = fn(&str) -> Option<String>;
+
+/// One variant: a name, what it removes, and the edits that make it.
+struct Variant {
+    name: &'static str,
+    removes: &'static str,
+    edits: &'static [Edit],
+}
+
+/// Applies `f` to every line; `None` when it changed none.
+fn edit_lines(wgsl: &str, f: impl Fn(&str) -> Option<String>) -> Option<String> {
+    let mut changed = false;
+    let mut out = String::with_capacity(wgsl.len());
+    for line in wgsl.lines() {
+        match f(line) {
+            Some(new) => {
+                changed = true;
+                out.push_str(&new);
+            }
+            None => out.push_str(line),
+        }
+        out.push('\n');
+    }
+    changed.then_some(out)
+}
+
+/// The indentation of `line`.
+fn indent(line: &str) -> &str {
+    &line[..line.len() - line.trim_start().len()]
+}
+
+/// The statistics atomics and the rate-image store.
+fn no_instrumentation(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        (t.starts_with("textureStore(mrsl_rate,")
+            || t.contains("atomicAdd(&mrsl_wg_stats[")
+            || t.starts_with("atomicAdd(&mrsl_stats[k]"))
+        .then(String::new)
+    })
+}
+
+/// No coarse effect is evaluated per pixel: every one is resampled.
+fn nothing_refined(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        (t.starts_with("if (mrsl_is_refined(mrsl_b, ") && t.ends_with(")) {"))
+            .then(|| format!("{}if (false) {{", indent(l)))
+    })
+}
+
+/// The key loads and comparisons of the resolve (each `disc_<key>` false).
+fn no_key_tests(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        let name = t.strip_prefix("let disc_")?.split(' ').next()?;
+        Some(format!("{}let disc_{name} = false;", indent(l)))
+    })
+}
+
+/// The corners' refine-flag words of the resolve (read as zero).
+fn no_flag_reads(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        let (lhs, rhs) = t.strip_prefix("let f")?.split_once(" = ")?;
+        (rhs.starts_with("mrsl_interface[") && lhs.contains('_')).then(|| format!("{}let f{lhs} = 0u;", indent(l)))
+    })
+}
+
+/// The resampling of the coarse effects (they read zero).
+fn no_resampling(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        (t.contains(" = mrsl_resample_") && t.ends_with("(mrsl_b);") && !t.starts_with("let ")).then(String::new)
+    })
+}
+
+/// Everything the fine pass does per pixel.
+fn no_fine_work(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        (l.trim_start() == "if (all(mrsl_pos < mrsl_grid())) {")
+            .then(|| format!("{}if (false && all(mrsl_pos < mrsl_grid())) {{", indent(l)))
+    })
+}
+
+/// The variants. Removing the key tests or the flag reads from the full
+/// kernel would also change what is refined, so those parts are measured
+/// within the fixed cost (nothing refined), where they decide nothing.
+const VARIANTS: [Variant; 6] = [
+    Variant {
+        name: "no instrumentation",
+        removes: "the statistics atomics and the rate-image store",
+        edits: &[no_instrumentation],
+    },
+    Variant {
+        name: "nothing refined (fixed cost)",
+        removes: "the per-pixel re-evaluation of refined coarse effects: every pixel resolves and resamples",
+        edits: &[nothing_refined],
+    },
+    Variant {
+        name: "fixed cost, no key tests",
+        removes: "also the discontinuity-key loads and comparisons of the resolve",
+        edits: &[nothing_refined, no_key_tests],
+    },
+    Variant {
+        name: "fixed cost, no flag reads",
+        removes: "also the corners' refine-flag words of the resolve",
+        edits: &[nothing_refined, no_flag_reads],
+    },
+    Variant {
+        name: "fixed cost, no resampling",
+        removes: "also the resampling of the coarse effects (they read zero)",
+        edits: &[nothing_refined, no_resampling],
+    },
+    Variant {
+        name: "no fine pass work",
+        removes: "everything the fine pass does per pixel (left: the coarse pass and the launches)",
+        edits: &[no_fine_work],
+    },
+];
+
+/// A variant's fine kernel, or `None` when one of its edits has nothing to edit.
+fn apply(variant: &Variant, wgsl: &str) -> Option<String> {
+    variant.edits.iter().try_fold(wgsl.to_string(), |w, edit| edit(&w))
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
+/// Runs the ablation; returns the files written.
+pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>, String> {
+    let block = match args.mode {
+        Mode::Coarse2x2 => 2,
+        Mode::Coarse4x4 => 4,
+        other => return Err(format!("--ablation takes a block mode (coarse2x2 or coarse4x4), not {other}")),
+    };
+    let modes = [Mode::Reference, args.mode];
+    let (name, program) = compile_program(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &modes)?;
+    let full: &CompiledProgram = &program;
+    let fine = full.kernel(KernelKind::Fine, block).ok_or("the program has no fine kernel")?;
+    let mut programs: Vec<(&str, &str, CompiledProgram)> = vec![("full", "nothing", full.clone())];
+    let mut skipped = vec![];
+    for v in &VARIANTS {
+        match apply(v, &fine.wgsl) {
+            Some(wgsl) => {
+                let mut p = full.clone();
+                for k in p.kernels.iter_mut().filter(|k| k.kind == KernelKind::Fine && k.block_size == Some(block)) {
+                    k.wgsl = wgsl.clone();
+                }
+                programs.push((v.name, v.removes, p));
+            }
+            None => skipped.push(v.name),
+        }
+    }
+    let gpu = Gpu::new().map_err(|e| e.to_string())?;
+    let device_name = format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
+    eprintln!("ablation: {name}, {} fine kernel, on {device_name}, {}x{}", args.mode, args.size.0, args.size.1);
+    let mut scene = bind_scene(&gpu, &args.scene, Some(args.size))?;
+    let mut shaders = vec![];
+    let mut textures = vec![];
+    for (k, (_, _, p)) in programs.iter().enumerate() {
+        let mut shader = Shader::new(&gpu.device, p).map_err(|e| e.to_string())?;
+        let prepared = scene.prepare(&gpu, &mut shader).map_err(|e| format!("{}: {e}", args.scene))?;
+        // The variants declare the uniforms of the first: its warnings are theirs, printed once.
+        textures = if k == 0 { prepared.warn() } else { prepared.textures };
+        shaders.push(shader);
+    }
+    let resources = Resources::new(&gpu, &program, scene.size, textures);
+    let bindings: Bindings = resources.bindings(&program, &scene.channels);
+    // Entry 0 is the reference (run with the full program's shader), then
+    // the full kernel, then the variants.
+    let runs: Vec<(usize, Mode)> =
+        std::iter::once((0, Mode::Reference)).chain((0..programs.len()).map(|k| (k, args.mode))).collect();
+    let mut time = |k: usize, mode: Mode| -> Result<f64, String> {
+        let start = Instant::now();
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        shaders[k]
+            .encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, DispatchOptions::new(mode))
+            .map_err(|e| e.to_string())?;
+        gpu.queue.submit([encoder.finish()]);
+        gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| e.to_string())?;
+        Ok(start.elapsed().as_secs_f64() * 1e3)
+    };
+    for &(k, mode) in &runs {
+        time(k, mode)?;
+    }
+    let rounds = args.runs.max(1);
+    let bar = ProgressBar::new(rounds as u64).with_style(
+        ProgressStyle::with_template("ablation [{bar:30}] {pos}/{len} rounds ({elapsed})")
+            .map_err(|e| e.to_string())?
+            .progress_chars("=> "),
+    );
+    let mut times: Vec<Vec<f64>> = vec![vec![]; runs.len()];
+    for round in 0..rounds {
+        for j in 0..runs.len() {
+            let at = (j + round) % runs.len();
+            let (k, mode) = runs[at];
+            times[at].push(time(k, mode)?);
+        }
+        if bar.is_hidden() {
+            eprintln!("ablation: round {}/{rounds}", round + 1);
+        }
+        bar.inc(1);
+    }
+    bar.finish();
+    // Per round: each entry's time over the full kernel's time (entry 1).
+    let ratio = |at: usize| median((0..rounds).map(|r| times[at][r] / times[1][r]).collect());
+    let full_ms = median(times[1].clone());
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "# Ablation of the {} fine pass\n\nProgram `{name}`, scene {}, {}x{}, device {device_name}; {rounds} interleaved \
+         rounds (the order rotates each round); `x full` is the median over the rounds of the variant's time / the full \
+         kernel's time in the same round. Full kernel: {full_ms:.1} ms (median).\n",
+        args.mode, args.scene, args.size.0, args.size.1
+    );
+    let _ = writeln!(md, "| variant | removes | median ms | x full | saved |");
+    let _ = writeln!(md, "|---|---|---|---|---|");
+    let _ = writeln!(
+        md,
+        "| reference | (the per-pixel reference mode) | {:.1} | {:.3} | |",
+        median(times[0].clone()),
+        ratio(0)
+    );
+    for (k, (variant, removes, _)) in programs.iter().enumerate() {
+        let at = k + 1;
+        let r = ratio(at);
+        let saved = if k == 0 { String::new() } else { format!("{:.1}%", 100.0 * (1.0 - r)) };
+        let _ = writeln!(md, "| {variant} | {removes} | {:.1} | {r:.3} | {saved} |", median(times[at].clone()));
+    }
+    if !skipped.is_empty() {
+        let _ = writeln!(md, "\nNot applicable to this program's kernel: {}.", skipped.join(", "));
+    }
+    std::fs::create_dir_all(&args.out_dir).map_err(|e| format!("cannot create {}: {e}", args.out_dir.display()))?;
+    let path = args.out_dir.join("ablation.md");
+    std::fs::write(&path, &md).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    println!("{md}");
+    Ok(vec![path])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every variant edits the kernel the code generator writes for the
+    /// workload, so a template change that breaks an edit fails here.
+    #[test]
+    fn every_variant_edits_the_workload_kernel() {
+        let program = mrsl::compile(WORKLOAD_PROGRAM, &mrsl::Options::default()).unwrap();
+        for block in [2, 4] {
+            let fine = &program.kernel(KernelKind::Fine, block).unwrap().wgsl;
+            for v in &VARIANTS {
+                let edited = apply(v, fine).unwrap_or_else(|| panic!("{}: no line to edit", v.name));
+                assert_ne!(&edited, fine, "{}", v.name);
+                mrsl::validate_wgsl(&edited).unwrap_or_else(|e| panic!("{} (block {block}): {e}", v.name));
+            }
+        }
+    }
+}
