@@ -5,13 +5,13 @@
 //!
 //! ```sh
 //! cargo run --release -p mrslc -- compile examples/demo.mrsl -o kernels
-//! cargo run --release -p mrsl-runtime --example engine -- kernels
+//! cargo run --release -p mrsl-runtime --example engine -- kernels [--out DIR]
 //! ```
 //!
-//! writes `engine.dynamic.png` and `engine.reference.png` into the current
-//! directory. Built with the runtime's `compile` feature (`--features
-//! compile`) and no argument, it compiles the built-in demo program at load
-//! time instead.
+//! writes `engine.dynamic.png` and `engine.reference.png` into `out/` (or
+//! `--out DIR`). Built with the runtime's `compile` feature (`--features
+//! compile`) and no kernel directory, it compiles the built-in demo program
+//! at load time instead.
 //!
 //! The G-buffer here is filled from the CPU (a sphere over a ground plane,
 //! analytically); an engine would rasterise it in its own geometry pass. It
@@ -26,17 +26,74 @@ const HEIGHT: u32 = 270;
 const EYE: [f32; 3] = [0.0, 1.2, 4.0];
 
 fn main() -> std::process::ExitCode {
-    match run() {
+    let runtime_dir = quiet_headless_vulkan();
+    let code = match run() {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("{e}");
             std::process::ExitCode::FAILURE
         }
+    };
+    if let Some(dir) = runtime_dir {
+        // Nothing was written there; leave no directory behind.
+        let _ = std::fs::remove_dir(dir);
     }
+    code
+}
+
+/// Headless runs without a login session (containers, CI, ssh without
+/// one) have no `XDG_RUNTIME_DIR`; libwayland, which Mesa's Vulkan drivers
+/// load, then prints "error: XDG_RUNTIME_DIR is invalid or not set in the
+/// environment." although nothing fails. An engine with a window runs in a
+/// session; this example, like `mrslc`, points the variable at a private
+/// directory (mode 0700, as the XDG specification asks) when it is unset or
+/// not absolute, and returns it. It must run before any thread starts or
+/// wgpu loads Vulkan.
+fn quiet_headless_vulkan() -> Option<std::path::PathBuf> {
+    let valid = std::env::var_os("XDG_RUNTIME_DIR")
+        .is_some_and(|v| std::path::Path::new(&v).is_absolute() && std::path::Path::new(&v).is_dir());
+    #[cfg(unix)]
+    if !valid {
+        use std::os::unix::fs::{DirBuilderExt, MetadataExt};
+        let dir = std::env::temp_dir().join(format!("mrsl-engine-runtime-{}", std::process::id()));
+        if std::fs::DirBuilder::new().mode(0o700).create(&dir).is_ok()
+            && std::fs::symlink_metadata(&dir).is_ok_and(|m| m.is_dir() && m.mode() & 0o077 == 0)
+        {
+            // SAFETY: called first thing in `main`, before any other thread exists.
+            unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+            return Some(dir);
+        }
+    }
+    #[cfg(not(unix))]
+    let _ = valid;
+    None
+}
+
+/// The command line: `[KERNEL_DIR] [--out DIR]`.
+struct Args {
+    kernels: Option<std::path::PathBuf>,
+    out: std::path::PathBuf,
+}
+
+fn args() -> Result<Args, Box<dyn std::error::Error>> {
+    let mut args = Args { kernels: None, out: "out".into() };
+    let mut rest = std::env::args_os().skip(1);
+    while let Some(arg) = rest.next() {
+        if arg == "--out" {
+            args.out = rest.next().ok_or("--out needs a directory")?.into();
+        } else if args.kernels.is_none() {
+            args.kernels = Some(arg.into());
+        } else {
+            return Err(format!("unexpected argument {}", arg.to_string_lossy()).into());
+        }
+    }
+    Ok(args)
 }
 
 fn run() -> Result<(), Box<dyn std::error::Error>> {
-    let program = load_program()?;
+    let args = args()?;
+    let program = load_program(args.kernels.as_deref())?;
+    std::fs::create_dir_all(&args.out).map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
 
     // 1. The engine's own device (here: whatever adapter wgpu finds first).
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
@@ -101,18 +158,18 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         let readback = copy_out(&device, &mut encoder, color);
         queue.submit([encoder.finish()]);
         println!("{}", shader.read_stats(&device)?.table());
-        let file = format!("engine.{mode}.png");
+        let file = args.out.join(format!("engine.{mode}.png"));
         save_png(&device, &readback, color.format(), &file).map_err(|e| format!("output `{name}`: {e}"))?;
-        println!("wrote {file}");
+        println!("wrote {}", file.display());
     }
     Ok(())
 }
 
-/// The kernels in the directory given as the first argument, or (with the
-/// `compile` feature and no argument) the demo program compiled now.
-fn load_program() -> Result<CompiledProgram, Box<dyn std::error::Error>> {
-    if let Some(dir) = std::env::args_os().nth(1) {
-        return Ok(CompiledProgram::read_dir(dir.as_ref(), None)?);
+/// The kernels in the directory given, or (with the `compile` feature and
+/// no directory) the demo program compiled now.
+fn load_program(dir: Option<&std::path::Path>) -> Result<CompiledProgram, Box<dyn std::error::Error>> {
+    if let Some(dir) = dir {
+        return Ok(CompiledProgram::read_dir(dir, None)?);
     }
     #[cfg(feature = "compile")]
     {
@@ -125,7 +182,7 @@ fn load_program() -> Result<CompiledProgram, Box<dyn std::error::Error>> {
         )?)
     }
     #[cfg(not(feature = "compile"))]
-    Err("usage: engine KERNEL_DIR\n\
+    Err("usage: engine KERNEL_DIR [--out DIR]\n\
          KERNEL_DIR holds the files `mrslc compile` writes, e.g.:\n  \
          cargo run --release -p mrslc -- compile examples/demo.mrsl -o kernels\n  \
          cargo run --release -p mrsl-runtime --example engine -- kernels\n\
@@ -208,7 +265,7 @@ fn save_png(
     device: &wgpu::Device,
     buffer: &wgpu::Buffer,
     format: wgpu::TextureFormat,
-    path: &str,
+    path: &std::path::Path,
 ) -> Result<(), Box<dyn std::error::Error>> {
     if format != wgpu::TextureFormat::Rgba32Float {
         return Err(format!("this example writes rgba32float outputs only, not {format:?}").into());

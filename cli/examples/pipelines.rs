@@ -24,6 +24,9 @@ use std::time::Instant;
 fn main() {
     // Before any thread exists: every pipeline is compiled, none comes from the cache.
     unsafe { std::env::set_var("MESA_SHADER_CACHE_DISABLE", "true") };
+    // And no "XDG_RUNTIME_DIR is invalid" line from Mesa (see mrsl_lab::runtime_dir).
+    // SAFETY: still before any thread exists.
+    unsafe { mrsl_lab::runtime_dir::ensure_xdg_runtime_dir() };
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut programs: Vec<(String, String)> = vec![];
     for arg in &args {

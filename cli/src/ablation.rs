@@ -218,13 +218,15 @@ pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>, String> {
     eprintln!("ablation: {name}, {} fine kernel, on {device_name}, {}x{}", args.mode, args.size.0, args.size.1);
     let mut scene = bind_scene(&gpu, &args.scene, Some(args.size))?;
     let mut shaders = vec![];
-    let mut shadow_map = None;
-    for (_, _, p) in &programs {
+    let mut textures = vec![];
+    for (k, (_, _, p)) in programs.iter().enumerate() {
         let mut shader = Shader::new(&gpu.device, p).map_err(|e| e.to_string())?;
-        shadow_map = scene.prepare(&gpu, &mut shader).map_err(|e| format!("{}: {e}", args.scene))?;
+        let prepared = scene.prepare(&gpu, &mut shader).map_err(|e| format!("{}: {e}", args.scene))?;
+        // The variants declare the uniforms of the first: its warnings are theirs, printed once.
+        textures = if k == 0 { prepared.warn() } else { prepared.textures };
         shaders.push(shader);
     }
-    let resources = Resources::new(&gpu, &program, scene.size, shadow_map);
+    let resources = Resources::new(&gpu, &program, scene.size, textures);
     let bindings: Bindings = resources.bindings(&program, &scene.channels);
     // Entry 0 is the reference (run with the full program's shader), then
     // the full kernel, then the variants.

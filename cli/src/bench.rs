@@ -210,8 +210,9 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
         let mut scene = bind_scene(&gpu, scene_name, Some(args.size))?;
         let mut shader = Shader::new(&gpu.device, &program).map_err(|e| e.to_string())?;
         shader.set_timestamp_period(&gpu.queue);
-        let shadow_map = scene.prepare(&gpu, &mut shader).map_err(|e| format!("{scene_name}: {e}"))?;
-        let resources = Resources::new(&gpu, &program, scene.size, shadow_map);
+        let textures = scene.prepare(&gpu, &mut shader).map_err(|e| format!("{scene_name}: {e}"))?.warn();
+        let resources = Resources::new(&gpu, &program, scene.size, textures);
+        resources.note_fallbacks();
         let mut bench = Bench { gpu: &gpu, shader, runs: args.runs.max(1) };
         let plan = plan(args, has_knob);
         let bar = ProgressBar::new(plan.len() as u64).with_style(
@@ -385,9 +386,10 @@ fn controller_run(
 ) -> Result<Vec<ControllerFrame>, String> {
     let mut shader = Shader::new(&gpu.device, program).map_err(|e| e.to_string())?;
     shader.set_timestamp_period(&gpu.queue);
-    let shadow_map = scene.prepare(gpu, &mut shader)?;
+    // The same bindings as the sweep's, whose warnings were printed there.
+    let textures = scene.prepare(gpu, &mut shader)?.textures;
     let mesh = scene.mesh.as_ref().ok_or("the controller needs a mesh scene")?;
-    let resources = Resources::new(gpu, program, args.size, shadow_map);
+    let resources = Resources::new(gpu, program, args.size, textures);
     if uniform(program, &args.knob).is_some() {
         shader.set_uniform(&args.knob, &[KNOB_OFF]).map_err(|e| e.to_string())?;
     }

@@ -9,6 +9,7 @@ use std::process::ExitCode;
 
 mod ablation;
 mod bench;
+mod legend;
 mod render;
 mod report;
 
@@ -58,8 +59,8 @@ enum Command {
     /// Render a program over a scene with the wgpu runtime (lavapipe works).
     ///
     /// With no arguments: the built-in demo program over the demo scene at
-    /// 960x540 in coarse 4x4 mode, writing demo.coarse4x4.png, a heatmap and
-    /// demo.stats.json into the current directory.
+    /// 960x540 in coarse 4x4 mode, writing demo.coarse4x4.png, heatmaps and
+    /// demo.stats.json into out/.
     Render(Render),
     /// Benchmark the modes: sweep refinement thresholds, measure shaded
     /// fraction, GPU and wall time and quality against the reference, and run
@@ -67,7 +68,7 @@ enum Command {
     ///
     /// With no arguments: examples/sponza_lights.mrsl (built in) over Sponza
     /// at 1920x1080, every mode; writes bench.md, bench.csv, controller.csv,
-    /// quality_vs_time.sponza.png and controller.png into bench-out/
+    /// quality_vs_time.sponza.png and controller.png into out/
     /// (docs/evaluation.md explains every figure).
     Bench(Bench),
 }
@@ -82,9 +83,9 @@ struct Bench {
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, value_parser = render::parse_size, default_value = "1920x1080")]
     size: (u32, u32),
-    /// Modes, comma-separated, or all.
-    #[arg(long, default_value = "all")]
-    modes: String,
+    /// Modes, comma-separated (reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard), or all.
+    #[arg(long, alias = "mode", value_parser = render::parse_modes, default_value = "all")]
+    modes: render::ModeList,
     /// The block and dynamic modes' knob: a float uniform of the program.
     #[arg(long, default_value = "light_tolerance")]
     knob: String,
@@ -98,8 +99,8 @@ struct Bench {
     /// run; the median of the per-pair ratios is reported.
     #[arg(long, default_value_t = 5)]
     runs: usize,
-    /// Output directory.
-    #[arg(short, long, default_value = "bench-out")]
+    /// Output directory (created if missing).
+    #[arg(short, long = "out", alias = "out-dir", default_value = "out")]
     out_dir: PathBuf,
     /// Frames of the dynamic-threshold camera path (0 skips it).
     #[arg(long, default_value_t = 24)]
@@ -121,16 +122,19 @@ struct Render {
     /// Scene: demo, gradient, steps, sinusoid, sponza, or a .toml scene file (docs/scenes.md).
     #[arg(long, default_value = "demo")]
     scene: String,
-    /// reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard or all.
-    #[arg(long, default_value = "coarse4x4")]
-    mode: String,
+    /// Modes, comma-separated (reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard), or all.
+    #[arg(long, alias = "modes", value_parser = render::parse_modes, default_value = "coarse4x4")]
+    mode: render::ModeList,
     /// Image size, WIDTHxHEIGHT (default: the scene file's, else 960x540).
     #[arg(long, value_parser = render::parse_size)]
     size: Option<(u32, u32)>,
     /// Set a uniform: NAME=VALUE or NAME=X,Y,Z (repeatable).
     #[arg(long = "set", value_parser = render::parse_set)]
     sets: Vec<(String, Vec<f64>)>,
-    /// Output PNG (default: PROGRAM.MODE.png in the current directory).
+    /// Directory of the files written (created if missing), except those named by -o and --heatmap.
+    #[arg(long = "out", default_value = "out")]
+    out_dir: PathBuf,
+    /// Output PNG (default: OUT/PROGRAM.MODE.png).
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Heatmap PNG of where coarse effects were evaluated per pixel.
@@ -160,6 +164,9 @@ enum Emit {
 }
 
 fn main() -> ExitCode {
+    // Before anything can start a thread or load Vulkan (see the function).
+    // SAFETY: no other thread exists yet: nothing has run but `main`'s start.
+    unsafe { mrsl_lab::runtime_dir::ensure_xdg_runtime_dir() };
     let cli = Cli::parse();
     locate_sponza();
     match run(&cli) {
@@ -203,19 +210,15 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
             }
         }
         Command::Render(r) => {
-            let modes: Vec<mrsl_runtime::Mode> = if r.mode == "all" {
-                mrsl_runtime::Mode::ALL.to_vec()
-            } else {
-                vec![r.mode.parse().map_err(|e: mrsl_runtime::Error| e.to_string())?]
-            };
             let args = render::RenderArgs {
                 program: r.program.clone(),
                 scene: r.scene.clone(),
-                modes,
+                modes: r.mode.0.clone(),
                 size: r.size,
                 sets: r.sets.clone(),
                 output: r.output.clone(),
                 heatmap: r.heatmap.clone(),
+                out_dir: r.out_dir.clone(),
                 stats: r.stats,
                 force_refine: r.force_refine,
                 compare: r.compare,
@@ -224,18 +227,11 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
             Ok(written(render::render(&args)))
         }
         Command::Bench(b) => {
-            let modes: Vec<mrsl_runtime::Mode> = if b.modes == "all" {
-                mrsl_runtime::Mode::ALL.to_vec()
-            } else {
-                b.modes
-                    .split(',')
-                    .map(|m| m.trim().parse().map_err(|e: mrsl_runtime::Error| e.to_string()))
-                    .collect::<Result<_, _>>()?
-            };
+            let modes = b.modes.0.clone();
             if b.ablation {
                 let mode = match modes.as_slice() {
                     [mode] => *mode,
-                    _ if b.modes == "all" => mrsl_runtime::Mode::Coarse4x4,
+                    _ if modes == mrsl_runtime::Mode::ALL => mrsl_runtime::Mode::Coarse4x4,
                     _ => return Err("--ablation takes one block mode in --modes (coarse2x2 or coarse4x4)".into()),
                 };
                 let args = ablation::AblationArgs {
@@ -308,12 +304,12 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
     }
 }
 
-/// The exit of a command that writes files: lists them (exit 0), or prints
-/// why it failed (exit 1).
+/// The exit of a command that writes files: lists them at the end (exit
+/// 0), or prints why it failed (exit 1).
 fn written(result: Result<Vec<PathBuf>, String>) -> ExitCode {
     match result {
         Ok(paths) => {
-            for p in paths {
+            for p in &paths {
                 eprintln!("wrote {}", p.display());
             }
             ExitCode::SUCCESS

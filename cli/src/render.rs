@@ -1,6 +1,7 @@
 //! `mrslc render`: runs a program over a scene with the wgpu runtime and
 //! writes the image, a refinement heatmap and statistics.
 
+use crate::legend::{self, Legend};
 use mrsl::Options;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::mesh_scene::MeshScene;
@@ -26,6 +27,8 @@ pub struct RenderArgs {
     pub sets: Vec<(String, Vec<f64>)>,
     pub output: Option<PathBuf>,
     pub heatmap: Option<PathBuf>,
+    /// Where files without an explicit path (`-o`, `--heatmap`) go.
+    pub out_dir: PathBuf,
     pub stats: bool,
     pub force_refine: bool,
     /// Compare each mode's first output with the reference: metrics and an error image.
@@ -73,6 +76,12 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
     if args.compare && !modes.contains(&Mode::Reference) {
         modes.push(Mode::Reference);
     }
+    if args.program.is_none() {
+        eprintln!(
+            "program: the built-in demo, examples/demo.mrsl (give a .mrsl file to render another; \
+             examples/sponza_lights.mrsl uses the light rig of mesh scenes)"
+        );
+    }
     let (name, program) = compile_program(args.program.as_deref(), ("demo.mrsl", DEMO_PROGRAM), &modes)?;
     progress(&format!("compiled {name}: {} kernels", program.kernels.len()), start);
 
@@ -86,12 +95,16 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
     let mut shader = Shader::new(&gpu.device, &program).map_err(|e| e.to_string())?;
     shader.set_timestamp_period(&gpu.queue);
     // The scene's uniforms, then the command line's.
-    let shadow_map = scene.prepare(&gpu, &mut shader).map_err(|e| format!("{}: {e}", args.scene))?;
+    let textures = scene.prepare(&gpu, &mut shader).map_err(|e| format!("{}: {e}", args.scene))?.warn();
     let channels = scene.channels;
     for (name, values) in &args.sets {
         shader.set_uniform(name, values).map_err(|e| e.to_string())?;
     }
-    let resources = Resources::new(&gpu, &program, size, shadow_map);
+    let resources = Resources::new(&gpu, &program, size, textures);
+    resources.note_fallbacks();
+    // Created only now, so that a run that fails before rendering leaves nothing behind.
+    std::fs::create_dir_all(&args.out_dir).map_err(|e| format!("cannot create {}: {e}", args.out_dir.display()))?;
+    let in_out = |file: String| args.out_dir.join(file);
     let outputs = &resources.outputs;
     let bindings = resources.bindings(&program, &channels);
 
@@ -107,9 +120,10 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
     if args.compare && !comparable {
         return Err("--compare needs the first output to be rgba32float".into());
     }
-    // The reference image the other modes are compared with.
+    // The reference image the other modes are compared with, rendered first
+    // unless it is the first mode that runs.
     let mut reference: Option<Vec<[f32; 4]>> = None;
-    if args.compare && !args.modes.contains(&Mode::Reference) {
+    if args.compare && args.modes.first() != Some(&Mode::Reference) {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         shader
             .encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options(Mode::Reference))
@@ -147,9 +161,12 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
                     mrsl_lab::metrics::DEFAULT_ERROR_SCALE,
                 )
                 .map_err(|e| e.to_string())?;
-                let path = PathBuf::from(format!("{stem}.{mode}.error.png"));
-                image::RgbaImage::from_raw(size.0, size.1, error)
-                    .ok_or("error image has the wrong size")?
+                let path = in_out(format!("{stem}.{mode}.error.png"));
+                let error =
+                    image::RgbaImage::from_raw(size.0, size.1, error).ok_or("error image has the wrong size")?;
+                let error = image::DynamicImage::ImageRgba8(error).to_rgb8();
+                let scale = mrsl_lab::metrics::DEFAULT_ERROR_SCALE;
+                legend::with_legend(&error, &Legend::Error { scale })?
                     .save(&path)
                     .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
                 written.push(path);
@@ -161,8 +178,8 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
             let path = match (&args.output, k) {
                 (Some(p), 0) => with_suffix(p, &suffix),
                 (Some(p), _) => with_suffix(p, &format!("{suffix}.{name}")),
-                (None, 0) => PathBuf::from(format!("{stem}{suffix}.png")),
-                (None, _) => PathBuf::from(format!("{stem}{suffix}.{name}.png")),
+                (None, 0) => in_out(format!("{stem}{suffix}.png")),
+                (None, _) => in_out(format!("{stem}{suffix}.{name}.png")),
             };
             save_output(&gpu, texture, &path)?;
             written.push(path);
@@ -170,7 +187,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
         if mode != Mode::Reference && !shader.layout().stats.counters.is_empty() {
             let path = match &args.heatmap {
                 Some(p) => with_suffix(p, if args.modes.len() > 1 { &suffix } else { "" }),
-                None => PathBuf::from(format!("{stem}.{mode}.heatmap.png")),
+                None => in_out(format!("{stem}.{mode}.heatmap.png")),
             };
             if let Some(rate) = shader.rate_image() {
                 let counters = shader.layout().stats.counters.clone();
@@ -179,7 +196,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
                 // One map per coarse effect: where that effect was evaluated per pixel.
                 for (bit, effect) in counters.iter().enumerate().take(32) {
                     let per_effect = with_suffix(&path, &format!(".{effect}"));
-                    save_heatmap(&gpu, rate, counters.len(), Some(bit as u32), &per_effect)?;
+                    save_heatmap(&gpu, rate, counters.len(), Some((bit as u32, effect)), &per_effect)?;
                     written.push(per_effect);
                 }
             }
@@ -191,7 +208,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
     }
     let stats_path = match &args.output {
         Some(p) => p.with_extension("stats.json"),
-        None => PathBuf::from(format!("{stem}.stats.json")),
+        None => in_out(format!("{stem}.stats.json")),
     };
     std::fs::write(&stats_path, serde_json::to_string_pretty(&all_stats).map_err(|e| e.to_string())?)
         .map_err(|e| format!("cannot write {}: {e}", stats_path.display()))?;
@@ -201,30 +218,52 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
 
 /// A scene ready to bind: its G-buffer textures, the image size, the
 /// mesh scene (camera, light rig, shadow map) for scenes made of a mesh, and
-/// a scene file's uniforms.
+/// the scene file, if any (its uniforms and images).
 pub struct BoundScene {
     pub channels: Vec<(String, wgpu::Texture)>,
     pub size: (u32, u32),
     pub mesh: Option<MeshScene>,
-    pub uniforms: Vec<(String, Vec<f64>)>,
+    pub file: Option<SceneFile>,
 }
 
 impl BoundScene {
     /// Sets the uniforms the scene provides (the mesh scene's rig and
-    /// camera, then the scene file's), and renders the shadow map if the
-    /// program samples `shadow_map`; returns it.
-    pub fn prepare(&mut self, gpu: &Gpu, shader: &mut Shader) -> Result<Option<wgpu::Texture>, String> {
-        let mut shadow_map = None;
+    /// camera, then the scene file's), by name and type, and renders the
+    /// shadow map if the program samples `shadow_map`. Returns the textures
+    /// to bind by name (the shadow map and the scene file's images) and the
+    /// names the program declares with another type, left at its defaults.
+    pub fn prepare(&mut self, gpu: &Gpu, shader: &mut Shader) -> Result<Prepared, String> {
+        let mut textures = vec![];
+        let mut warnings = vec![];
         if let Some(mesh) = &mut self.mesh {
-            mesh.set_uniforms(shader, &mesh.camera.clone()).map_err(|e| e.to_string())?;
-            if shader.layout().textures.iter().any(|t| t.name == "shadow_map") {
-                shadow_map = Some(mesh.shadow_map(gpu).map_err(|e| e.to_string())?.clone());
+            let applied = mesh.set_uniforms(shader, &mesh.camera.clone()).map_err(|e| e.to_string())?;
+            if applied.set.iter().any(|name| name == "shadow_map") {
+                textures.push(("shadow_map".to_string(), mesh.shadow_map(gpu).map_err(|e| e.to_string())?.clone()));
             }
+            warnings.extend(applied.warnings);
         }
-        for (name, values) in &self.uniforms {
-            shader.set_uniform(name, values).map_err(|e| format!("`uniforms.{name}`: {e}"))?;
+        if let Some(file) = &self.file {
+            let bound = file.bind(gpu, shader).map_err(|e| e.to_string())?;
+            warnings.extend(bound.applied.warnings);
+            textures.extend(bound.textures);
         }
-        Ok(shadow_map)
+        Ok(Prepared { textures, warnings })
+    }
+}
+
+/// What [`BoundScene::prepare`] provides besides uniform values.
+pub struct Prepared {
+    pub textures: Vec<(String, wgpu::Texture)>,
+    pub warnings: Vec<mrsl_lab::uniforms::Mismatch>,
+}
+
+impl Prepared {
+    /// Prints the warnings; returns the textures.
+    pub fn warn(self) -> Vec<(String, wgpu::Texture)> {
+        for warning in &self.warnings {
+            eprintln!("warning: {warning}");
+        }
+        self.textures
     }
 }
 
@@ -238,7 +277,7 @@ pub fn bind_scene(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> Result<Bo
             Some(m) => m.gbuffer(gpu, &m.camera, size).map_err(|e| e.to_string())?,
             None => builtin.textures_on(gpu, size.0, size.1).map_err(|e| e.to_string())?,
         };
-        return Ok(BoundScene { channels, size, mesh, uniforms: vec![] });
+        return Ok(BoundScene { channels, size, mesh, file: None });
     }
     let path = Path::new(scene);
     if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
@@ -247,37 +286,64 @@ pub fn bind_scene(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> Result<Bo
         let size = size.or(file.size).unwrap_or(DEFAULT_SIZE);
         let mesh = file.mesh_scene(gpu, size).map_err(|e| e.to_string())?;
         let channels = mesh.gbuffer(gpu, &mesh.camera, size).map_err(|e| format!("{scene}: {e}"))?;
-        return Ok(BoundScene { channels, size, mesh: Some(mesh), uniforms: file.uniforms.clone() });
+        return Ok(BoundScene { channels, size, mesh: Some(mesh), file: Some(file) });
     }
     Err(format!("unknown scene `{scene}` (expected {}, or a .toml scene file)", Scene::NAMES.join(", ")))
 }
 
-/// What a program binds besides the G-buffer: its outputs, and for its
-/// textures the scene's shadow map as `shadow_map` and a procedural checker
-/// for any other, with a linear, repeating sampler (scenes carry no
-/// material textures yet).
+/// What a program binds besides the G-buffer: its outputs, and for each of
+/// its textures the scene's texture of that name (the shadow map, a scene
+/// file's image), else a procedural checker; every sampler is linear and
+/// repeating.
 pub struct Resources {
     pub size: (u32, u32),
     pub outputs: Vec<(String, wgpu::Texture)>,
     checker_view: wgpu::TextureView,
-    shadow_view: Option<wgpu::TextureView>,
+    views: Vec<(String, wgpu::TextureView)>,
+    /// The program's textures that get the checker.
+    checkered: Vec<String>,
     sampler: wgpu::Sampler,
 }
 
 impl Resources {
-    pub fn new(gpu: &Gpu, program: &mrsl::Program, size: (u32, u32), shadow_map: Option<wgpu::Texture>) -> Resources {
+    pub fn new(
+        gpu: &Gpu,
+        program: &mrsl::Program,
+        size: (u32, u32),
+        textures: Vec<(String, wgpu::Texture)>,
+    ) -> Resources {
         let outputs = program
             .layout
             .outputs
             .iter()
             .map(|o| (o.name.clone(), gpu.output_texture(&o.name, size, mrsl_runtime::wgpu_format(o.format))))
             .collect();
+        let views: Vec<(String, wgpu::TextureView)> =
+            textures.iter().map(|(name, t)| (name.clone(), t.create_view(&Default::default()))).collect();
+        let checkered = program
+            .layout
+            .textures
+            .iter()
+            .filter(|t| !views.iter().any(|(name, _)| *name == t.name))
+            .map(|t| t.name.clone())
+            .collect();
         Resources {
             size,
             outputs,
             checker_view: checker_texture(gpu).create_view(&Default::default()),
-            shadow_view: shadow_map.map(|t| t.create_view(&Default::default())),
+            views,
+            checkered,
             sampler: linear_sampler(gpu),
+        }
+    }
+
+    /// Says which textures get the procedural checker, and how to give them an image.
+    pub fn note_fallbacks(&self) {
+        for name in &self.checkered {
+            eprintln!(
+                "note: texture `{name}` gets a procedural 64x64 checker (a scene file binds an image to it: \
+                 `{name} = \"FILE.png\"` under [uniforms])"
+            );
         }
     }
 
@@ -288,10 +354,7 @@ impl Resources {
             bindings.channels.insert(name.clone(), texture);
         }
         for t in &program.layout.textures {
-            let view = match &self.shadow_view {
-                Some(shadow) if t.name == "shadow_map" => shadow,
-                _ => &self.checker_view,
-            };
+            let view = self.views.iter().find(|(name, _)| *name == t.name).map_or(&self.checker_view, |(_, v)| v);
             bindings.textures.insert(t.name.clone(), view);
         }
         for s in &program.layout.samplers {
@@ -371,10 +434,18 @@ fn save_output(gpu: &Gpu, texture: &wgpu::Texture, path: &Path) -> Result<(), St
 }
 
 /// Colours each pixel by the rate its coarse effects were shaded at, in the
-/// style of He et al.'s heatmaps: blue = every coarse effect resampled from
-/// the first (2x2 or 4x4) level, green = some taken from the dynamic mode's
-/// 2x2 level, then yellow to red as the fraction evaluated per pixel grows.
-fn save_heatmap(gpu: &Gpu, rate: &wgpu::Texture, effects: usize, only: Option<u32>, path: &Path) -> Result<(), String> {
+/// style of He et al.'s heatmaps ([`legend::heat`]): blue = every coarse
+/// effect resampled from the first (2x2 or 4x4) level, green = some taken
+/// from the dynamic mode's 2x2 level, then yellow to red as the fraction
+/// evaluated per pixel grows; `only`: one effect's bit (blue, green or red).
+/// The key is drawn below the map.
+fn save_heatmap(
+    gpu: &Gpu,
+    rate: &wgpu::Texture,
+    effects: usize,
+    only: Option<(u32, &str)>,
+    path: &Path,
+) -> Result<(), String> {
     let (w, h) = (rate.width(), rate.height());
     let bytes = gpu.read_texture(rate).map_err(|e| e.to_string())?;
     let mut img = image::RgbImage::new(w, h);
@@ -383,27 +454,55 @@ fn save_heatmap(gpu: &Gpu, rate: &wgpu::Texture, effects: usize, only: Option<u3
         let mut mask = u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
         let mut level2 = u32::from_le_bytes([b[4], b[5], b[6], b[7]]);
         let mut counted = counted;
-        if let Some(bit) = only {
+        if let Some((bit, _)) = only {
             // A single effect: red where it was evaluated per pixel.
             mask = (mask >> bit) & 1;
             level2 = (level2 >> bit) & 1;
             counted = 1.0;
         }
         let f = mask.count_ones() as f32 / counted;
-        let (r, g, bl) = if f <= 0.0 && level2 != 0 {
-            (60, 190, 80)
-        } else if f <= 0.0 {
-            (40, 70, 200)
-        } else if f < 0.5 {
-            let t = f / 0.5;
-            ((40.0 + t * 215.0) as u8, (70.0 + t * 150.0) as u8, (200.0 - t * 160.0) as u8)
-        } else {
-            let t = (f - 0.5) / 0.5;
-            (255, (220.0 - t * 180.0) as u8, 40)
-        };
-        img.put_pixel(i as u32 % w, i as u32 / w, image::Rgb([r, g, bl]));
+        img.put_pixel(i as u32 % w, i as u32 / w, image::Rgb(legend::heat(f, level2 != 0)));
     }
-    img.save(path).map_err(|e| format!("cannot write {}: {e}", path.display()))
+    let key = match only {
+        Some((_, effect)) => Legend::Effect(effect.to_string()),
+        None => Legend::Fraction,
+    };
+    legend::with_legend(&img, &key)?.save(path).map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+/// The modes of `--mode`, in the order given, each once.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModeList(pub Vec<Mode>);
+
+/// Parses `--mode`: a comma-separated list of mode names, where `all`
+/// stands for the six modes in their usual order; every unknown name is
+/// reported at once.
+pub fn parse_modes(text: &str) -> Result<ModeList, String> {
+    let mut modes = vec![];
+    let mut unknown = vec![];
+    for name in text.split(',').map(str::trim) {
+        let named: Vec<Mode> = match name {
+            "all" => Mode::ALL.to_vec(),
+            _ => match name.parse() {
+                Ok(mode) => vec![mode],
+                Err(_) => {
+                    unknown.push(format!("`{name}`"));
+                    continue;
+                }
+            },
+        };
+        for mode in named {
+            if !modes.contains(&mode) {
+                modes.push(mode);
+            }
+        }
+    }
+    let expected = format!("{}, or all", Mode::ALL.map(Mode::name).join(", "));
+    match unknown.len() {
+        0 => Ok(ModeList(modes)),
+        1 => Err(format!("unknown mode {} (expected a comma-separated list of {expected})", unknown[0])),
+        _ => Err(format!("unknown modes {} (expected a comma-separated list of {expected})", unknown.join(", "))),
+    }
 }
 
 /// Parses `name=v1,v2,...`.
@@ -429,4 +528,50 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
         return Err(format!("size `{text}` must be between 1x1 and 16384x16384"));
     }
     Ok((w, h))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn modes_are_a_comma_list_or_all() {
+        assert_eq!(parse_modes("coarse4x4"), Ok(ModeList(vec![Mode::Coarse4x4])));
+        assert_eq!(
+            parse_modes("hierarchical, reference"),
+            Ok(ModeList(vec![Mode::Hierarchical, Mode::Reference])),
+            "in the order given"
+        );
+        assert_eq!(parse_modes("all"), Ok(ModeList(Mode::ALL.to_vec())));
+        // Each mode once, where it first appears.
+        assert_eq!(
+            parse_modes("dynamic,all,dynamic"),
+            Ok(ModeList(vec![
+                Mode::Dynamic,
+                Mode::Reference,
+                Mode::Coarse2x2,
+                Mode::Coarse4x4,
+                Mode::Hierarchical,
+                Mode::Checkerboard
+            ]))
+        );
+    }
+
+    #[test]
+    fn unknown_modes_are_named_together() {
+        assert_eq!(
+            parse_modes("reference,coarse8x8"),
+            Err("unknown mode `coarse8x8` (expected a comma-separated list of reference, coarse2x2, coarse4x4, \
+                 dynamic, hierarchical, checkerboard, or all)"
+                .into())
+        );
+        let e = parse_modes("fast,reference,,slow").unwrap_err();
+        assert!(e.starts_with("unknown modes `fast`, ``, `slow` (expected"), "{e}");
+    }
+
+    #[test]
+    fn outputs_named_after_a_path_take_the_suffix_before_the_extension() {
+        assert_eq!(with_suffix(Path::new("out/heat.png"), ".dynamic"), PathBuf::from("out/heat.dynamic.png"));
+        assert_eq!(with_suffix(Path::new("heat.png"), ""), PathBuf::from("heat.png"));
+    }
 }

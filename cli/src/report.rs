@@ -388,7 +388,7 @@ pub fn markdown(setup: &str, points: &[Point], frames: &[ControllerFrame]) -> St
 
 /// Registers the plots' font once (plotters draws text with ab_glyph from a
 /// font it is given; the machines CI runs on have no system fonts).
-fn register_font() -> Result<(), String> {
+pub(crate) fn register_font() -> Result<(), String> {
     static ONCE: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
     ONCE.get_or_init(|| {
         plotters::style::register_font(

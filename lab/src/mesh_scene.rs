@@ -6,7 +6,7 @@ use crate::gpu::Gpu;
 use crate::mesh::Mesh;
 use crate::raster::{Camera, GpuMesh, RasterError, Rasterizer};
 use crate::rig::{DEFAULT_LIGHTS, DEFAULT_SHADOW_MAP_SIZE, LightRig, RigError};
-use mrsl_abi::{Scalar, ValueType};
+use crate::uniforms::{Applied, Offered};
 use mrsl_runtime::Shader;
 
 /// A mesh scene ready to render.
@@ -47,18 +47,17 @@ impl MeshScene {
         Ok(self.shadow_map.as_ref().expect("set just above"))
     }
 
-    /// Sets what the scene provides among the uniforms the program declares:
-    /// the rig's (see [`crate::rig`]) and `camera_pos` (a `float3`: the eye of
-    /// `camera`). Returns the names set.
-    pub fn set_uniforms(&self, shader: &mut Shader, camera: &Camera) -> Result<Vec<String>, RigError> {
-        let mut set = self.rig.apply(shader)?;
-        let has_camera_pos = shader.layout().uniforms.as_ref().is_some_and(|u| {
-            u.fields.iter().any(|f| f.name == "camera_pos" && f.ty == ValueType::Vector(Scalar::Float, 3))
-        });
-        if has_camera_pos {
+    /// Sets what the scene provides among the uniforms the program declares,
+    /// by name and type ([`crate::uniforms`]): the rig's (see [`crate::rig`])
+    /// and `camera_pos` (a `float3`: the eye of `camera`). Returns the names
+    /// set and the names left at the program's default for their type.
+    pub fn set_uniforms(&self, shader: &mut Shader, camera: &Camera) -> Result<Applied, RigError> {
+        let mut applied = self.rig.apply(shader)?;
+        let layout = shader.layout().clone();
+        if applied.admit(&layout, "scene", "camera_pos", &Offered::float3())? {
             shader.set_uniform("camera_pos", &camera.eye.map(f64::from))?;
-            set.push("camera_pos".into());
+            applied.record("camera_pos");
         }
-        Ok(set)
+        Ok(applied)
     }
 }

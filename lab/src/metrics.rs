@@ -259,7 +259,9 @@ pub fn error_image(
         .collect())
 }
 
-fn magma_rgba8(v: f32) -> [u8; 4] {
+/// The Magma colour of `v` in [0, 1] (clamped) as opaque RGBA8: the colour
+/// scale of [`error_image`] and [`FlipMap::to_rgba8`], for drawing their keys.
+pub fn magma_rgba8(v: f32) -> [u8; 4] {
     // As flip_rs::ErrorMap::colorize: NaN clamps to NaN and `as usize` maps it to 0.
     let [r, g, b] = flip_rs::MAGMA[(v.clamp(0.0, 1.0) * 255.0 + 0.5) as usize];
     let byte = |c: f32| (c * 255.0 + 0.5) as u8;

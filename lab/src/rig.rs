@@ -14,6 +14,10 @@
 //! | `sun_size`      | `float`        | the sun's width in world units (PCSS light size)           |
 //! | `shadow_map`    | `texture2d`    | distance from `sun_pos` as `r + g` (see below)             |
 //!
+//! A uniform is set only when the program declares it with the type above
+//! (any length N for the arrays); see [`crate::uniforms`] for what happens
+//! to a name declared with another type.
+//!
 //! The shadow map is the `depth` channel of a G-buffer rasterised from the
 //! sun (a pinhole camera: the same rasteriser and pixel convention as the
 //! view), so texel `(x, y)` holds the distance from `sun_pos` to the nearest
@@ -26,6 +30,8 @@
 use crate::gpu::Gpu;
 use crate::mesh::{Bounds, length, normalize, sub};
 use crate::raster::{Camera, GpuMesh, RasterError, Rasterizer};
+use crate::uniforms::{Applied, Offered, UniformTypeError};
+use mrsl_abi::{Scalar, ValueType};
 use mrsl_runtime::Shader;
 
 /// A point light.
@@ -131,44 +137,62 @@ impl LightRig {
     }
 
     /// Sets the rig's uniforms that the shader's program declares (names
-    /// above); arrays take as many lights as they hold. Returns the names set.
-    pub fn apply(&self, shader: &mut Shader) -> Result<Vec<String>, RigError> {
-        let declared: Vec<(String, mrsl_abi::ValueType)> = shader
-            .layout()
-            .uniforms
-            .as_ref()
-            .map(|u| u.fields.iter().map(|f| (f.name.clone(), f.ty.clone())).collect())
-            .unwrap_or_default();
+    /// above) with the rig's type ([`crate::uniforms`]): a name the program
+    /// declares with another type is left at its default and reported in
+    /// [`Applied::warnings`], or is [`RigError::Type`] when it has no
+    /// default. Arrays take as many lights as they hold. `shadow_map` is
+    /// checked (a `texture2d`) and listed in [`Applied::set`] when the
+    /// program samples it; the caller binds the texture
+    /// ([`LightRig::shadow_map`]).
+    pub fn apply(&self, shader: &mut Shader) -> Result<Applied, RigError> {
+        let mut applied = Applied::default();
+        let layout = shader.layout().clone();
+        let lights = self.lights.len();
+        let float = Offered::scalar(Scalar::Float);
+        // The arrays first: light_count counts the lights they hold.
+        let mut capacity: Option<usize> = None;
+        for name in ["light_pos", "light_color"] {
+            if !applied.admit(&layout, SOURCE, name, &Offered::Float4Array(lights))? {
+                continue;
+            }
+            let components = declared_components(&layout, name);
+            let held = components / 4;
+            capacity = Some(capacity.map_or(held, |c| c.min(held)));
+            let mut values: Vec<f64> = self
+                .lights
+                .iter()
+                .take(held)
+                .flat_map(|l| match name {
+                    "light_pos" => [l.position[0], l.position[1], l.position[2], l.range],
+                    _ => [l.color[0], l.color[1], l.color[2], l.intensity],
+                })
+                .map(f64::from)
+                .collect();
+            // Arrays larger than the rig: the rest stays zero (lights past light_count).
+            values.resize(components, 0.0);
+            shader.set_uniform(name, &values)?;
+            applied.record(name);
+        }
         let focal = 0.5 / (self.sun.camera.fov_y_degrees.to_radians() / 2.0).tan();
         let view_proj = self.sun_view_proj()?;
-        let light_capacity = declared_capacity(shader, "light_pos").unwrap_or(self.lights.len());
-        let mut set = vec![];
-        for (name, ty) in declared {
-            let capacity = ty.components() as usize / 4;
-            let lights = || self.lights.iter().take(capacity);
-            let values: Vec<f64> = match name.as_str() {
-                "light_pos" => lights().flat_map(|l| [l.position[0], l.position[1], l.position[2], l.range]).collect(),
-                "light_color" => lights().flat_map(|l| [l.color[0], l.color[1], l.color[2], l.intensity]).collect(),
-                "light_count" => vec![self.lights.len().min(light_capacity) as f32],
-                "sun_pos" => self.sun.camera.eye.to_vec(),
-                "sun_view_proj" => view_proj.to_vec(),
-                "sun_focal" => vec![focal],
-                "sun_color" => self.sun.color.to_vec(),
-                "sun_size" => vec![self.sun.size],
-                _ => continue,
+        let singles: [(&str, Offered, Vec<f32>); 6] = [
+            ("light_count", Offered::scalar(Scalar::Int), vec![lights.min(capacity.unwrap_or(lights)) as f32]),
+            ("sun_pos", Offered::float3(), self.sun.camera.eye.to_vec()),
+            ("sun_view_proj", Offered::Value(ValueType::Matrix(4)), view_proj.to_vec()),
+            ("sun_focal", float.clone(), vec![focal]),
+            ("sun_color", Offered::float3(), self.sun.color.to_vec()),
+            ("sun_size", float, vec![self.sun.size]),
+        ];
+        for (name, offered, values) in singles {
+            if applied.admit(&layout, SOURCE, name, &offered)? {
+                shader.set_uniform(name, &values.into_iter().map(f64::from).collect::<Vec<_>>())?;
+                applied.record(name);
             }
-            .into_iter()
-            .map(f64::from)
-            .collect();
-            // Arrays larger than the rig: the rest stays zero (lights past light_count).
-            let mut values = values;
-            if name == "light_pos" || name == "light_color" {
-                values.resize(ty.components() as usize, 0.0);
-            }
-            shader.set_uniform(&name, &values)?;
-            set.push(name);
         }
-        Ok(set)
+        if applied.admit(&layout, SOURCE, "shadow_map", &Offered::Texture)? {
+            applied.record("shadow_map");
+        }
+        Ok(applied)
     }
 
     /// Renders the sun's shadow map (`size` x `size`, `Rg16Float`, distance
@@ -217,12 +241,19 @@ pub enum RigError {
     /// The shader refused a value.
     #[error(transparent)]
     Uniform(#[from] mrsl_runtime::Error),
+    /// The program declares one of the rig's names with another type and no
+    /// default, so its value would be missing.
+    #[error(transparent)]
+    Type(#[from] UniformTypeError),
 }
 
-/// How many float4 elements the program's array uniform `name` holds.
-fn declared_capacity(shader: &Shader, name: &str) -> Option<usize> {
-    let field = shader.layout().uniforms.as_ref()?.fields.iter().find(|f| f.name == name)?;
-    Some(field.ty.components() as usize / 4)
+/// How the rig names itself in warnings and errors.
+pub const SOURCE: &str = "light rig";
+
+/// The number of components of the program's uniform `name` (0 if it has none).
+fn declared_components(layout: &mrsl_abi::Layout, name: &str) -> usize {
+    let field = layout.uniforms.as_ref().and_then(|u| u.fields.iter().find(|f| f.name == name));
+    field.map_or(0, |f| f.ty.components() as usize)
 }
 
 #[cfg(test)]

@@ -15,14 +15,26 @@
 //! light_dir = [0.3, 0.9, 0.3]
 //! shininess = 20
 //! show_checker = true
+//! albedo_map = "textures/albedo.png"                       # a texture2d: an sRGB colour image
+//! roughness_map = { image = "textures/rough.png", srgb = false }   # data, read as stored
 //! ```
+//!
+//! Uniforms are bound by name and type ([`crate::uniforms`]): numbers go to
+//! a uniform with as many components, images to a `texture2d` (see
+//! [`crate::image_texture`] for decoding, sRGB and mipmaps). A name the
+//! program declares with another type is left at the program's default with
+//! a warning ([`SceneBinding::applied`]), or is an error when the program
+//! has no default for it; a name the program does not declare is an error.
 
 use crate::gbuffer::GBuffer;
 use crate::gpu::Gpu;
+use crate::image_texture::{ColorSpace, ImageError, ImageTexture};
 use crate::mesh::{DEFAULT_CREASE_ANGLE, Mesh, MeshError};
 use crate::mesh_scene::MeshScene;
 use crate::raster::{Camera, RasterError};
 use crate::scene::Scene;
+use crate::uniforms::{Applied, Offered, UniformTypeError, Verdict};
+use mrsl_runtime::Shader;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -54,6 +66,53 @@ pub enum SceneFileError {
         #[source]
         source: RasterError,
     },
+    /// An image named under `[uniforms]` could not be loaded.
+    #[error("{}: `{key}`: {source}", path.display())]
+    Image {
+        path: PathBuf,
+        key: String,
+        #[source]
+        source: ImageError,
+    },
+    /// A uniform the program declares with another type and no default.
+    #[error("{}: `{key}`: {source}", path.display())]
+    UniformType {
+        path: PathBuf,
+        key: String,
+        #[source]
+        source: UniformTypeError,
+    },
+}
+
+/// A value under `[uniforms]`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum UniformValue {
+    /// A number, a bool (0 or 1) or an array of them, flattened (matrices
+    /// column by column): for a uniform with that many components.
+    Numbers(Vec<f64>),
+    /// An image file (resolved against the scene file's folder): for a
+    /// `texture2d`.
+    Image { path: PathBuf, color_space: ColorSpace },
+}
+
+impl UniformValue {
+    /// What it offers a program ([`crate::uniforms`]).
+    pub fn offered(&self) -> Offered {
+        match self {
+            UniformValue::Numbers(values) => Offered::Numbers(values.len()),
+            UniformValue::Image { .. } => Offered::Texture,
+        }
+    }
+}
+
+/// What a scene file bound to a program ([`SceneFile::bind`]).
+#[derive(Debug)]
+pub struct SceneBinding {
+    /// The uniforms set and the textures bound, by name; and the names the
+    /// program declares with another type, left at its defaults.
+    pub applied: Applied,
+    /// The images, uploaded, for the program's `texture2d` uniforms of the same name.
+    pub textures: Vec<(String, wgpu::Texture)>,
 }
 
 /// Which mesh a scene file names.
@@ -75,8 +134,8 @@ pub struct SceneFile {
     pub camera: Option<Camera>,
     pub size: Option<(u32, u32)>,
     pub crease_angle: Option<f32>,
-    /// Uniform values, in the order of the file (scalars as one value, bools as 0/1).
-    pub uniforms: Vec<(String, Vec<f64>)>,
+    /// Uniform values and images, in the order of the file.
+    pub uniforms: Vec<(String, UniformValue)>,
 }
 
 impl SceneFile {
@@ -181,23 +240,73 @@ impl SceneFile {
             }
             Some(other) => return Err(key_error("camera", format!("expected a table, found {}", other.type_str()))),
         };
+        let base = path.parent().unwrap_or(Path::new(""));
         let mut uniforms = vec![];
         match table.get("uniforms") {
             None => {}
             Some(toml::Value::Table(t)) => {
                 for (name, v) in t {
-                    let values = numbers(v).filter(|n| !n.is_empty()).ok_or_else(|| {
-                        key_error(
-                            &format!("uniforms.{name}"),
-                            format!("expected a number, a bool or an array of them, found {}", describe_value(v)),
-                        )
-                    })?;
-                    uniforms.push((name.clone(), values));
+                    let key = format!("uniforms.{name}");
+                    let value = match v {
+                        toml::Value::String(file) => {
+                            UniformValue::Image { path: base.join(file), color_space: ColorSpace::Srgb }
+                        }
+                        toml::Value::Table(image) => image_value(image, base).map_err(|m| key_error(&key, m))?,
+                        _ => UniformValue::Numbers(numbers(v).filter(|n| !n.is_empty()).ok_or_else(|| {
+                            key_error(
+                                &key,
+                                format!(
+                                    "expected a number, a bool, an array of them, or an image file, found {}",
+                                    describe_value(v)
+                                ),
+                            )
+                        })?),
+                    };
+                    uniforms.push((name.clone(), value));
                 }
             }
             Some(other) => return Err(key_error("uniforms", format!("expected a table, found {}", other.type_str()))),
         }
         Ok(SceneFile { path: path.to_path_buf(), mesh, camera, size, crease_angle, uniforms })
+    }
+
+    /// Sets the file's `[uniforms]` on `shader` and uploads its images, by
+    /// name and type ([`crate::uniforms`]): a mismatch is a warning in the
+    /// result when the program has a default, else
+    /// [`SceneFileError::UniformType`]; a name the program does not declare
+    /// is [`SceneFileError::Key`], and an image that cannot be loaded
+    /// [`SceneFileError::Image`].
+    pub fn bind(&self, gpu: &Gpu, shader: &mut Shader) -> Result<SceneBinding, SceneFileError> {
+        let source = format!("scene file {}", self.path.display());
+        let layout = shader.layout().clone();
+        let mut applied = Applied::default();
+        let mut textures = vec![];
+        for (name, value) in &self.uniforms {
+            let key = format!("uniforms.{name}");
+            let verdict = crate::uniforms::check(&layout, &source, name, &value.offered())
+                .map_err(|source| SceneFileError::UniformType { path: self.path.clone(), key: key.clone(), source })?;
+            let key_error =
+                |message: String| SceneFileError::Key { path: self.path.clone(), key: key.clone(), message };
+            match verdict {
+                Verdict::Absent => return Err(key_error(format!("the program has no uniform `{name}`"))),
+                Verdict::Skip(mismatch) => applied.warnings.push(mismatch),
+                Verdict::Bind => {
+                    match value {
+                        UniformValue::Numbers(values) => {
+                            shader.set_uniform(name, values).map_err(|e| key_error(e.to_string()))?
+                        }
+                        UniformValue::Image { path, color_space } => {
+                            let image = ImageTexture::load(path, *color_space).map_err(|source| {
+                                SceneFileError::Image { path: self.path.clone(), key: key.clone(), source }
+                            })?;
+                            textures.push((name.clone(), image.upload(gpu, name)));
+                        }
+                    }
+                    applied.record(name);
+                }
+            }
+        }
+        Ok(SceneBinding { applied, textures })
     }
 
     /// Loads the mesh the file names (Sponza is shared between calls).
@@ -262,6 +371,26 @@ impl SceneFile {
         crate::raster::read_gbuffer(gpu, &textures)
             .map_err(|source| SceneFileError::Raster { path: self.path.clone(), source })
     }
+}
+
+/// `{ image = "FILE", srgb = BOOL }`: an image, sRGB unless `srgb = false`.
+fn image_value(table: &toml::Table, base: &Path) -> Result<UniformValue, String> {
+    for key in table.keys() {
+        if !["image", "srgb"].contains(&key.as_str()) {
+            return Err(format!("unknown key `{key}` (an image is {{ image = \"FILE\", srgb = true|false }})"));
+        }
+    }
+    let file = match table.get("image") {
+        Some(toml::Value::String(file)) => file,
+        Some(other) => return Err(format!("`image`: expected a file name, found {}", describe_value(other))),
+        None => return Err("missing `image = \"FILE\"`".into()),
+    };
+    let color_space = match table.get("srgb") {
+        None | Some(toml::Value::Boolean(true)) => ColorSpace::Srgb,
+        Some(toml::Value::Boolean(false)) => ColorSpace::Linear,
+        Some(other) => return Err(format!("`srgb`: expected true or false, found {}", describe_value(other))),
+    };
+    Ok(UniformValue::Image { path: base.join(file), color_space })
 }
 
 /// A single number.

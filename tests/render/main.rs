@@ -9,6 +9,7 @@
 
 mod harness;
 
+mod binding;
 mod errors;
 mod modes;
 mod sponza;
@@ -21,6 +22,8 @@ type GpuTest = (&'static str, fn(&mrsl_lab::gpu::Gpu));
 
 /// Tests that need a device.
 const GPU_TESTS: &[GpuTest] = &[
+    ("binding::textured_materials_are_lit_over_a_mesh_scene", binding::textured_materials_are_lit_over_a_mesh_scene),
+    ("binding::mismatches_without_defaults_are_typed_errors", binding::mismatches_without_defaults_are_typed_errors),
     ("errors::binding_mismatches_are_typed_errors", errors::binding_mismatches_are_typed_errors),
     ("errors::extra_channels_are_ignored", errors::extra_channels_are_ignored),
     ("errors::modes_without_kernels_are_unsupported", errors::modes_without_kernels_are_unsupported),
@@ -65,6 +68,10 @@ const GPU_TESTS: &[GpuTest] = &[
 
 /// Tests that run on the CPU only.
 const CPU_TESTS: &[(&str, fn())] = &[
+    (
+        "binding::scene_file_images_parse_and_name_their_mistakes",
+        binding::scene_file_images_parse_and_name_their_mistakes,
+    ),
     ("errors::unknown_modes_are_named", errors::unknown_modes_are_named),
     ("errors::compiled_kernels_are_those_of_the_modes", errors::compiled_kernels_are_those_of_the_modes),
     ("sponza::sponza_loads_with_its_35_materials", sponza::sponza_loads_with_its_35_materials),
@@ -74,6 +81,11 @@ const CPU_TESTS: &[(&str, fn())] = &[
 ];
 
 fn main() {
+    // Before the test threads and the Vulkan loader start: without it, Mesa
+    // prints "error: XDG_RUNTIME_DIR is invalid or not set" on machines
+    // without a session (see mrsl_lab::runtime_dir).
+    // SAFETY: no other thread exists yet.
+    unsafe { mrsl_lab::runtime_dir::ensure_xdg_runtime_dir() };
     let args = Arguments::from_args();
     let gpu = harness::gpu(GPU_TESTS.len());
     let mut trials: Vec<Trial> = GPU_TESTS

@@ -7,7 +7,7 @@ use mrsl_lab::gpu::Gpu;
 use mrsl_lab::mesh::{Mesh, MeshError};
 use mrsl_lab::raster::{self, Camera, RasterError};
 use mrsl_lab::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
-use mrsl_lab::scene_file::{MeshSource, SceneFile, SceneFileError};
+use mrsl_lab::scene_file::{MeshSource, SceneFile, SceneFileError, UniformValue};
 use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader};
 use std::path::PathBuf;
 
@@ -476,9 +476,9 @@ show_checker = false
     assert_eq!(
         scene.uniforms,
         [
-            ("light_dir".to_string(), vec![0.3, 0.9, 0.3]),
-            ("shininess".to_string(), vec![20.0]),
-            ("show_checker".to_string(), vec![0.0])
+            ("light_dir".to_string(), UniformValue::Numbers(vec![0.3, 0.9, 0.3])),
+            ("shininess".to_string(), UniformValue::Numbers(vec![20.0])),
+            ("show_checker".to_string(), UniformValue::Numbers(vec![0.0]))
         ]
     );
     assert_eq!(SceneFile::parse("mesh = \"sponza\"", &path).unwrap().mesh, MeshSource::Sponza);
@@ -500,7 +500,7 @@ show_checker = false
     assert_eq!(key_of("mesh = \"a.obj\"\n[camera]\neye = [1, 2, 3]\ntarget = [0, 0, 0]\nfov = 200"), "camera.fov");
     assert_eq!(key_of("mesh = \"a.obj\"\n[camera]\neye = [1, 2, 3]\ntarget = [1, 2, 3]"), "camera");
     assert_eq!(key_of("mesh = \"a.obj\"\n[camera]\nposition = [1, 2, 3]"), "camera.position");
-    assert_eq!(key_of("mesh = \"a.obj\"\n[uniforms]\ncolor = \"red\""), "uniforms.color");
+    assert_eq!(key_of("mesh = \"a.obj\"\n[uniforms]\ncolor = [1, \"red\"]"), "uniforms.color");
     assert_eq!(key_of("mesh = \"a.obj\"\nlights = 3"), "lights");
     match SceneFile::parse("mesh = ", &path) {
         Err(e @ SceneFileError::Syntax { .. }) => assert!(e.to_string().contains("scene.toml"), "{e}"),
@@ -606,7 +606,9 @@ pub fn sponza_lights_workload_matches_its_reference(gpu: &Gpu) {
     let sampler = gpu.device.create_sampler(&Default::default());
     let run = |mode: Mode, force_refine: bool| {
         let mut shader = Shader::new(&gpu.device, &program).unwrap();
-        let set = scene.set_uniforms(&mut shader, &scene.camera).unwrap();
+        let applied = scene.set_uniforms(&mut shader, &scene.camera).unwrap();
+        assert_eq!(applied.warnings, [], "the workload declares the rig's uniforms with the rig's types");
+        let set = applied.set;
         for name in ["light_pos", "light_color", "light_count", "sun_pos", "sun_view_proj", "sun_focal", "sun_size"] {
             assert!(set.iter().any(|s| s == name), "the rig did not set `{name}`: {set:?}");
         }
