@@ -3,8 +3,10 @@
 //!
 //! Every scene provides the same channels, so any program reading a subset
 //! of them runs on any scene: `position` (float3, world space), `normal`
-//! (float3, unit), `uv` (float2), `material` (uint; 255 is the background)
-//! and `depth` (float, distance from the camera).
+//! (float3, unit), `uv` (float2), `material` (uint; 255 is the background),
+//! `depth` (float, distance from the camera), and the material channels of
+//! a deferred renderer: `albedo` (float4, linear base colour and alpha),
+//! `roughness` and `metallic` (floats in [0, 1]).
 //!
 //! [`Scene::Sponza`] is a real model, rasterised on the GPU by
 //! [`crate::raster`]: build it with [`Scene::render_on`] or
@@ -204,7 +206,7 @@ fn surface(width: u32, height: u32, f: impl Fn(f32, f32) -> (u32, [f32; 3], [f32
             let (u, v) = ((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32);
             let (material, position, normal) = f(u, v);
             let depth = 5.0 - position[2];
-            b.push(position, normalize(normal), [u, v], material, depth);
+            b.push(position, normalize(normal), [u, v], material, depth, GREY);
         }
     }
     b.finish()
@@ -218,7 +220,20 @@ struct Builder {
     uv: Vec<f32>,
     material: Vec<u32>,
     depth: Vec<f32>,
+    albedo: Vec<f32>,
+    roughness: Vec<f32>,
+    metallic: Vec<f32>,
 }
+
+/// The surface of a CPU scene's pixel: (albedo, roughness, metallic).
+type Surface = ([f32; 4], f32, f32);
+
+/// The pattern scenes' surface: a light grey dielectric of medium roughness
+/// (the mesh loaders' default material).
+const GREY: Surface = ([0.8, 0.8, 0.8, 1.0], 0.5, 0.0);
+
+/// The background's: no albedo, fully rough, not metallic (the rasteriser's too).
+const BACKGROUND_SURFACE: Surface = ([0.0; 4], 1.0, 0.0);
 
 impl Builder {
     fn new(width: u32, height: u32) -> Builder {
@@ -231,14 +246,20 @@ impl Builder {
             uv: Vec::with_capacity(2 * n),
             material: Vec::with_capacity(n),
             depth: Vec::with_capacity(n),
+            albedo: Vec::with_capacity(4 * n),
+            roughness: Vec::with_capacity(n),
+            metallic: Vec::with_capacity(n),
         }
     }
-    fn push(&mut self, position: [f32; 3], normal: [f32; 3], uv: [f32; 2], material: u32, depth: f32) {
+    fn push(&mut self, position: [f32; 3], normal: [f32; 3], uv: [f32; 2], material: u32, depth: f32, surface: Surface) {
         self.position.extend(position);
         self.normal.extend(normal);
         self.uv.extend(uv);
         self.material.push(material);
         self.depth.push(depth);
+        self.albedo.extend(surface.0);
+        self.roughness.push(surface.1);
+        self.metallic.push(surface.2);
     }
     fn finish(self) -> GBuffer {
         GBuffer {
@@ -250,6 +271,9 @@ impl Builder {
                 ("uv".into(), ChannelData::Float { components: 2, data: self.uv }),
                 ("material".into(), ChannelData::Uint(self.material)),
                 ("depth".into(), ChannelData::Float { components: 1, data: self.depth }),
+                ("albedo".into(), ChannelData::Float { components: 4, data: self.albedo }),
+                ("roughness".into(), ChannelData::Float { components: 1, data: self.roughness }),
+                ("metallic".into(), ChannelData::Float { components: 1, data: self.metallic }),
             ],
         }
     }
@@ -312,9 +336,14 @@ fn demo(width: u32, height: u32) -> GBuffer {
                 }
             }
             match best {
-                Some((t, n, uv, material)) => {
-                    b.push([eye[0] + t * dir[0], eye[1] + t * dir[1], eye[2] + t * dir[2]], n, uv, material, t)
-                }
+                Some((t, n, uv, material)) => b.push(
+                    [eye[0] + t * dir[0], eye[1] + t * dir[1], eye[2] + t * dir[2]],
+                    n,
+                    uv,
+                    material,
+                    t,
+                    demo_surface(material, uv),
+                ),
                 None => {
                     let t = 50.0;
                     b.push(
@@ -323,10 +352,26 @@ fn demo(width: u32, height: u32) -> GBuffer {
                         [0.0, 0.0],
                         BACKGROUND,
                         t,
+                        BACKGROUND_SURFACE,
                     )
                 }
             }
         }
     }
     b.finish()
+}
+
+/// The demo scene's materials: a ground of light and dark tiles (8 per uv
+/// unit), a red plastic, a gold, a glossy blue and a rough white sphere.
+fn demo_surface(material: u32, uv: [f32; 2]) -> Surface {
+    match material {
+        0 => {
+            let light = ((uv[0] * 8.0).floor() + (uv[1] * 8.0).floor()).rem_euclid(2.0) == 0.0;
+            (if light { [0.75, 0.72, 0.66, 1.0] } else { [0.2, 0.19, 0.18, 1.0] }, 0.7, 0.0)
+        }
+        1 => ([0.8, 0.12, 0.08, 1.0], 0.45, 0.0),
+        2 => ([1.0, 0.77, 0.34, 1.0], 0.3, 1.0),
+        3 => ([0.1, 0.3, 0.8, 1.0], 0.15, 0.0),
+        _ => ([0.9, 0.9, 0.88, 1.0], 0.85, 0.0),
+    }
 }
