@@ -58,6 +58,12 @@ pub enum MeshError {
         searched.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
     )]
     SponzaNotFound { searched: Vec<PathBuf> },
+    #[error(
+        "the textured dungeon scene (level-dungeon.gltf of Debian's castle-game-engine-doc package) was not found; \
+         run scripts/fetch-dungeon.sh in the workspace, or set MRSL_DUNGEON to the file. Looked at: {}",
+        searched.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+    )]
+    DungeonNotFound { searched: Vec<PathBuf> },
     #[error("invalid mesh: {0}")]
     Invalid(String),
 }
@@ -1028,6 +1034,55 @@ pub fn sponza_shared() -> Result<Arc<Mesh>, MeshError> {
         return Ok(mesh.clone());
     }
     let mesh = Arc::new(Mesh::sponza()?);
+    *guard = Some(mesh.clone());
+    Ok(mesh)
+}
+
+/// The dungeon path the application chose ([`set_dungeon_path`]).
+static DUNGEON_PATH: Mutex<Option<PathBuf>> = Mutex::new(None);
+
+/// Where the dungeon level lies in Debian's `castle-game-engine-doc` package.
+const DUNGEON_IN_PACKAGE: &str =
+    "/usr/share/doc/castle-game-engine-doc/examples/third_person_navigation/data/level/level-dungeon.gltf";
+
+/// Tells [`dungeon_path`] where the dungeon's `level-dungeon.gltf` is.
+pub fn set_dungeon_path(path: PathBuf) {
+    *DUNGEON_PATH.lock().unwrap_or_else(|e| e.into_inner()) = Some(path);
+}
+
+/// The places [`dungeon_path`] looks, in order: the path given to
+/// [`set_dungeon_path`], `$MRSL_DUNGEON`, where `scripts/fetch-dungeon.sh`
+/// puts it (`$XDG_DATA_HOME/mrsl/castle-dungeon/level-dungeon.gltf`,
+/// `XDG_DATA_HOME` defaulting to `~/.local/share`), and where Debian's
+/// package installs it.
+pub fn dungeon_candidates() -> Vec<PathBuf> {
+    let chosen = DUNGEON_PATH.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    let data_home = std::env::var_os("XDG_DATA_HOME")
+        .map(PathBuf::from)
+        .filter(|p| p.is_absolute())
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".local/share")));
+    chosen
+        .into_iter()
+        .chain(std::env::var_os("MRSL_DUNGEON").map(PathBuf::from))
+        .chain(data_home.map(|d| d.join("mrsl/castle-dungeon/level-dungeon.gltf")))
+        .chain(std::iter::once(PathBuf::from(DUNGEON_IN_PACKAGE)))
+        .collect()
+}
+
+/// The path of the dungeon level: the first of [`dungeon_candidates`] that exists.
+pub fn dungeon_path() -> Result<PathBuf, MeshError> {
+    let searched = dungeon_candidates();
+    searched.iter().find(|p| p.is_file()).cloned().ok_or(MeshError::DungeonNotFound { searched })
+}
+
+/// The dungeon mesh with its materials and textures, loaded once per process and shared.
+pub fn dungeon_shared() -> Result<Arc<Mesh>, MeshError> {
+    static CACHE: Mutex<Option<Arc<Mesh>>> = Mutex::new(None);
+    let mut guard = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(mesh) = guard.as_ref() {
+        return Ok(mesh.clone());
+    }
+    let mesh = Arc::new(Mesh::load_gltf(dungeon_path()?)?);
     *guard = Some(mesh.clone());
     Ok(mesh)
 }

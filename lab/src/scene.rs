@@ -23,6 +23,11 @@ const SPONZA_EYE: [f32; 3] = [-11.5, 2.2, -0.3];
 const SPONZA_TARGET: [f32; 3] = [10.0, 4.5, 0.4];
 const SPONZA_FOV: f32 = 60.0;
 
+// The dungeon's default camera (see `Scene::dungeon_camera`).
+const DUNGEON_EYE: [f32; 3] = [-8.0, 3.0, 10.0];
+const DUNGEON_TARGET: [f32; 3] = [15.0, 0.5, -4.0];
+const DUNGEON_FOV: f32 = 60.0;
+
 /// Which synthetic scene to make.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Scene {
@@ -37,6 +42,10 @@ pub enum Scene {
     /// The Dabrovic Sponza atrium (a real model, 76k triangles, 35
     /// materials), rasterised on the GPU from [`Scene::sponza_camera`].
     Sponza,
+    /// A textured game level (the Castle Game Engine's dungeon: base colour
+    /// and normal maps), rasterised on the GPU from [`Scene::dungeon_camera`];
+    /// fetched by `scripts/fetch-dungeon.sh` (see docs/scenes.md).
+    Dungeon,
 }
 
 /// Why a scene could not be built.
@@ -65,16 +74,17 @@ impl Scene {
                 Scene::Sinusoid { angle: *angle, frequency: *frequency }
             }
             ("sponza", []) => Scene::Sponza,
+            ("dungeon", []) => Scene::Dungeon,
             _ => return None,
         })
     }
 
     /// The names [`Scene::parse`] accepts.
-    pub const NAMES: [&str; 5] = ["demo", "gradient", "steps", "sinusoid", "sponza"];
+    pub const NAMES: [&str; 6] = ["demo", "gradient", "steps", "sinusoid", "sponza", "dungeon"];
 
     /// Whether the scene is rasterised on the GPU (and so needs [`Scene::render_on`]).
     pub fn needs_gpu(self) -> bool {
-        matches!(self, Scene::Sponza)
+        matches!(self, Scene::Sponza | Scene::Dungeon)
     }
 
     /// The camera the scene is seen from, for scenes that have a free one
@@ -82,6 +92,7 @@ impl Scene {
     pub fn camera(self) -> Option<Camera> {
         match self {
             Scene::Sponza => Some(Scene::sponza_camera()),
+            Scene::Dungeon => Some(Scene::dungeon_camera()),
             _ => None,
         }
     }
@@ -92,11 +103,16 @@ impl Scene {
         Camera { eye: SPONZA_EYE, target: SPONZA_TARGET, up: [0.0, 1.0, 0.0], fov_y_degrees: SPONZA_FOV }
     }
 
-    /// The G-buffer on `gpu`: rasterised for [`Scene::Sponza`], made on the
+    /// The dungeon's default camera (see docs/scenes.md, "Dungeon").
+    pub fn dungeon_camera() -> Camera {
+        Camera { eye: DUNGEON_EYE, target: DUNGEON_TARGET, up: [0.0, 1.0, 0.0], fov_y_degrees: DUNGEON_FOV }
+    }
+
+    /// The G-buffer on `gpu`: rasterised for the mesh scenes, made on the
     /// CPU (as [`Scene::render`]) for the others.
     pub fn render_on(self, gpu: &Gpu, width: u32, height: u32) -> Result<GBuffer, SceneError> {
         match self {
-            Scene::Sponza => Ok(crate::raster::read_gbuffer(gpu, &self.textures_on(gpu, width, height)?)?),
+            Scene::Sponza | Scene::Dungeon => Ok(crate::raster::read_gbuffer(gpu, &self.textures_on(gpu, width, height)?)?),
             _ => Ok(self.render(width, height)),
         }
     }
@@ -108,6 +124,10 @@ impl Scene {
             Scene::Sponza => {
                 let mesh = crate::mesh::sponza_shared()?;
                 Ok(Some(MeshScene::new(gpu, &mesh, Scene::sponza_camera())?))
+            }
+            Scene::Dungeon => {
+                let mesh = crate::mesh::dungeon_shared()?;
+                Ok(Some(MeshScene::new(gpu, &mesh, Scene::dungeon_camera())?))
             }
             _ => Ok(None),
         }
@@ -127,14 +147,14 @@ impl Scene {
     ///
     /// # Panics
     ///
-    /// [`Scene::Sponza`] is rasterised on a GPU: here it makes its own device
-    /// and panics if there is none or the model cannot be loaded. Use
+    /// The mesh scenes are rasterised on a GPU: here they make their own
+    /// device and panic if there is none or the model cannot be loaded. Use
     /// [`Scene::render_on`] to get those failures as errors.
     pub fn render(self, width: u32, height: u32) -> GBuffer {
         match self {
-            Scene::Sponza => {
-                let gpu = Gpu::new().unwrap_or_else(|e| panic!("the Sponza scene needs a GPU adapter: {e}"));
-                self.render_on(&gpu, width, height).unwrap_or_else(|e| panic!("cannot render the Sponza scene: {e}"))
+            Scene::Sponza | Scene::Dungeon => {
+                let gpu = Gpu::new().unwrap_or_else(|e| panic!("the mesh scenes need a GPU adapter: {e}"));
+                self.render_on(&gpu, width, height).unwrap_or_else(|e| panic!("cannot render the {self:?} scene: {e}"))
             }
             Scene::Demo => demo(width, height),
             Scene::Gradient => {
