@@ -86,6 +86,9 @@ pub struct Material {
     pub wrap: [Wrap; 2],
     /// glTF's `MASK` alpha mode: fragments whose alpha is below this are not drawn.
     pub alpha_cutoff: Option<f32>,
+    /// The texture coordinates' v runs up the image (OBJ's convention), so
+    /// textures are sampled at (u, 1 − v); glTF's v runs down (false).
+    pub flip_v: bool,
 }
 
 impl Default for Material {
@@ -102,6 +105,7 @@ impl Default for Material {
             normal_scale: 1.0,
             wrap: [Wrap::Repeat; 2],
             alpha_cutoff: None,
+            flip_v: false,
         }
     }
 }
@@ -120,7 +124,7 @@ impl Material {
         mut texture: impl FnMut(&str, &str) -> Option<Arc<TextureImage>>,
     ) -> (Material, Vec<String>) {
         let mut unsupported = vec![];
-        let mut out = Material::default();
+        let mut out = Material { flip_v: true, ..Material::default() };
         if let Some(kd) = m.diffuse {
             out.base_color = [kd[0], kd[1], kd[2], 1.0];
         }

@@ -200,6 +200,7 @@ impl Mesh {
         // with exactly these names is put in front of the file.
         let mut names: Vec<String> = vec![];
         let mut libraries: Vec<String> = vec![];
+        let mut degenerate = 0usize;
         for line in text.lines() {
             let line = line.map_err(|e| obj_error(e.to_string()))?;
             if let Some(rest) = line.trim_start().strip_prefix("usemtl") {
@@ -211,6 +212,12 @@ impl Mesh {
                 && rest.starts_with(char::is_whitespace)
             {
                 libraries.push(rest.trim().to_string());
+            } else if let Some(rest) = line.trim_start().strip_prefix("f ")
+                && rest.split_whitespace().count() < 3
+            {
+                // tobj reads a face of one or two corners as a point or a
+                // line and drops it unseen; counted here.
+                degenerate += 1;
             }
         }
         const SYNTHETIC: &str = "<mrsl usemtl names>";
@@ -239,7 +246,6 @@ impl Mesh {
         let mut material_names = names.clone();
         let mut default_material: Option<u32> = None;
         let mut pieces: Vec<(Mesh, bool)> = vec![];
-        let mut degenerate = 0usize;
         for model in &models {
             let m = &model.mesh;
             let corners = m.indices.len();
@@ -582,6 +588,10 @@ impl Mesh {
         let mapped: Vec<bool> = (0..self.material_names.len().max(self.material_params.len()))
             .map(|id| self.material_params.get(id).is_some_and(Material::has_normal_map))
             .collect();
+        // MikkTSpace is given texture coordinates whose second axis runs up
+        // the image (OpenGL's convention, which glTF's normal maps follow:
+        // +Y is up), so the bitangent points up the texture.
+        let flip: Vec<bool> = self.material_params.iter().map(|m| m.flip_v).collect();
         let needs = |mesh: &Mesh, t: &[u32]| {
             let id = mesh.materials[t[0] as usize] as usize;
             mapped.get(id).copied().unwrap_or(false)
@@ -598,6 +608,7 @@ impl Mesh {
         struct Geometry<'a> {
             mesh: &'a Mesh,
             faces: &'a [usize],
+            flip: &'a [bool],
             out: Vec<[f32; 4]>,
         }
         impl bevy_mikktspace::Geometry for Geometry<'_> {
@@ -614,13 +625,16 @@ impl Mesh {
                 self.mesh.normals[self.mesh.indices[3 * self.faces[face] + vert] as usize]
             }
             fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
-                self.mesh.uvs[self.mesh.indices[3 * self.faces[face] + vert] as usize]
+                let i = self.mesh.indices[3 * self.faces[face] + vert] as usize;
+                let [u, v] = self.mesh.uvs[i];
+                // v already runs up for OBJ materials; glTF's runs down.
+                if self.flip.get(self.mesh.materials[i] as usize).copied().unwrap_or(false) { [u, v] } else { [u, 1.0 - v] }
             }
             fn set_tangent(&mut self, tangent: Option<bevy_mikktspace::TangentSpace>, face: usize, vert: usize) {
                 self.out[3 * face + vert] = tangent.map(|t| t.tangent_encoded()).unwrap_or([0.0; 4]);
             }
         }
-        let mut geometry = Geometry { mesh: self, faces: &faces, out: vec![[0.0; 4]; 3 * faces.len()] };
+        let mut geometry = Geometry { mesh: self, faces: &faces, flip: &flip, out: vec![[0.0; 4]; 3 * faces.len()] };
         if let Err(e) = bevy_mikktspace::generate_tangents::<_, bevy_mikktspace::StdOps>(&mut geometry) {
             self.warnings.push(MeshWarning::Tangents {
                 message: format!("MikkTSpace failed on {} normal-mapped triangles: {e}", faces.len()),

@@ -180,7 +180,7 @@ struct MaterialUniform {
     base_color: [f32; 4],
     /// x: roughness, y: metallic, z: normal scale, w: alpha cutoff (negative: none).
     params: [f32; 4],
-    /// x: 1 where a normal map applies.
+    /// x: 1 where a normal map applies; y: 1 to sample at (u, 1 − v).
     flags: [u32; 4],
 }
 
@@ -215,7 +215,7 @@ struct Material {
     base_color: vec4<f32>,
     // x: roughness, y: metallic, z: normal scale, w: alpha cutoff (negative: none)
     params: vec4<f32>,
-    // x: 1 where the normal map applies
+    // x: 1 where the normal map applies; y: 1 to sample at (u, 1 - v) (OBJ)
     flags: vec4<u32>,
 };
 @group(1) @binding(0) var<uniform> material: Material;
@@ -268,8 +268,12 @@ fn vs_mesh(@location(0) p: vec3<f32>, @location(1) n: vec3<f32>, @location(2) uv
 // Every pass samples the base colour first (in uniform control flow, so
 // that the quad's uv derivatives pick the mip level) and discards the same
 // masked fragments.
+fn texture_uv(v: VsOut) -> vec2<f32> {
+    return select(v.uv, vec2<f32>(v.uv.x, 1.0 - v.uv.y), material.flags.y != 0u);
+}
+
 fn base_color(v: VsOut) -> vec4<f32> {
-    return material.base_color * v.color * textureSample(base_color_map, material_sampler, v.uv);
+    return material.base_color * v.color * textureSample(base_color_map, material_sampler, texture_uv(v));
 }
 
 fn alpha_test(alpha: f32) {
@@ -281,7 +285,7 @@ fn alpha_test(alpha: f32) {
 @fragment
 fn fs_mesh1(v: VsOut, @builtin(front_facing) front: bool) -> Pass1 {
     let albedo = base_color(v);
-    let mapped = textureSample(normal_map, material_sampler, v.uv).xyz * 2.0 - 1.0;
+    let mapped = textureSample(normal_map, material_sampler, texture_uv(v)).xyz * 2.0 - 1.0;
     alpha_test(albedo.a);
     var n = v.normal;
     if (dot(n, n) > 0.0) {
@@ -314,7 +318,7 @@ fn fs_mesh2(v: VsOut) -> Pass2 {
 @fragment
 fn fs_mesh3(v: VsOut) -> Pass3 {
     let albedo = base_color(v);
-    let mr = textureSample(metallic_roughness_map, material_sampler, v.uv);
+    let mr = textureSample(metallic_roughness_map, material_sampler, texture_uv(v));
     alpha_test(albedo.a);
     return Pass3(albedo, clamp(material.params.x * mr.g, 0.0, 1.0), clamp(material.params.y * mr.b, 0.0, 1.0));
 }
@@ -598,7 +602,7 @@ impl Rasterizer {
         let uniform = MaterialUniform {
             base_color: material.base_color,
             params: [material.roughness, material.metallic, material.normal_scale, material.alpha_cutoff.unwrap_or(-1.0)],
-            flags: [u32::from(material.has_normal_map()), 0, 0, 0],
+            flags: [u32::from(material.has_normal_map()), u32::from(material.flip_v), 0, 0],
         };
         let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("mrsl raster material"),

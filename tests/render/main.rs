@@ -12,6 +12,7 @@ mod harness;
 mod errors;
 mod modes;
 mod sponza;
+mod textures;
 
 pub use harness::*;
 use libtest_mimic::{Arguments, Trial};
@@ -58,6 +59,14 @@ const GPU_TESTS: &[GpuTest] = &[
     ("sponza::rasterised_quads_match_the_analytic_gbuffer", sponza::rasterised_quads_match_the_analytic_gbuffer),
     ("sponza::sponza_lights_workload_matches_its_reference", sponza::sponza_lights_workload_matches_its_reference),
     ("sponza::scene_files_parse_and_name_their_mistakes", sponza::scene_files_parse_and_name_their_mistakes),
+    ("textures::textured_quads_show_their_texels", textures::textured_quads_show_their_texels),
+    ("textures::minified_textures_average_linear_light", textures::minified_textures_average_linear_light),
+    ("textures::material_maps_reach_the_gbuffer", textures::material_maps_reach_the_gbuffer),
+    ("textures::missing_material_channels_are_typed_errors", textures::missing_material_channels_are_typed_errors),
+    (
+        "textures::pbr_example_renders_textured_content_in_every_mode",
+        textures::pbr_example_renders_textured_content_in_every_mode,
+    ),
 ];
 
 /// Tests that run on the CPU only.
@@ -67,6 +76,7 @@ const CPU_TESTS: &[(&str, fn())] = &[
     ("sponza::obj_written_to_a_temp_dir_loads", sponza::obj_written_to_a_temp_dir_loads),
     ("sponza::gltf_and_glb_written_to_a_temp_dir_load", sponza::gltf_and_glb_written_to_a_temp_dir_load),
     ("sponza::bad_mesh_files_are_typed_errors", sponza::bad_mesh_files_are_typed_errors),
+    ("textures::loaders_report_what_they_skip", textures::loaders_report_what_they_skip),
 ];
 
 fn main() {
