@@ -128,7 +128,8 @@ impl Material {
         if let Some(kd) = m.diffuse {
             out.base_color = [kd[0], kd[1], kd[2], 1.0];
         }
-        let number = |key: &str| m.unknown_param.get(key).and_then(|v| v.split_whitespace().next()?.parse::<f32>().ok());
+        let number =
+            |key: &str| m.unknown_param.get(key).and_then(|v| v.split_whitespace().next()?.parse::<f32>().ok());
         if let Some(d) = m.dissolve {
             out.base_color[3] = d.clamp(0.0, 1.0);
         } else if let Some(tr) = number("Tr") {
@@ -209,13 +210,13 @@ pub fn linear_to_srgb(v: f32) -> u8 {
 /// side is folded into its neighbour's average). RGBA bytes per level.
 pub fn mip_chain(image: &TextureImage, encoding: TexelEncoding) -> Vec<(u32, u32, Vec<u8>)> {
     let decode: Box<dyn Fn(&[u8]) -> [f32; 4]> = match encoding {
-        TexelEncoding::Srgb => Box::new(|t: &[u8]| {
-            [srgb_to_linear(t[0]), srgb_to_linear(t[1]), srgb_to_linear(t[2]), t[3] as f32 / 255.0]
-        }),
-        TexelEncoding::Linear => Box::new(|t: &[u8]| std::array::from_fn(|c| t[c] as f32 / 255.0)),
-        TexelEncoding::Normal => {
-            Box::new(|t: &[u8]| std::array::from_fn(|c| if c < 3 { t[c] as f32 / 255.0 * 2.0 - 1.0 } else { t[c] as f32 / 255.0 }))
+        TexelEncoding::Srgb => {
+            Box::new(|t: &[u8]| [srgb_to_linear(t[0]), srgb_to_linear(t[1]), srgb_to_linear(t[2]), t[3] as f32 / 255.0])
         }
+        TexelEncoding::Linear => Box::new(|t: &[u8]| std::array::from_fn(|c| t[c] as f32 / 255.0)),
+        TexelEncoding::Normal => Box::new(|t: &[u8]| {
+            std::array::from_fn(|c| if c < 3 { t[c] as f32 / 255.0 * 2.0 - 1.0 } else { t[c] as f32 / 255.0 })
+        }),
     };
     let encode = |v: [f32; 4]| -> [u8; 4] {
         let unorm = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
@@ -308,7 +309,12 @@ mod tests {
     #[test]
     fn odd_sides_keep_every_texel_and_normals_stay_unit() {
         // 3x1: one level of 1x1 averaging all three texels.
-        let image = TextureImage { width: 3, height: 1, rgba: vec![0, 0, 0, 0, 30, 0, 0, 0, 60, 0, 0, 0], source: "row".into() };
+        let image = TextureImage {
+            width: 3,
+            height: 1,
+            rgba: vec![0, 0, 0, 0, 30, 0, 0, 0, 60, 0, 0, 0],
+            source: "row".into(),
+        };
         let chain = mip_chain(&image, TexelEncoding::Linear);
         assert_eq!(chain.len(), 2);
         assert_eq!(chain[1].2, vec![30, 0, 0, 0]);
@@ -327,7 +333,12 @@ mod tests {
 
     #[test]
     fn mtl_statements_map_onto_the_pbr_model() {
-        let mut m = tobj::Material { name: "m".into(), diffuse: Some([0.5, 0.25, 1.0]), shininess: Some(98.0), ..Default::default() };
+        let mut m = tobj::Material {
+            name: "m".into(),
+            diffuse: Some([0.5, 0.25, 1.0]),
+            shininess: Some(98.0),
+            ..Default::default()
+        };
         m.diffuse_texture = Some("-s 1 1 1 tex/albedo.png".into());
         m.unknown_param.insert("Pm".into(), "1".into());
         m.unknown_param.insert("norm".into(), "n.png".into());

@@ -150,7 +150,10 @@ impl std::fmt::Display for MeshWarning {
                 if *count == 1 { "" } else { "s" }
             ),
             MeshWarning::Texture { material, texture, message } => {
-                write!(f, "material `{material}`: texture {texture} not loaded ({message}); its constant factor is used")
+                write!(
+                    f,
+                    "material `{material}`: texture {texture} not loaded ({message}); its constant factor is used"
+                )
             }
             MeshWarning::MaterialLibrary { path, message } => {
                 write!(f, "material library {} not read ({message}); its materials get the default", path.display())
@@ -628,7 +631,11 @@ impl Mesh {
                 let i = self.mesh.indices[3 * self.faces[face] + vert] as usize;
                 let [u, v] = self.mesh.uvs[i];
                 // v already runs up for OBJ materials; glTF's runs down.
-                if self.flip.get(self.mesh.materials[i] as usize).copied().unwrap_or(false) { [u, v] } else { [u, 1.0 - v] }
+                if self.flip.get(self.mesh.materials[i] as usize).copied().unwrap_or(false) {
+                    [u, v]
+                } else {
+                    [u, 1.0 - v]
+                }
             }
             fn set_tangent(&mut self, tangent: Option<bevy_mikktspace::TangentSpace>, face: usize, vert: usize) {
                 self.out[3 * face + vert] = tangent.map(|t| t.tangent_encoded()).unwrap_or([0.0; 4]);
@@ -819,8 +826,9 @@ fn read_mtl_materials(mesh: &mut Mesh, dir: &Path, libraries: &[String]) {
                 .clone()
         });
         mesh.warnings.extend(warnings);
-        mesh.warnings
-            .extend(unsupported.into_iter().map(|feature| MeshWarning::Unsupported { material: name.clone(), feature }));
+        mesh.warnings.extend(
+            unsupported.into_iter().map(|feature| MeshWarning::Unsupported { material: name.clone(), feature }),
+        );
         mesh.material_params.push(material);
     }
 }
@@ -834,7 +842,8 @@ fn gltf_material(
     images: &mut HashMap<usize, Option<Arc<TextureImage>>>,
     warnings: &mut Vec<MeshWarning>,
 ) -> Material {
-    let name = material.name().map(str::to_string).unwrap_or_else(|| format!("material{}", material.index().unwrap_or(0)));
+    let name =
+        material.name().map(str::to_string).unwrap_or_else(|| format!("material{}", material.index().unwrap_or(0)));
     let pbr = material.pbr_metallic_roughness();
     let mut out = Material {
         base_color: pbr.base_color_factor(),
@@ -887,7 +896,8 @@ fn gltf_material(
         out.base_color_texture = texture("baseColorTexture", info.texture(), info.tex_coord(), &mut out);
     }
     if let Some(info) = pbr.metallic_roughness_texture() {
-        out.metallic_roughness_texture = texture("metallicRoughnessTexture", info.texture(), info.tex_coord(), &mut out);
+        out.metallic_roughness_texture =
+            texture("metallicRoughnessTexture", info.texture(), info.tex_coord(), &mut out);
     }
     if let Some(info) = material.normal_texture() {
         out.normal_scale = info.scale();
@@ -901,7 +911,8 @@ fn gltf_image(image: &gltf::Image, path: &Path, buffers: &[Vec<u8>]) -> Result<T
     match image.source() {
         gltf::image::Source::View { view, .. } => {
             let data = buffers.get(view.buffer().index()).ok_or("its buffer is missing")?;
-            let bytes = data.get(view.offset()..view.offset() + view.length()).ok_or("its buffer view is out of range")?;
+            let bytes =
+                data.get(view.offset()..view.offset() + view.length()).ok_or("its buffer view is out of range")?;
             TextureImage::decode(bytes, &format!("image {}", image.index()))
         }
         gltf::image::Source::Uri { uri, .. } => {

@@ -459,7 +459,9 @@ impl Rasterizer {
         let targets = |pass: usize| -> Vec<Option<wgpu::ColorTargetState>> {
             CHANNELS[PASSES[pass].clone()]
                 .iter()
-                .map(|&(_, format)| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }))
+                .map(|&(_, format)| {
+                    Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
+                })
                 .collect()
         };
         let pipeline = |label: &str,
@@ -601,7 +603,12 @@ impl Rasterizer {
     ) -> Result<wgpu::BindGroup, RasterError> {
         let uniform = MaterialUniform {
             base_color: material.base_color,
-            params: [material.roughness, material.metallic, material.normal_scale, material.alpha_cutoff.unwrap_or(-1.0)],
+            params: [
+                material.roughness,
+                material.metallic,
+                material.normal_scale,
+                material.alpha_cutoff.unwrap_or(-1.0),
+            ],
             flags: [u32::from(material.has_normal_map()), u32::from(material.flip_v), 0, 0],
         };
         let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -609,12 +616,11 @@ impl Rasterizer {
             contents: bytemuck::bytes_of(&uniform),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let mut view = |image: &Option<std::sync::Arc<TextureImage>>, encoding, fallback: &wgpu::TextureView| {
-            match image {
+        let mut view =
+            |image: &Option<std::sync::Arc<TextureImage>>, encoding, fallback: &wgpu::TextureView| match image {
                 Some(image) => cache.view(gpu, image, encoding).cloned(),
                 None => Ok(fallback.clone()),
-            }
-        };
+            };
         let base = view(&material.base_color_texture, TexelEncoding::Srgb, &self.white_srgb)?;
         let mr = view(&material.metallic_roughness_texture, TexelEncoding::Linear, &self.white_linear)?;
         let normal = view(&material.normal_texture, TexelEncoding::Normal, &self.flat_normal)?;

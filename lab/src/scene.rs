@@ -112,7 +112,9 @@ impl Scene {
     /// CPU (as [`Scene::render`]) for the others.
     pub fn render_on(self, gpu: &Gpu, width: u32, height: u32) -> Result<GBuffer, SceneError> {
         match self {
-            Scene::Sponza | Scene::Dungeon => Ok(crate::raster::read_gbuffer(gpu, &self.textures_on(gpu, width, height)?)?),
+            Scene::Sponza | Scene::Dungeon => {
+                Ok(crate::raster::read_gbuffer(gpu, &self.textures_on(gpu, width, height)?)?)
+            }
             _ => Ok(self.render(width, height)),
         }
     }
@@ -271,7 +273,15 @@ impl Builder {
             metallic: Vec::with_capacity(n),
         }
     }
-    fn push(&mut self, position: [f32; 3], normal: [f32; 3], uv: [f32; 2], material: u32, depth: f32, surface: Surface) {
+    fn push(
+        &mut self,
+        position: [f32; 3],
+        normal: [f32; 3],
+        uv: [f32; 2],
+        material: u32,
+        depth: f32,
+        surface: Surface,
+    ) {
         self.position.extend(position);
         self.normal.extend(normal);
         self.uv.extend(uv);

@@ -191,7 +191,12 @@ fn png_of(rgba: &[u8]) -> Vec<u8> {
 
 /// The quad as OBJ + MTL + PNG in `dir` (OBJ's v runs up the image, so the
 /// image's top row is again at the quad's top); returns the OBJ's path.
-fn obj_quad(dir: &std::path::Path, kd: [f32; 3], texture: Option<&str>, normal_map: Option<&str>) -> std::path::PathBuf {
+fn obj_quad(
+    dir: &std::path::Path,
+    kd: [f32; 3],
+    texture: Option<&str>,
+    normal_map: Option<&str>,
+) -> std::path::PathBuf {
     let mut mtl = format!("newmtl painted\nKd {} {} {}\nNs 98\n", kd[0], kd[1], kd[2]);
     if let Some(t) = texture {
         mtl += &format!("map_Kd -s 1 1 1 {t}\n");
@@ -233,9 +238,7 @@ fn bilinear(rgba: &[u8], n: u32, uv: [f32; 2]) -> [f32; 4] {
         [srgb_to_linear(p[0]), srgb_to_linear(p[1]), srgb_to_linear(p[2]), p[3] as f32 / 255.0]
     };
     let (a, b, c, d) = (texel(i, j), texel(i + 1.0, j), texel(i, j + 1.0), texel(i + 1.0, j + 1.0));
-    std::array::from_fn(|k| {
-        (a[k] * (1.0 - fs) + b[k] * fs) * (1.0 - ft) + (c[k] * (1.0 - fs) + d[k] * fs) * ft
-    })
+    std::array::from_fn(|k| (a[k] * (1.0 - fs) + b[k] * fs) * (1.0 - ft) + (c[k] * (1.0 - fs) + d[k] * fs) * ft)
 }
 
 /// Compares the `albedo` channel of `g` with `factor` times the bilinearly
@@ -329,7 +332,8 @@ pub fn minified_textures_average_linear_light(gpu: &Gpu) {
         for x in 0..SIZE.0 {
             // Pixels whose whole quad of neighbours is on the quad (the
             // level of detail comes from 2x2 pixel quads).
-            let inside = |dx: i32, dy: i32| quad_uv((x as i32 + dx).max(0) as u32, (y as i32 + dy).max(0) as u32).is_some();
+            let inside =
+                |dx: i32, dy: i32| quad_uv((x as i32 + dx).max(0) as u32, (y as i32 + dy).max(0) as u32).is_some();
             if !(inside(-1, -1) && inside(1, 1) && inside(-1, 1) && inside(1, -1)) {
                 continue;
             }
