@@ -209,14 +209,16 @@ pub fn linear_to_srgb(v: f32) -> u8 {
 /// one texel, where a side is already 1; the last row or column of an odd
 /// side is folded into its neighbour's average). RGBA bytes per level.
 pub fn mip_chain(image: &TextureImage, encoding: TexelEncoding) -> Vec<(u32, u32, Vec<u8>)> {
-    let decode: Box<dyn Fn(&[u8]) -> [f32; 4]> = match encoding {
-        TexelEncoding::Srgb => {
-            Box::new(|t: &[u8]| [srgb_to_linear(t[0]), srgb_to_linear(t[1]), srgb_to_linear(t[2]), t[3] as f32 / 255.0])
+    let decode = |t: &[u8]| -> [f32; 4] {
+        match encoding {
+            TexelEncoding::Srgb => {
+                [srgb_to_linear(t[0]), srgb_to_linear(t[1]), srgb_to_linear(t[2]), t[3] as f32 / 255.0]
+            }
+            TexelEncoding::Linear => std::array::from_fn(|c| t[c] as f32 / 255.0),
+            TexelEncoding::Normal => {
+                std::array::from_fn(|c| if c < 3 { t[c] as f32 / 255.0 * 2.0 - 1.0 } else { t[c] as f32 / 255.0 })
+            }
         }
-        TexelEncoding::Linear => Box::new(|t: &[u8]| std::array::from_fn(|c| t[c] as f32 / 255.0)),
-        TexelEncoding::Normal => Box::new(|t: &[u8]| {
-            std::array::from_fn(|c| if c < 3 { t[c] as f32 / 255.0 * 2.0 - 1.0 } else { t[c] as f32 / 255.0 })
-        }),
     };
     let encode = |v: [f32; 4]| -> [u8; 4] {
         let unorm = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
@@ -231,7 +233,7 @@ pub fn mip_chain(image: &TextureImage, encoding: TexelEncoding) -> Vec<(u32, u32
         }
     };
     let (mut w, mut h) = (image.width, image.height);
-    let mut level: Vec<[f32; 4]> = image.rgba.chunks_exact(4).map(|t| decode(t)).collect();
+    let mut level: Vec<[f32; 4]> = image.rgba.chunks_exact(4).map(decode).collect();
     let mut out = vec![(w, h, image.rgba.clone())];
     while w > 1 || h > 1 {
         let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
@@ -294,7 +296,7 @@ mod tests {
         let n = 8u32;
         let rgba: Vec<u8> = (0..n * n)
             .flat_map(|i| {
-                let v = if (i % n + i / n) % 2 == 0 { 255 } else { 0 };
+                let v = if (i % n + i / n).is_multiple_of(2) { 255 } else { 0 };
                 [v, v, v, 255]
             })
             .collect();

@@ -773,7 +773,11 @@ impl TextureCache {
         encoding: TexelEncoding,
     ) -> Result<&wgpu::TextureView, RasterError> {
         let key = (std::sync::Arc::as_ptr(image) as usize, encoding);
-        if !self.views.contains_key(&key) {
+        let entry = match self.views.entry(key) {
+            std::collections::hash_map::Entry::Occupied(e) => return Ok(e.into_mut()),
+            std::collections::hash_map::Entry::Vacant(e) => e,
+        };
+        {
             let limit = gpu.device.limits().max_texture_dimension_2d;
             if image.width > limit || image.height > limit {
                 return Err(RasterError::TextureTooLarge {
@@ -811,9 +815,8 @@ impl TextureCache {
                     wgpu::Extent3d { width: *w, height: *h, depth_or_array_layers: 1 },
                 );
             }
-            self.views.insert(key, texture.create_view(&Default::default()));
+            Ok(entry.insert(texture.create_view(&Default::default())))
         }
-        Ok(&self.views[&key])
     }
 
     fn sampler(&mut self, gpu: &Gpu, wrap: [Wrap; 2]) -> wgpu::Sampler {

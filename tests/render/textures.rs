@@ -150,7 +150,7 @@ impl Quad {
         let mut bin = self.geometry();
         let mut views = String::new();
         for (k, &texels) in self.images().iter().enumerate() {
-            while bin.len() % 4 != 0 {
+            while !bin.len().is_multiple_of(4) {
                 bin.push(0);
             }
             let png = png_of(texels);
@@ -158,14 +158,14 @@ impl Quad {
             bin.extend(png);
             let _ = k;
         }
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         let mut json = self
             .json(None, |k| format!(r#"{{ "bufferView": {}, "mimeType": "image/png" }}"#, 4 + k), &views)
             .replace("BUFFER_LENGTH", &bin.len().to_string())
             .into_bytes();
-        while json.len() % 4 != 0 {
+        while !json.len().is_multiple_of(4) {
             json.push(b' ');
         }
         let total = 12 + 8 + json.len() + 8 + bin.len();
@@ -313,7 +313,7 @@ pub fn minified_textures_average_linear_light(gpu: &Gpu) {
     let n = 8u32;
     let rgba: Vec<u8> = (0..n * n)
         .flat_map(|i| {
-            let v = if (i % n + i / n) % 2 == 0 { 255 } else { 0 };
+            let v = if (i % n + i / n).is_multiple_of(2) { 255 } else { 0 };
             [v, v, v, 255]
         })
         .collect();
@@ -455,6 +455,9 @@ pub fn missing_material_channels_are_typed_errors(gpu: &Gpu) {
     );
 }
 
+/// A map of points or directions.
+type Map = dyn Fn([f32; 3]) -> [f32; 3];
+
 /// A small textured scene written here: a floor and a box (glTF) with a
 /// base colour texture, a metallic-roughness texture and a normal map.
 fn textured_scene(dir: &std::path::Path) -> Mesh {
@@ -477,7 +480,7 @@ fn textured_scene(dir: &std::path::Path) -> Mesh {
     std::fs::write(dir.join("tile.gltf"), quad.gltf()).unwrap();
     let tile = Mesh::load(dir.join("tile.gltf")).unwrap();
     // The floor: the tile scaled to 8 x 8 on y = 0; the box: five tiles.
-    let place = |m: &Mesh, f: &dyn Fn([f32; 3]) -> [f32; 3], g: &dyn Fn([f32; 3]) -> [f32; 3]| {
+    let place = |m: &Mesh, f: &Map, g: &Map| {
         let mut out = m.clone();
         out.positions.iter_mut().for_each(|p| *p = f(*p));
         out.normals.iter_mut().for_each(|v| *v = g(*v));
@@ -488,7 +491,7 @@ fn textured_scene(dir: &std::path::Path) -> Mesh {
         out
     };
     let mut scene = place(&tile, &|p| [4.0 * p[0], 0.0, -4.0 * p[1]], &|v| [v[0], v[2], -v[1]]);
-    let sides: [(&dyn Fn([f32; 3]) -> [f32; 3], &dyn Fn([f32; 3]) -> [f32; 3]); 5] = [
+    let sides: [(&Map, &Map); 5] = [
         (&|p| [p[0], 1.0 + p[1], 1.0], &|v| v),
         (&|p| [p[0], 1.0 + p[1], -1.0], &|v| [-v[0], v[1], -v[2]]),
         (&|p| [1.0, 1.0 + p[1], -p[0]], &|v| [v[2], v[1], -v[0]]),
