@@ -79,9 +79,18 @@ const CPU_TESTS: &[(&str, fn())] = &[
     ("textures::loaders_report_what_they_skip", textures::loaders_report_what_they_skip),
 ];
 
+/// GPU tests over the textured dungeon, which is fetched separately
+/// (scripts/fetch-dungeon.sh): listed as ignored, after a line saying why,
+/// where it is not there.
+const DUNGEON_TESTS: &[GpuTest] = &[("textures::pbr_example_over_the_dungeon", textures::pbr_example_over_the_dungeon)];
+
 fn main() {
     let args = Arguments::from_args();
-    let gpu = harness::gpu(GPU_TESTS.len());
+    let gpu = harness::gpu(GPU_TESTS.len() + DUNGEON_TESTS.len());
+    let dungeon = mrsl_lab::mesh::dungeon_path();
+    if let (Some(_), Err(e)) = (gpu, &dungeon) {
+        println!("SKIPPING {} render test(s) over the dungeon (reported as ignored below): {e}", DUNGEON_TESTS.len());
+    }
     let mut trials: Vec<Trial> = GPU_TESTS
         .iter()
         .map(|&(name, test)| match gpu {
@@ -92,6 +101,13 @@ fn main() {
             None => Trial::test(name, || Ok(())).with_ignored_flag(true),
         })
         .collect();
+    trials.extend(DUNGEON_TESTS.iter().map(|&(name, test)| match (gpu, &dungeon) {
+        (Some(gpu), Ok(_)) => Trial::test(name, move || {
+            test(gpu);
+            Ok(())
+        }),
+        _ => Trial::test(name, || Ok(())).with_ignored_flag(true),
+    }));
     trials.extend(CPU_TESTS.iter().map(|&(name, test)| {
         Trial::test(name, move || {
             test();

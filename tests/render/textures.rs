@@ -569,3 +569,54 @@ pub fn pbr_example_renders_textured_content_in_every_mode(gpu: &Gpu) {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// examples/pbr_deferred.mrsl over the textured real scene (the dungeon,
+/// fetched by scripts/fetch-dungeon.sh; the harness lists this test as
+/// ignored, saying so, when it is not there) at 192x108 from the scene's
+/// camera, with its rig and shadow map: the G-buffer carries the level's
+/// textures, every mode with every predicate forced is bit for bit the
+/// reference, and the adaptive modes' PSNR against it is reported.
+pub fn pbr_example_over_the_dungeon(gpu: &Gpu) {
+    let size = (192, 108);
+    let mut scene = Scene::Dungeon.mesh_scene(gpu).unwrap().expect("the dungeon is a mesh scene");
+    let camera = scene.camera;
+    let channels = scene.gbuffer(gpu, &camera, size).unwrap();
+    let shadow_map = scene.shadow_map(gpu).unwrap().clone();
+    let shadow_view = shadow_map.create_view(&Default::default());
+    let g = raster::read_gbuffer(gpu, &channels).unwrap();
+    let (albedo, _) = floats(&g, "albedo");
+    let mut distinct: Vec<u32> = albedo.chunks_exact(4).map(|p| p[1].to_bits()).collect();
+    distinct.sort_unstable();
+    distinct.dedup();
+    assert!(distinct.len() > 1000, "only {} distinct albedo values: textures missing?", distinct.len());
+    let program = compile(include_str!("../../examples/pbr_deferred.mrsl"));
+    let run = |mode: Mode, force_refine: bool| {
+        let mut shader = Shader::new(&gpu.device, &program).unwrap();
+        scene.set_uniforms(&mut shader, &camera).unwrap();
+        let color = gpu.output_texture("color", size, wgpu::TextureFormat::Rgba32Float);
+        let mut bindings = Bindings { size, ..Default::default() };
+        for (name, texture) in &channels {
+            bindings.channels.insert(name.clone(), texture);
+        }
+        bindings.textures.insert("shadow_map".into(), &shadow_view);
+        bindings.outputs.insert("color".into(), &color);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let options = DispatchOptions { force_refine, ..DispatchOptions::new(mode) };
+        shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options).unwrap();
+        gpu.queue.submit([encoder.finish()]);
+        let stats = shader.read_stats(&gpu.device).unwrap();
+        Output { pixels: gpu.read_rgba32f(&color).unwrap(), stats, width: size.0 }
+    };
+    let reference = run(Mode::Reference, false);
+    assert!(reference.pixels.iter().all(|p| p.iter().all(|v| v.is_finite())));
+    for mode in Mode::ALL.into_iter().filter(|m| *m != Mode::Reference) {
+        let forced = run(mode, true);
+        assert!(forced.pixels == reference.pixels, "{mode}: forced refinement differs from the reference");
+        let adaptive = run(mode, false);
+        let m = mrsl_lab::metrics::compare(&adaptive.pixels, &reference.pixels, size.0, size.1).unwrap();
+        eprintln!(
+            "dungeon {}x{} {mode}: PSNR {:.2} dB, shaded fraction {:.3}",
+            size.0, size.1, m.psnr, adaptive.stats.shaded_fraction
+        );
+    }
+}
