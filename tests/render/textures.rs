@@ -508,7 +508,7 @@ fn textured_scene(dir: &std::path::Path) -> Mesh {
 /// metallic-roughness and normal maps) with its light rig and the sun's
 /// shadow map: every mode with every refine predicate forced is bit for bit
 /// the reference, the image is lit and finite, and the adaptive modes shade
-/// less than every pixel.
+/// less than every pixel and stay close to the reference.
 pub fn pbr_example_renders_textured_content_in_every_mode(gpu: &Gpu) {
     let dir = temp_dir("pbr");
     let mesh = textured_scene(&dir);
@@ -564,7 +564,18 @@ pub fn pbr_example_renders_textured_content_in_every_mode(gpu: &Gpu) {
         assert_eq!(worst, 0, "{mode}: forced refinement differs from the reference by up to {worst} ulps");
         let adaptive = run(mode, false);
         assert!(adaptive.pixels.iter().all(|p| p.iter().all(|v| v.is_finite())), "{mode}");
-        eprintln!("pbr {mode}: shaded fraction {:.3}", adaptive.stats.shaded_fraction);
+        let m = mrsl_lab::metrics::compare(&adaptive.pixels, &reference.pixels, size.0, size.1).unwrap();
+        eprintln!("pbr {mode}: PSNR {:.2} dB, shaded fraction {:.3}", m.psnr, adaptive.stats.shaded_fraction);
+        // Measured on lavapipe (Mesa 22.3) at 128x96: coarse2x2 116.0 dB,
+        // coarse4x4 175.6 dB, dynamic 116.0 dB, hierarchical 67.7 dB (the
+        // glossy, normal-mapped tiles refine almost every block), and the
+        // checkerboard baseline, which has no refine predicates, 10.9 dB:
+        // it interpolates the per-pixel glints of the bumpy glossy tiles.
+        // The bar, 50 dB, leaves room for another driver's rounding to flip
+        // a few refine decisions, each of which costs far less than that.
+        if mode != Mode::Checkerboard {
+            assert!(m.psnr >= 50.0, "{mode}: PSNR {:.1} dB", m.psnr);
+        }
         assert!(adaptive.stats.shaded_fraction < 1.0, "{mode}: shaded everything");
     }
     std::fs::remove_dir_all(&dir).unwrap();
@@ -575,7 +586,7 @@ pub fn pbr_example_renders_textured_content_in_every_mode(gpu: &Gpu) {
 /// ignored, saying so, when it is not there) at 192x108 from the scene's
 /// camera, with its rig and shadow map: the G-buffer carries the level's
 /// textures, every mode with every predicate forced is bit for bit the
-/// reference, and the adaptive modes' PSNR against it is reported.
+/// reference, and the adaptive modes stay close to it at a fraction of the cost.
 pub fn pbr_example_over_the_dungeon(gpu: &Gpu) {
     let size = (192, 108);
     let mut scene = Scene::Dungeon.mesh_scene(gpu).unwrap().expect("the dungeon is a mesh scene");
@@ -618,5 +629,11 @@ pub fn pbr_example_over_the_dungeon(gpu: &Gpu) {
             "dungeon {}x{} {mode}: PSNR {:.2} dB, shaded fraction {:.3}",
             size.0, size.1, m.psnr, adaptive.stats.shaded_fraction
         );
+        // Measured on lavapipe (Mesa 22.3): coarse2x2 49.9 dB at shaded
+        // fraction 0.781, coarse4x4 51.6 at 0.672, dynamic 48.5 at 0.828,
+        // hierarchical 57.2 at 0.624, checkerboard 39.2 at 0.636. The bar is
+        // 4 dB below the lowest, for another driver's rounding.
+        assert!(m.psnr >= 35.0, "{mode}: PSNR {:.1} dB", m.psnr);
+        assert!(adaptive.stats.shaded_fraction < 0.9, "{mode}: shaded {}", adaptive.stats.shaded_fraction);
     }
 }
