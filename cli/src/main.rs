@@ -119,7 +119,7 @@ struct Bench {
 struct Render {
     /// The .mrsl program (default: the built-in demo program).
     program: Option<PathBuf>,
-    /// Scene: demo, gradient, steps, sinusoid, sponza, or a .toml scene file (docs/scenes.md).
+    /// Scene: demo, gradient, steps, sinusoid, sponza, dungeon, or a .toml scene file (docs/scenes.md).
     #[arg(long, default_value = "demo")]
     scene: String,
     /// Modes, comma-separated (reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard), or all.

@@ -269,7 +269,16 @@ impl Prepared {
 
 /// `--scene`: a built-in scene's name, or a `.toml` scene file (see
 /// docs/scenes.md). A scene file's `size` applies unless `--size` was given.
+/// What loading a mesh skipped or could not use is printed as warnings.
 pub fn bind_scene(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> Result<BoundScene, String> {
+    let bound = bind_scene_quietly(gpu, scene, size)?;
+    for warning in bound.mesh.iter().flat_map(|m| &m.warnings) {
+        eprintln!("warning: {scene}: {warning}");
+    }
+    Ok(bound)
+}
+
+fn bind_scene_quietly(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> Result<BoundScene, String> {
     if let Some(builtin) = Scene::parse(scene) {
         let size = size.unwrap_or(DEFAULT_SIZE);
         let mesh = builtin.mesh_scene(gpu).map_err(|e| e.to_string())?;

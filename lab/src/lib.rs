@@ -6,6 +6,7 @@
 //! - [`gbuffer`]: G-buffers in CPU memory (a leaf module).
 //! - [`scene`]: the built-in scenes: CPU test patterns and a ray-cast demo,
 //!   and the Dabrovic Sponza rasterised on the GPU.
+//! - [`material`]: surface materials (factors, textures, mipmaps).
 //! - [`mesh`], [`raster`]: OBJ/glTF loading and the G-buffer rasteriser.
 //! - [`rig`], [`mesh_scene`]: the light rig (point lights, a sun with a
 //!   shadow map) and a mesh on the GPU with its camera and rig.
@@ -17,15 +18,16 @@
 //!   that Mesa's Vulkan drivers print no error line.
 //! - [`metrics`]: RMSE, PSNR, MSSIM and FLIP against a reference image.
 //!
-//! Module dependencies run one way: `gbuffer` ← `mesh` ← `raster` ← `rig`
-//! ← `mesh_scene` ← `scene` ← `scene_file`, with `gpu` beneath them all;
-//! `uniforms` (used from `rig` on) and `image_texture` (used by
-//! `scene_file`) depend on no other module but `gpu`, and `runtime_dir` on
-//! none.
+//! Module dependencies run one way: `gbuffer` ← `material` ← `mesh` ←
+//! `raster` ← `rig` ← `mesh_scene` ← `scene` ← `scene_file`, with `gpu`
+//! beneath them all; `uniforms` (used from `rig` on) and `image_texture`
+//! (used by `scene_file`) depend on no other module but `gpu`, and
+//! `runtime_dir` on none.
 
 pub mod gbuffer;
 pub mod gpu;
 pub mod image_texture;
+pub mod material;
 pub mod mesh;
 pub mod mesh_scene;
 pub mod metrics;

@@ -4,16 +4,25 @@
 //! the crates.io package `obj-rs` 0.7.4 ships as a test fixture.
 //!
 //! A [`Mesh`] is indexed and single-indexed: vertex `i` has `positions[i]`,
-//! `normals[i]`, `uvs[i]` and `materials[i]`. Materials are stored **per
+//! `normals[i]`, `uvs[i]` and `materials[i]` (and `tangents[i]` and
+//! `colors[i]` where those are not empty). Materials are stored **per
 //! vertex**, and the loaders never share a vertex between two materials, so
 //! the three vertices of a triangle always carry the same id (the rasteriser
 //! takes a triangle's material from its first vertex). Material ids index
-//! `material_names`.
+//! `material_names` and `material_params` (the factors and textures, see
+//! [`crate::material`]).
+//!
+//! What a loader skips or cannot use is not dropped silently: degenerate
+//! faces (fewer than three corners, or no area), textures that cannot be
+//! read and material features that are not supported become
+//! [`MeshWarning`]s in `Mesh::warnings`, which the tools print once.
 
 use std::collections::HashMap;
 use std::io::{BufRead, Read};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
+
+use crate::material::{Material, TextureImage, Wrap};
 
 /// Default crease angle (degrees) for computed normals: faces meeting at a
 /// sharper angle keep their own normal, so boxes stay boxes while Sponza's
@@ -49,6 +58,12 @@ pub enum MeshError {
         searched.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
     )]
     SponzaNotFound { searched: Vec<PathBuf> },
+    #[error(
+        "the textured dungeon scene (level-dungeon.gltf of Debian's castle-game-engine-doc package) was not found; \
+         run scripts/fetch-dungeon.sh in the workspace, or set MRSL_DUNGEON to the file. Looked at: {}",
+        searched.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+    )]
+    DungeonNotFound { searched: Vec<PathBuf> },
     #[error("invalid mesh: {0}")]
     Invalid(String),
 }
@@ -95,6 +110,60 @@ pub struct Mesh {
     /// Three per triangle, counter-clockwise seen from the front.
     pub indices: Vec<u32>,
     pub material_names: Vec<String>,
+    /// Per vertex, or empty: xyz the unit tangent (the direction of
+    /// increasing u), w the bitangent's sign (bitangent = w · normal ×
+    /// tangent); w = 0 where the vertex has none. Filled for the triangles of
+    /// normal-mapped materials (from the file, else by MikkTSpace).
+    pub tangents: Vec<[f32; 4]>,
+    /// Per vertex, or empty (white): linear RGBA that multiplies the base
+    /// colour (glTF's `COLOR_0`).
+    pub colors: Vec<[f32; 4]>,
+    /// Per material id (missing entries are [`Material::default`]).
+    pub material_params: Vec<Material>,
+    /// What the loader skipped or could not use (see [`MeshWarning`]).
+    pub warnings: Vec<MeshWarning>,
+}
+
+/// Something a loader skipped or could not use; the mesh is still usable.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MeshWarning {
+    /// Faces with fewer than three corners, or triangles without area (two
+    /// corners at the same position, or all three on a line), were left out.
+    DegenerateFaces { count: usize },
+    /// A texture could not be loaded; the material uses its constant factor.
+    Texture { material: String, texture: String, message: String },
+    /// A material library (`mtllib`) could not be read.
+    MaterialLibrary { path: PathBuf, message: String },
+    /// A material feature the kit does not use.
+    Unsupported { material: String, feature: String },
+    /// Tangents could not be generated for a normal-mapped material (its
+    /// normal map is then not applied where they are missing).
+    Tangents { message: String },
+}
+
+impl std::fmt::Display for MeshWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            MeshWarning::DegenerateFaces { count } => write!(
+                f,
+                "{count} degenerate face{} (fewer than three corners, or no area) left out",
+                if *count == 1 { "" } else { "s" }
+            ),
+            MeshWarning::Texture { material, texture, message } => {
+                write!(
+                    f,
+                    "material `{material}`: texture {texture} not loaded ({message}); its constant factor is used"
+                )
+            }
+            MeshWarning::MaterialLibrary { path, message } => {
+                write!(f, "material library {} not read ({message}); its materials get the default", path.display())
+            }
+            MeshWarning::Unsupported { material, feature } => {
+                write!(f, "material `{material}`: {feature} is not supported and is ignored")
+            }
+            MeshWarning::Tangents { message } => write!(f, "tangents: {message}"),
+        }
+    }
 }
 
 impl Mesh {
@@ -133,6 +202,8 @@ impl Mesh {
         // materials it found in an .mtl file, so a synthetic material library
         // with exactly these names is put in front of the file.
         let mut names: Vec<String> = vec![];
+        let mut libraries: Vec<String> = vec![];
+        let mut degenerate = 0usize;
         for line in text.lines() {
             let line = line.map_err(|e| obj_error(e.to_string()))?;
             if let Some(rest) = line.trim_start().strip_prefix("usemtl") {
@@ -140,6 +211,16 @@ impl Mesh {
                 if !name.is_empty() && rest.starts_with(char::is_whitespace) && !names.iter().any(|n| n == name) {
                     names.push(name.to_string());
                 }
+            } else if let Some(rest) = line.trim_start().strip_prefix("mtllib")
+                && rest.starts_with(char::is_whitespace)
+            {
+                libraries.push(rest.trim().to_string());
+            } else if let Some(rest) = line.trim_start().strip_prefix("f ")
+                && rest.split_whitespace().count() < 3
+            {
+                // tobj reads a face of one or two corners as a point or a
+                // line and drops it unseen; counted here.
+                degenerate += 1;
             }
         }
         const SYNTHETIC: &str = "<mrsl usemtl names>";
@@ -226,11 +307,19 @@ impl Mesh {
                 start = end;
                 if polygon.len() >= 3 {
                     triangulate(&piece.positions, polygon, &mut piece.indices);
+                } else {
+                    degenerate += 1;
                 }
             }
+            degenerate += drop_degenerate_triangles(&piece.positions, &mut piece.indices);
             pieces.push((piece, has_normals));
         }
         let mut mesh = Mesh { material_names, ..Default::default() };
+        if degenerate > 0 {
+            mesh.warnings.push(MeshWarning::DegenerateFaces { count: degenerate });
+        }
+        let dir = path.parent().unwrap_or(Path::new("."));
+        read_mtl_materials(&mut mesh, dir, &libraries);
         if pieces.iter().all(|(_, has_normals)| !has_normals) {
             // No normals anywhere: smooth over the whole model, so that
             // surfaces split across objects or materials stay continuous.
@@ -249,6 +338,7 @@ impl Mesh {
         if mesh.indices.is_empty() {
             return Err(MeshError::Empty { path: path.to_path_buf() });
         }
+        mesh.ensure_tangents();
         Ok(mesh)
     }
 
@@ -300,7 +390,19 @@ impl Mesh {
                 .collect(),
             ..Default::default()
         };
+        let mut images: HashMap<usize, Option<Arc<TextureImage>>> = HashMap::new();
+        for material in gltf.materials() {
+            let params = gltf_material(&material, path, &buffers, &mut images, &mut mesh.warnings);
+            mesh.material_params.push(params);
+        }
+        if gltf.extensions_used().any(|e| e == "KHR_texture_transform") {
+            mesh.warnings.push(MeshWarning::Unsupported {
+                material: "(any)".into(),
+                feature: "KHR_texture_transform (texture coordinates are used untransformed)".into(),
+            });
+        }
         let mut default_material: Option<u32> = None;
+        let mut degenerate = 0usize;
         let identity = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
         let mut instances: Vec<(gltf::Mesh, [[f32; 4]; 4])> = vec![];
         match gltf.default_scene().or_else(|| gltf.scenes().next()) {
@@ -345,6 +447,25 @@ impl Mesh {
                     .map(|t| t.into_f32().collect::<Vec<_>>())
                     .filter(|v| v.len() == n)
                     .unwrap_or_else(|| vec![[0.0, 0.0]; n]);
+                let colors: Vec<[f32; 4]> = reader
+                    .read_colors(0)
+                    .map(|c| c.into_rgba_f32().collect::<Vec<_>>())
+                    .filter(|v| v.len() == n)
+                    .unwrap_or_default();
+                // Tangents follow the node transform like directions; a
+                // mirroring transform turns the bitangent's handedness.
+                let tangents: Vec<[f32; 4]> = reader
+                    .read_tangents()
+                    .map(|ts| {
+                        ts.map(|t| {
+                            let d = normalize(transform_vector(world, [t[0], t[1], t[2]]));
+                            let w = if t[3] < 0.0 { -1.0 } else { 1.0 };
+                            [d[0], d[1], d[2], if mirrored { -w } else { w }]
+                        })
+                        .collect::<Vec<_>>()
+                    })
+                    .filter(|v| v.len() == n && normals.is_some())
+                    .unwrap_or_default();
                 let raw: Vec<u32> = match reader.read_indices() {
                     Some(i) => i.into_u32().collect(),
                     None => (0..n as u32).collect(),
@@ -361,6 +482,7 @@ impl Mesh {
                         t.swap(1, 2);
                     }
                 }
+                degenerate += drop_degenerate_triangles(&positions, &mut indices);
                 let material = match primitive.material().index() {
                     Some(i) => i as u32,
                     None => *default_material.get_or_insert_with(|| {
@@ -374,7 +496,9 @@ impl Mesh {
                     uvs,
                     materials: vec![material; n],
                     indices,
-                    material_names: vec![],
+                    tangents,
+                    colors,
+                    ..Default::default()
                 };
                 if normals.is_none() {
                     piece.compute_normals(DEFAULT_CREASE_ANGLE);
@@ -382,9 +506,13 @@ impl Mesh {
                 mesh.append(&piece);
             }
         }
+        if degenerate > 0 {
+            mesh.warnings.push(MeshWarning::DegenerateFaces { count: degenerate });
+        }
         if mesh.indices.is_empty() {
             return Err(MeshError::Empty { path: path.to_path_buf() });
         }
+        mesh.ensure_tangents();
         Ok(mesh)
     }
 
@@ -425,20 +553,131 @@ impl Mesh {
                 self.indices.len()
             )));
         }
+        for (what, len) in [("tangents", self.tangents.len()), ("colors", self.colors.len())] {
+            if len != 0 && len != n {
+                return Err(MeshError::Invalid(format!("{len} {what} for {n} positions (expected 0 or {n})")));
+            }
+        }
         if let Some(bad) = self.indices.iter().find(|&&i| i as usize >= n) {
             return Err(MeshError::Invalid(format!("index {bad} is out of range ({n} vertices)")));
         }
         Ok(())
     }
 
-    /// Appends `other`'s triangles; its material ids are kept as they are.
+    /// The material of id `id` (the default for ids without parameters).
+    pub fn material(&self, id: u32) -> Material {
+        self.material_params.get(id as usize).cloned().unwrap_or_default()
+    }
+
+    /// Appends `other`'s triangles; its material ids are kept as they are
+    /// (and so are this mesh's names, parameters and warnings).
     pub fn append(&mut self, other: &Mesh) {
-        let base = self.positions.len() as u32;
+        let base = self.positions.len();
+        extend_optional(&mut self.tangents, base, &other.tangents, other.positions.len(), [0.0; 4]);
+        extend_optional(&mut self.colors, base, &other.colors, other.positions.len(), [1.0; 4]);
         self.positions.extend_from_slice(&other.positions);
         self.normals.extend_from_slice(&other.normals);
         self.uvs.extend_from_slice(&other.uvs);
         self.materials.extend_from_slice(&other.materials);
-        self.indices.extend(other.indices.iter().map(|i| i + base));
+        self.indices.extend(other.indices.iter().map(|i| i + base as u32));
+    }
+
+    /// Gives tangents to the triangles of normal-mapped materials that lack
+    /// them, by MikkTSpace (what glTF prescribes for files without
+    /// tangents), from their positions, normals and texture coordinates.
+    /// Vertices are split where corners that share one need different
+    /// tangents. Failures become a [`MeshWarning::Tangents`].
+    pub fn ensure_tangents(&mut self) {
+        let mapped: Vec<bool> = (0..self.material_names.len().max(self.material_params.len()))
+            .map(|id| self.material_params.get(id).is_some_and(Material::has_normal_map))
+            .collect();
+        // MikkTSpace is given texture coordinates whose second axis runs up
+        // the image (OpenGL's convention, which glTF's normal maps follow:
+        // +Y is up), so the bitangent points up the texture.
+        let flip: Vec<bool> = self.material_params.iter().map(|m| m.flip_v).collect();
+        let needs = |mesh: &Mesh, t: &[u32]| {
+            let id = mesh.materials[t[0] as usize] as usize;
+            mapped.get(id).copied().unwrap_or(false)
+                && t.iter().any(|&i| mesh.tangents.get(i as usize).is_none_or(|v| v[3] == 0.0))
+        };
+        let faces: Vec<usize> =
+            (0..self.indices.len() / 3).filter(|&f| needs(self, &self.indices[3 * f..3 * f + 3])).collect();
+        if faces.is_empty() {
+            return;
+        }
+        if self.tangents.is_empty() {
+            self.tangents = vec![[0.0; 4]; self.positions.len()];
+        }
+        struct Geometry<'a> {
+            mesh: &'a Mesh,
+            faces: &'a [usize],
+            flip: &'a [bool],
+            out: Vec<[f32; 4]>,
+        }
+        impl bevy_mikktspace::Geometry for Geometry<'_> {
+            fn num_faces(&self) -> usize {
+                self.faces.len()
+            }
+            fn num_vertices_of_face(&self, _face: usize) -> usize {
+                3
+            }
+            fn position(&self, face: usize, vert: usize) -> [f32; 3] {
+                self.mesh.positions[self.mesh.indices[3 * self.faces[face] + vert] as usize]
+            }
+            fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
+                self.mesh.normals[self.mesh.indices[3 * self.faces[face] + vert] as usize]
+            }
+            fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
+                let i = self.mesh.indices[3 * self.faces[face] + vert] as usize;
+                let [u, v] = self.mesh.uvs[i];
+                // v already runs up for OBJ materials; glTF's runs down.
+                if self.flip.get(self.mesh.materials[i] as usize).copied().unwrap_or(false) {
+                    [u, v]
+                } else {
+                    [u, 1.0 - v]
+                }
+            }
+            fn set_tangent(&mut self, tangent: Option<bevy_mikktspace::TangentSpace>, face: usize, vert: usize) {
+                self.out[3 * face + vert] = tangent.map(|t| t.tangent_encoded()).unwrap_or([0.0; 4]);
+            }
+        }
+        let mut geometry = Geometry { mesh: self, faces: &faces, flip: &flip, out: vec![[0.0; 4]; 3 * faces.len()] };
+        if let Err(e) = bevy_mikktspace::generate_tangents::<_, bevy_mikktspace::StdOps>(&mut geometry) {
+            self.warnings.push(MeshWarning::Tangents {
+                message: format!("MikkTSpace failed on {} normal-mapped triangles: {e}", faces.len()),
+            });
+            return;
+        }
+        let generated = geometry.out;
+        let mut split: HashMap<(u32, [u32; 4]), u32> = HashMap::new();
+        let mut claimed: std::collections::HashSet<u32> = std::collections::HashSet::new();
+        for (k, &f) in faces.iter().enumerate() {
+            for v in 0..3 {
+                let old = self.indices[3 * f + v];
+                let t = generated[3 * k + v];
+                // MikkTSpace's sign is ±1; a zero tangent (no uv gradient)
+                // keeps w = 0 so that the rasteriser skips the normal map there.
+                let t = if t[0] == 0.0 && t[1] == 0.0 && t[2] == 0.0 { [0.0; 4] } else { t };
+                let index = *split.entry((old, t.map(f32::to_bits))).or_insert_with(|| {
+                    let i = old as usize;
+                    if claimed.insert(old) {
+                        // First use: the vertex itself takes the tangent.
+                        self.tangents[i] = t;
+                        return old;
+                    }
+                    self.positions.push(self.positions[i]);
+                    self.normals.push(self.normals[i]);
+                    self.uvs.push(self.uvs[i]);
+                    self.materials.push(self.materials[i]);
+                    if !self.colors.is_empty() {
+                        self.colors.push(self.colors[i]);
+                    }
+                    self.tangents.push(t);
+                    (self.positions.len() - 1) as u32
+                });
+                self.indices[3 * f + v] = index;
+            }
+        }
     }
 
     /// Replaces the normals by smooth ones: at each corner, the normals of
@@ -482,9 +721,16 @@ impl Mesh {
                 corner_normal[c as usize] = if dot(n, n) > 0.0 { n } else { [0.0, 1.0, 0.0] };
             }
         }
-        // Rebuild the vertices: one per (old vertex, normal).
+        // Rebuild the vertices: one per (old vertex, normal). Tangents
+        // depend on the normals, so they are made again afterwards.
+        let had_tangents = self.tangents.iter().any(|t| t[3] != 0.0);
         let mut map: HashMap<(u32, [u32; 3]), u32> = HashMap::new();
-        let mut out = Mesh { material_names: std::mem::take(&mut self.material_names), ..Default::default() };
+        let mut out = Mesh {
+            material_names: std::mem::take(&mut self.material_names),
+            material_params: std::mem::take(&mut self.material_params),
+            warnings: std::mem::take(&mut self.warnings),
+            ..Default::default()
+        };
         for (c, &i) in self.indices.iter().enumerate() {
             let n = corner_normal[c];
             let index = *map.entry((i, n.map(f32::to_bits))).or_insert_with(|| {
@@ -493,11 +739,192 @@ impl Mesh {
                 out.normals.push(n);
                 out.uvs.push(self.uvs[i]);
                 out.materials.push(self.materials[i]);
+                if let Some(color) = self.colors.get(i) {
+                    out.colors.push(*color);
+                }
                 (out.positions.len() - 1) as u32
             });
             out.indices.push(index);
         }
         *self = out;
+        if had_tangents {
+            self.ensure_tangents();
+        }
+    }
+}
+
+/// Appends `src` (per vertex of `src_len` vertices, or empty) to `dst`
+/// (per vertex of `dst_len`, or empty), filling in `default` where one side
+/// has the attribute and the other does not; both empty stays empty.
+fn extend_optional<T: Copy>(dst: &mut Vec<T>, dst_len: usize, src: &[T], src_len: usize, default: T) {
+    if dst.is_empty() && src.is_empty() {
+        return;
+    }
+    if dst.is_empty() {
+        dst.resize(dst_len, default);
+    }
+    if src.is_empty() {
+        dst.extend(std::iter::repeat_n(default, src_len));
+    } else {
+        dst.extend_from_slice(src);
+    }
+}
+
+/// Removes the triangles without area (two corners at the same position,
+/// or three on a line: a cross product of exactly zero), which cover no
+/// pixel; returns how many.
+fn drop_degenerate_triangles(positions: &[[f32; 3]], indices: &mut Vec<u32>) -> usize {
+    let before = indices.len() / 3;
+    let mut kept = Vec::with_capacity(indices.len());
+    for t in indices.chunks_exact(3) {
+        let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize]);
+        if cross(sub(b, a), sub(c, a)) != [0.0; 3] {
+            kept.extend_from_slice(t);
+        }
+    }
+    *indices = kept;
+    before - indices.len() / 3
+}
+
+/// Reads the OBJ's material libraries (relative to `dir`) and gives each of
+/// `mesh.material_names` its parameters, reporting what cannot be used.
+fn read_mtl_materials(mesh: &mut Mesh, dir: &Path, libraries: &[String]) {
+    let mut found: HashMap<String, tobj::Material> = HashMap::new();
+    for library in libraries {
+        let path = dir.join(library);
+        match tobj::load_mtl(&path) {
+            Ok((materials, _)) => {
+                for m in materials {
+                    found.entry(m.name.clone()).or_insert(m);
+                }
+            }
+            Err(e) => mesh.warnings.push(MeshWarning::MaterialLibrary { path, message: e.to_string() }),
+        }
+    }
+    let mut cache: HashMap<PathBuf, Option<Arc<TextureImage>>> = HashMap::new();
+    for name in &mesh.material_names {
+        let Some(m) = found.get(name) else {
+            mesh.material_params.push(Material::default());
+            continue;
+        };
+        let mut warnings = vec![];
+        let (material, unsupported) = Material::from_mtl(m, |key, file| {
+            let path = dir.join(file);
+            cache
+                .entry(path.clone())
+                .or_insert_with(|| match TextureImage::load(&path) {
+                    Ok(image) => Some(Arc::new(image)),
+                    Err(message) => {
+                        warnings.push(MeshWarning::Texture {
+                            material: name.clone(),
+                            texture: format!("`{key} {file}`"),
+                            message,
+                        });
+                        None
+                    }
+                })
+                .clone()
+        });
+        mesh.warnings.extend(warnings);
+        mesh.warnings.extend(
+            unsupported.into_iter().map(|feature| MeshWarning::Unsupported { material: name.clone(), feature }),
+        );
+        mesh.material_params.push(material);
+    }
+}
+
+/// A glTF material's parameters, its textures decoded (once per image, in
+/// `images`) from GLB chunks, data URIs or files next to the model.
+fn gltf_material(
+    material: &gltf::Material,
+    path: &Path,
+    buffers: &[Vec<u8>],
+    images: &mut HashMap<usize, Option<Arc<TextureImage>>>,
+    warnings: &mut Vec<MeshWarning>,
+) -> Material {
+    let name =
+        material.name().map(str::to_string).unwrap_or_else(|| format!("material{}", material.index().unwrap_or(0)));
+    let pbr = material.pbr_metallic_roughness();
+    let mut out = Material {
+        base_color: pbr.base_color_factor(),
+        roughness: pbr.roughness_factor(),
+        metallic: pbr.metallic_factor(),
+        alpha_cutoff: match material.alpha_mode() {
+            gltf::material::AlphaMode::Mask => Some(material.alpha_cutoff().unwrap_or(0.5)),
+            _ => None,
+        },
+        ..Material::default()
+    };
+    if material.alpha_mode() == gltf::material::AlphaMode::Blend {
+        warnings.push(MeshWarning::Unsupported {
+            material: name.clone(),
+            feature: "alpha blending (drawn opaque; alpha is in the albedo channel)".into(),
+        });
+    }
+    let mut texture = |slot: &str, texture: gltf::Texture, tex_coord: u32, out: &mut Material| {
+        if tex_coord != 0 {
+            warnings.push(MeshWarning::Unsupported {
+                material: name.clone(),
+                feature: format!("{slot} on texture coordinates {tex_coord} (only TEXCOORD_0 is read)"),
+            });
+            return None;
+        }
+        let sampler = texture.sampler();
+        let wrap = |mode: gltf::texture::WrappingMode| match mode {
+            gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+            gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+            gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        };
+        out.wrap = [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())];
+        let image = texture.source();
+        images
+            .entry(image.index())
+            .or_insert_with(|| match gltf_image(&image, path, buffers) {
+                Ok(decoded) => Some(Arc::new(decoded)),
+                Err(message) => {
+                    warnings.push(MeshWarning::Texture {
+                        material: name.clone(),
+                        texture: format!("{slot} (image {})", image.index()),
+                        message,
+                    });
+                    None
+                }
+            })
+            .clone()
+    };
+    if let Some(info) = pbr.base_color_texture() {
+        out.base_color_texture = texture("baseColorTexture", info.texture(), info.tex_coord(), &mut out);
+    }
+    if let Some(info) = pbr.metallic_roughness_texture() {
+        out.metallic_roughness_texture =
+            texture("metallicRoughnessTexture", info.texture(), info.tex_coord(), &mut out);
+    }
+    if let Some(info) = material.normal_texture() {
+        out.normal_scale = info.scale();
+        out.normal_texture = texture("normalTexture", info.texture(), info.tex_coord(), &mut out);
+    }
+    out
+}
+
+/// Decodes a glTF image from a buffer view, a data URI or a file next to the model.
+fn gltf_image(image: &gltf::Image, path: &Path, buffers: &[Vec<u8>]) -> Result<TextureImage, String> {
+    match image.source() {
+        gltf::image::Source::View { view, .. } => {
+            let data = buffers.get(view.buffer().index()).ok_or("its buffer is missing")?;
+            let bytes =
+                data.get(view.offset()..view.offset() + view.length()).ok_or("its buffer view is out of range")?;
+            TextureImage::decode(bytes, &format!("image {}", image.index()))
+        }
+        gltf::image::Source::Uri { uri, .. } => {
+            if let Some(rest) = uri.strip_prefix("data:") {
+                let (_, data) = rest.split_once(";base64,").ok_or("only base64 data URIs are supported")?;
+                let bytes = base64_decode(data).ok_or("invalid base64 data")?;
+                TextureImage::decode(&bytes, &format!("image {}", image.index()))
+            } else {
+                let file = path.parent().unwrap_or(Path::new(".")).join(percent_decode(uri));
+                TextureImage::load(&file).map_err(|e| format!("{}: {e}", file.display()))
+            }
+        }
     }
 }
 
@@ -636,6 +1063,55 @@ pub fn sponza_shared() -> Result<Arc<Mesh>, MeshError> {
     Ok(mesh)
 }
 
+/// The dungeon path the application chose ([`set_dungeon_path`]).
+static DUNGEON_PATH: Mutex<Option<PathBuf>> = Mutex::new(None);
+
+/// Where the dungeon level lies in Debian's `castle-game-engine-doc` package.
+const DUNGEON_IN_PACKAGE: &str =
+    "/usr/share/doc/castle-game-engine-doc/examples/third_person_navigation/data/level/level-dungeon.gltf";
+
+/// Tells [`dungeon_path`] where the dungeon's `level-dungeon.gltf` is.
+pub fn set_dungeon_path(path: PathBuf) {
+    *DUNGEON_PATH.lock().unwrap_or_else(|e| e.into_inner()) = Some(path);
+}
+
+/// The places [`dungeon_path`] looks, in order: the path given to
+/// [`set_dungeon_path`], `$MRSL_DUNGEON`, where `scripts/fetch-dungeon.sh`
+/// puts it (`$XDG_DATA_HOME/mrsl/castle-dungeon/level-dungeon.gltf`,
+/// `XDG_DATA_HOME` defaulting to `~/.local/share`), and where Debian's
+/// package installs it.
+pub fn dungeon_candidates() -> Vec<PathBuf> {
+    let chosen = DUNGEON_PATH.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    let data_home = std::env::var_os("XDG_DATA_HOME")
+        .map(PathBuf::from)
+        .filter(|p| p.is_absolute())
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".local/share")));
+    chosen
+        .into_iter()
+        .chain(std::env::var_os("MRSL_DUNGEON").map(PathBuf::from))
+        .chain(data_home.map(|d| d.join("mrsl/castle-dungeon/level-dungeon.gltf")))
+        .chain(std::iter::once(PathBuf::from(DUNGEON_IN_PACKAGE)))
+        .collect()
+}
+
+/// The path of the dungeon level: the first of [`dungeon_candidates`] that exists.
+pub fn dungeon_path() -> Result<PathBuf, MeshError> {
+    let searched = dungeon_candidates();
+    searched.iter().find(|p| p.is_file()).cloned().ok_or(MeshError::DungeonNotFound { searched })
+}
+
+/// The dungeon mesh with its materials and textures, loaded once per process and shared.
+pub fn dungeon_shared() -> Result<Arc<Mesh>, MeshError> {
+    static CACHE: Mutex<Option<Arc<Mesh>>> = Mutex::new(None);
+    let mut guard = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(mesh) = guard.as_ref() {
+        return Ok(mesh.clone());
+    }
+    let mesh = Arc::new(Mesh::load_gltf(dungeon_path()?)?);
+    *guard = Some(mesh.clone());
+    Ok(mesh)
+}
+
 fn base64_decode(text: &str) -> Option<Vec<u8>> {
     let value = |c: u8| -> Option<u32> {
         Some(match c {
@@ -689,6 +1165,10 @@ fn mat4_mul(a: [[f32; 4]; 4], b: [[f32; 4]; 4]) -> [[f32; 4]; 4] {
 
 fn transform_point(m: [[f32; 4]; 4], p: [f32; 3]) -> [f32; 3] {
     std::array::from_fn(|row| m[0][row] * p[0] + m[1][row] * p[1] + m[2][row] * p[2] + m[3][row])
+}
+
+fn transform_vector(m: [[f32; 4]; 4], v: [f32; 3]) -> [f32; 3] {
+    std::array::from_fn(|row| m[0][row] * v[0] + m[1][row] * v[1] + m[2][row] * v[2])
 }
 
 fn det3(m: [[f32; 4]; 4]) -> f32 {

@@ -3,7 +3,7 @@
 //! once, on first use) and the uniforms a program takes from the scene.
 
 use crate::gpu::Gpu;
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, MeshWarning};
 use crate::raster::{Camera, GpuMesh, RasterError, Rasterizer};
 use crate::rig::{DEFAULT_LIGHTS, DEFAULT_SHADOW_MAP_SIZE, LightRig, RigError};
 use crate::uniforms::{Applied, Offered};
@@ -17,6 +17,8 @@ pub struct MeshScene {
     pub camera: Camera,
     pub rig: LightRig,
     shadow_map: Option<wgpu::Texture>,
+    /// What loading the mesh skipped or could not use (for the tools to print once).
+    pub warnings: Vec<MeshWarning>,
 }
 
 impl MeshScene {
@@ -26,7 +28,7 @@ impl MeshScene {
         let uploaded = rasterizer.upload(gpu, mesh)?;
         let bounds = uploaded.bounds().unwrap_or(crate::mesh::Bounds { min: [-1.0, -1.0, -1.0], max: [1.0, 1.0, 1.0] });
         let rig = LightRig::for_bounds(&bounds, DEFAULT_LIGHTS);
-        Ok(MeshScene { rasterizer, mesh: uploaded, camera, rig, shadow_map: None })
+        Ok(MeshScene { rasterizer, mesh: uploaded, camera, rig, shadow_map: None, warnings: mesh.warnings.clone() })
     }
 
     /// The G-buffer seen from `camera` (see [`Rasterizer::render`]).

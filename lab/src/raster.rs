@@ -1,46 +1,70 @@
 //! A G-buffer rasteriser: draws a [`Mesh`] with a wgpu render pipeline into
-//! the channels every scene provides (see [`crate::scene`]), as textures
-//! that a [`crate::Shader`] binds directly.
+//! the channels a deferred renderer's geometry pass writes (see
+//! [`crate::scene`] and docs/scenes.md), as textures that a
+//! [`crate::Shader`] binds directly.
 //!
-//! | channel    | format        | content                                             |
-//! | ---------- | ------------- | --------------------------------------------------- |
-//! | `position` | `Rgba32Float` | world-space position (w = 0)                        |
-//! | `normal`   | `Rgba32Float` | unit world-space normal, towards the camera (w = 0) |
-//! | `uv`       | `Rg32Float`   | texture coordinates                                 |
-//! | `material` | `R32Uint`     | material id; [`BACKGROUND`] where nothing was drawn |
-//! | `depth`    | `R32Float`    | distance from the camera's eye                      |
+//! | channel     | format        | content                                                  |
+//! | ----------- | ------------- | -------------------------------------------------------- |
+//! | `position`  | `Rgba32Float` | world-space position (w = 0)                             |
+//! | `normal`    | `Rgba32Float` | unit shading normal, normal-mapped, towards the camera   |
+//! | `uv`        | `Rg32Float`   | texture coordinates                                      |
+//! | `material`  | `R32Uint`     | material id; [`BACKGROUND`] where nothing was drawn      |
+//! | `depth`     | `R32Float`    | distance from the camera's eye                           |
+//! | `albedo`    | `Rgba32Float` | linear base colour × factor × vertex colour; a: alpha    |
+//! | `roughness` | `R32Float`    | perceptual roughness, factor × texture (G)               |
+//! | `metallic`  | `R32Float`    | metalness, factor × texture (B)                          |
+//!
+//! Each material is drawn with its own bind group: its factors and its
+//! textures, sampled with trilinear filtering from mipmaps made on the CPU
+//! ([`crate::material::mip_chain`]); the level of detail comes from the
+//! derivatives of uv across each 2x2 pixel quad, as in any geometry pass.
+//! Base colour textures are `Rgba8UnormSrgb`, so the sampler decodes sRGB to
+//! linear before filtering; metallic-roughness and normal maps are linear.
+//! Normal maps perturb the interpolated normal in the tangent frame (the
+//! tangent made orthogonal to the normal, bitangent = w · normal × tangent).
+//! Materials without a texture sample a 1x1 white (or flat-normal) texture,
+//! so their constant factors come through unchanged.
 //!
 //! WebGPU's default `max_color_attachment_bytes_per_sample` is 32 bytes,
-//! and position and normal alone take 32, so the mesh is drawn twice with a
-//! shared `Depth32Float` buffer: pass 1 writes position and normal (and the
-//! depth buffer), pass 2 writes uv, material and depth where the depth
-//! equals pass 1's (the vertex position is `@invariant`). Where coplanar
-//! triangles tie, the last one drawn wins in both passes (pass 1 tests
-//! greater-or-equal), so a pixel's channels all come from one triangle.
-//! Depth is reversed
-//! (1 at the near plane, 0 at infinity) with an infinite far plane, which
-//! keeps float depth precise over Sponza's whole depth range.
+//! and position and normal alone take 32, so the mesh is drawn three times
+//! with a shared `Depth32Float` buffer: pass 1 writes position and normal
+//! (and the depth buffer), pass 2 uv, material and depth, pass 3 albedo,
+//! roughness and metallic, the last two where the depth equals pass 1's
+//! (the vertex position is `@invariant`). Where coplanar triangles tie,
+//! the last one drawn wins in every pass (pass 1 tests greater-or-equal),
+//! so a pixel's channels all come from one triangle. Alpha-masked materials
+//! (glTF `MASK`) discard the same fragments in all three passes. Depth is
+//! reversed (1 at the near plane, 0 at infinity) with an infinite far plane,
+//! which keeps float depth precise over Sponza's whole depth range.
 //!
 //! Background pixels follow the CPU demo scene's convention: material
 //! [`BACKGROUND`], the normal pointing back along the view ray, the position
-//! on the ray at [`background_distance`], and that distance as depth.
+//! on the ray at [`background_distance`], and that distance as depth; albedo
+//! (0, 0, 0, 0), roughness 1 and metallic 0.
 //! Triangles are two-sided: a triangle seen from behind reports its normal
 //! flipped, so every normal in the G-buffer faces the camera.
 
 use crate::gbuffer::{BACKGROUND, ChannelData, GBuffer};
 use crate::gpu::Gpu;
+use crate::material::{Material, TexelEncoding, TextureImage, Wrap, mip_chain};
 use crate::mesh::{Bounds, Mesh, MeshError, cross, dot, normalize, sub};
 use wgpu::util::DeviceExt;
 
 /// Channel names and formats, in the order [`Rasterizer::render`] returns them
 /// (the same as [`GBuffer::upload`] makes for the CPU scenes).
-pub const CHANNELS: [(&str, wgpu::TextureFormat); 5] = [
+pub const CHANNELS: [(&str, wgpu::TextureFormat); 8] = [
     ("position", wgpu::TextureFormat::Rgba32Float),
     ("normal", wgpu::TextureFormat::Rgba32Float),
     ("uv", wgpu::TextureFormat::Rg32Float),
     ("material", wgpu::TextureFormat::R32Uint),
     ("depth", wgpu::TextureFormat::R32Float),
+    ("albedo", wgpu::TextureFormat::Rgba32Float),
+    ("roughness", wgpu::TextureFormat::R32Float),
+    ("metallic", wgpu::TextureFormat::R32Float),
 ];
+
+/// Which channels each pass writes (ranges of [`CHANNELS`]).
+const PASSES: [std::ops::Range<usize>; 3] = [0..2, 2..5, 5..8];
 
 /// Why rasterising failed.
 #[derive(Debug, thiserror::Error)]
@@ -55,6 +79,8 @@ pub enum RasterError {
     BadSize { width: u32, height: u32, reason: String },
     #[error("the mesh's {what} need {bytes} bytes, more than the device's {limit}-byte buffer limit")]
     TooLarge { what: &'static str, bytes: u64, limit: u64 },
+    #[error("texture {image} is {width}x{height}, larger than the device's {limit}-texel limit")]
+    TextureTooLarge { image: String, width: u32, height: u32, limit: u32 },
     #[error("bad camera: {0}")]
     BadCamera(String),
     #[error(transparent)]
@@ -143,6 +169,19 @@ struct Vertex {
     normal: [f32; 3],
     uv: [f32; 2],
     material: u32,
+    tangent: [f32; 4],
+    color: [f32; 4],
+}
+
+/// A material's factors as the shader reads them.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct MaterialUniform {
+    base_color: [f32; 4],
+    /// x: roughness, y: metallic, z: normal scale, w: alpha cutoff (negative: none).
+    params: [f32; 4],
+    /// x: 1 where a normal map applies; y: 1 to sample at (u, 1 − v).
+    flags: [u32; 4],
 }
 
 #[repr(C)]
@@ -172,12 +211,27 @@ struct Globals {
 };
 @group(0) @binding(0) var<uniform> g: Globals;
 
+struct Material {
+    base_color: vec4<f32>,
+    // x: roughness, y: metallic, z: normal scale, w: alpha cutoff (negative: none)
+    params: vec4<f32>,
+    // x: 1 where the normal map applies; y: 1 to sample at (u, 1 - v) (OBJ)
+    flags: vec4<u32>,
+};
+@group(1) @binding(0) var<uniform> material: Material;
+@group(1) @binding(1) var base_color_map: texture_2d<f32>;
+@group(1) @binding(2) var metallic_roughness_map: texture_2d<f32>;
+@group(1) @binding(3) var normal_map: texture_2d<f32>;
+@group(1) @binding(4) var material_sampler: sampler;
+
 struct VsOut {
     @builtin(position) @invariant clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
     @location(3) @interpolate(flat) material: u32,
+    @location(4) tangent: vec4<f32>,
+    @location(5) color: vec4<f32>,
 };
 
 struct Pass1 {
@@ -191,23 +245,63 @@ struct Pass2 {
     @location(2) depth: f32,
 };
 
+struct Pass3 {
+    @location(0) albedo: vec4<f32>,
+    @location(1) roughness: f32,
+    @location(2) metallic: f32,
+};
+
 @vertex
 fn vs_mesh(@location(0) p: vec3<f32>, @location(1) n: vec3<f32>, @location(2) uv: vec2<f32>,
-           @location(3) material: u32) -> VsOut {
+           @location(3) material_id: u32, @location(4) tangent: vec4<f32>, @location(5) color: vec4<f32>) -> VsOut {
     var out: VsOut;
     out.clip = g.view_proj * vec4<f32>(p, 1.0);
     out.world = p;
     out.normal = n;
     out.uv = uv;
-    out.material = material;
+    out.material = material_id;
+    out.tangent = tangent;
+    out.color = color;
     return out;
+}
+
+// Every pass samples the base colour first (in uniform control flow, so
+// that the quad's uv derivatives pick the mip level) and discards the same
+// masked fragments.
+fn texture_uv(v: VsOut) -> vec2<f32> {
+    return select(v.uv, vec2<f32>(v.uv.x, 1.0 - v.uv.y), material.flags.y != 0u);
+}
+
+fn base_color(v: VsOut) -> vec4<f32> {
+    return material.base_color * v.color * textureSample(base_color_map, material_sampler, texture_uv(v));
+}
+
+fn alpha_test(alpha: f32) {
+    if (material.params.w >= 0.0 && alpha < material.params.w) {
+        discard;
+    }
 }
 
 @fragment
 fn fs_mesh1(v: VsOut, @builtin(front_facing) front: bool) -> Pass1 {
+    let albedo = base_color(v);
+    let mapped = textureSample(normal_map, material_sampler, texture_uv(v)).xyz * 2.0 - 1.0;
+    alpha_test(albedo.a);
     var n = v.normal;
     if (dot(n, n) > 0.0) {
         n = normalize(n);
+        // The tangent frame: the tangent made orthogonal to the normal, the
+        // bitangent's handedness from w. A vertex without a tangent (zero)
+        // keeps the interpolated normal.
+        let t = v.tangent.xyz - n * dot(n, v.tangent.xyz);
+        if (material.flags.x != 0u && dot(t, t) > 1e-12) {
+            let tu = normalize(t);
+            let b = cross(n, tu) * select(-1.0, 1.0, v.tangent.w >= 0.0);
+            let p = (mapped.x * material.params.z) * tu + (mapped.y * material.params.z) * b + mapped.z * n;
+            if (dot(p, p) > 0.0) {
+                n = normalize(p);
+            }
+        }
     }
     if (!front) {
         n = -n;
@@ -217,7 +311,16 @@ fn fs_mesh1(v: VsOut, @builtin(front_facing) front: bool) -> Pass1 {
 
 @fragment
 fn fs_mesh2(v: VsOut) -> Pass2 {
+    alpha_test(base_color(v).a);
     return Pass2(v.uv, v.material, distance(v.world, g.eye.xyz));
+}
+
+@fragment
+fn fs_mesh3(v: VsOut) -> Pass3 {
+    let albedo = base_color(v);
+    let mr = textureSample(metallic_roughness_map, material_sampler, texture_uv(v));
+    alpha_test(albedo.a);
+    return Pass3(albedo, clamp(material.params.x * mr.g, 0.0, 1.0), clamp(material.params.y * mr.b, 0.0, 1.0));
 }
 
 // A full-screen triangle at depth 0 (infinitely far with reversed depth).
@@ -243,13 +346,21 @@ fn fs_background1(@builtin(position) frag: vec4<f32>) -> Pass1 {
 fn fs_background2(@builtin(position) frag: vec4<f32>) -> Pass2 {
     return Pass2(vec2<f32>(0.0, 0.0), BACKGROUND_ID, g.eye.w);
 }
+
+@fragment
+fn fs_background3() -> Pass3 {
+    return Pass3(vec4<f32>(0.0), 1.0, 0.0);
+}
 "#;
 
-/// A mesh in GPU buffers.
+/// A mesh in GPU buffers, its triangles grouped by material, with each
+/// material's bind group (factors and textures).
 pub struct GpuMesh {
     vertices: Option<wgpu::Buffer>,
     indices: Option<wgpu::Buffer>,
-    index_count: u32,
+    /// (first index, index count, bind group) per run of one material.
+    draws: Vec<(u32, u32, usize)>,
+    bind_groups: Vec<wgpu::BindGroup>,
     bounds: Option<Bounds>,
 }
 
@@ -262,10 +373,14 @@ impl GpuMesh {
 /// The rasteriser's pipelines on one device: make it once, render many frames.
 pub struct Rasterizer {
     globals_layout: wgpu::BindGroupLayout,
-    mesh1: wgpu::RenderPipeline,
-    mesh2: wgpu::RenderPipeline,
-    background1: wgpu::RenderPipeline,
-    background2: wgpu::RenderPipeline,
+    material_layout: wgpu::BindGroupLayout,
+    /// Mesh pipelines of passes 1 to 3, then the background's.
+    mesh: [wgpu::RenderPipeline; 3],
+    background: [wgpu::RenderPipeline; 3],
+    /// 1x1 stand-ins for missing textures: white sRGB, white linear, flat normal.
+    white_srgb: wgpu::TextureView,
+    white_linear: wgpu::TextureView,
+    flat_normal: wgpu::TextureView,
 }
 
 fn describe(error: &wgpu::Error) -> String {
@@ -284,45 +399,82 @@ impl Rasterizer {
             label: Some("mrsl rasteriser"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         });
+        let uniform = |binding, size: usize| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: wgpu::BufferSize::new(size as u64),
+            },
+            count: None,
+        };
         let globals_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("mrsl rasteriser globals"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<Globals>() as u64),
-                },
-                count: None,
-            }],
+            entries: &[uniform(0, std::mem::size_of::<Globals>())],
         });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("mrsl rasteriser"),
+        let texture = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("mrsl rasteriser material"),
+            entries: &[
+                uniform(0, std::mem::size_of::<MaterialUniform>()),
+                texture(1),
+                texture(2),
+                texture(3),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 4,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        let mesh_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("mrsl rasteriser mesh"),
+            bind_group_layouts: &[Some(&globals_layout), Some(&material_layout)],
+            immediate_size: 0,
+        });
+        let background_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("mrsl rasteriser background"),
             bind_group_layouts: &[Some(&globals_layout)],
             immediate_size: 0,
         });
-        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Uint32];
+        let attributes = wgpu::vertex_attr_array![
+            0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Uint32, 4 => Float32x4, 5 => Float32x4
+        ];
         let vertex_layout = wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<Vertex>() as u64,
             step_mode: wgpu::VertexStepMode::Vertex,
             attributes: &attributes,
         };
-        let target = |(_, format): (&str, wgpu::TextureFormat)| {
-            Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
+        let targets = |pass: usize| -> Vec<Option<wgpu::ColorTargetState>> {
+            CHANNELS[PASSES[pass].clone()]
+                .iter()
+                .map(|&(_, format)| {
+                    Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
+                })
+                .collect()
         };
-        let pass1_targets = [target(CHANNELS[0]), target(CHANNELS[1])];
-        let pass2_targets = [target(CHANNELS[2]), target(CHANNELS[3]), target(CHANNELS[4])];
         let pipeline = |label: &str,
+                        layout: &wgpu::PipelineLayout,
                         vs: &str,
                         fs: &str,
                         buffers: &[Option<wgpu::VertexBufferLayout>],
-                        targets: &[Option<wgpu::ColorTargetState>],
+                        pass: usize,
                         write: bool,
                         compare: wgpu::CompareFunction| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
-                layout: Some(&layout),
+                layout: Some(layout),
                 vertex: wgpu::VertexState {
                     module: &module,
                     entry_point: Some(vs),
@@ -347,35 +499,40 @@ impl Rasterizer {
                     module: &module,
                     entry_point: Some(fs),
                     compilation_options: Default::default(),
-                    targets,
+                    targets: &targets(pass),
                 }),
                 multiview_mask: None,
                 cache: None,
             })
         };
         use wgpu::CompareFunction::{Equal, GreaterEqual};
-        let mesh1 = pipeline(
-            "mrsl raster mesh 1",
-            "vs_mesh",
-            "fs_mesh1",
-            &[Some(vertex_layout.clone())],
-            &pass1_targets,
-            true,
-            GreaterEqual,
-        );
-        let mesh2 =
-            pipeline("mrsl raster mesh 2", "vs_mesh", "fs_mesh2", &[Some(vertex_layout)], &pass2_targets, false, Equal);
-        let background1 =
-            pipeline("mrsl raster background 1", "vs_background", "fs_background1", &[], &pass1_targets, false, Equal);
-        let background2 =
-            pipeline("mrsl raster background 2", "vs_background", "fs_background2", &[], &pass2_targets, false, Equal);
+        let vertex = [Some(vertex_layout)];
+        let mesh = [0, 1, 2].map(|pass| {
+            let (write, compare) = if pass == 0 { (true, GreaterEqual) } else { (false, Equal) };
+            let label = format!("mrsl raster mesh {}", pass + 1);
+            pipeline(&label, &mesh_layout, "vs_mesh", &format!("fs_mesh{}", pass + 1), &vertex, pass, write, compare)
+        });
+        let background = [0, 1, 2].map(|pass| {
+            let label = format!("mrsl raster background {}", pass + 1);
+            let fs = format!("fs_background{}", pass + 1);
+            pipeline(&label, &background_layout, "vs_background", &fs, &[], pass, false, Equal)
+        });
+        let pixel = |label: &str, format, texel: [u8; 4]| {
+            gpu.texture_with_data(label, (1, 1), format, &texel).create_view(&Default::default())
+        };
+        let white_srgb = pixel("mrsl white", wgpu::TextureFormat::Rgba8UnormSrgb, [255; 4]);
+        let white_linear = pixel("mrsl white", wgpu::TextureFormat::Rgba8Unorm, [255; 4]);
+        let flat_normal = pixel("mrsl flat normal", wgpu::TextureFormat::Rgba8Unorm, [128, 128, 255, 255]);
         if let Some(error) = pollster::block_on(scope.pop()) {
             return Err(RasterError::Pipeline(describe(&error)));
         }
-        Ok(Rasterizer { globals_layout, mesh1, mesh2, background1, background2 })
+        Ok(Rasterizer { globals_layout, material_layout, mesh, background, white_srgb, white_linear, flat_normal })
     }
 
-    /// Uploads a mesh (after checking it with [`Mesh::validate`]).
+    /// Uploads a mesh (after checking it with [`Mesh::validate`]): its
+    /// vertices, its triangles grouped by material (in the order of first
+    /// use, each material's triangles in their original order), and each
+    /// material's factors and textures with their mipmaps.
     pub fn upload(&self, gpu: &Gpu, mesh: &Mesh) -> Result<GpuMesh, RasterError> {
         mesh.validate()?;
         let limit = gpu.device.limits().max_buffer_size;
@@ -387,7 +544,7 @@ impl Rasterizer {
             }
         }
         if mesh.indices.is_empty() {
-            return Ok(GpuMesh { vertices: None, indices: None, index_count: 0, bounds: None });
+            return Ok(GpuMesh { vertices: None, indices: None, draws: vec![], bind_groups: vec![], bounds: None });
         }
         let vertices: Vec<Vertex> = (0..mesh.positions.len())
             .map(|i| Vertex {
@@ -395,8 +552,30 @@ impl Rasterizer {
                 normal: mesh.normals[i],
                 uv: mesh.uvs[i],
                 material: mesh.materials[i],
+                tangent: mesh.tangents.get(i).copied().unwrap_or([0.0; 4]),
+                color: mesh.colors.get(i).copied().unwrap_or([1.0; 4]),
             })
             .collect();
+        // Triangles grouped by material, so that each material is one draw.
+        let mut order: Vec<u32> = vec![];
+        let mut runs: Vec<(u32, Vec<u32>)> = vec![];
+        for t in mesh.indices.chunks_exact(3) {
+            let id = mesh.materials[t[0] as usize];
+            match runs.iter_mut().find(|(m, _)| *m == id) {
+                Some((_, list)) => list.extend_from_slice(t),
+                None => runs.push((id, t.to_vec())),
+            }
+        }
+        let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut textures = TextureCache::default();
+        let mut draws = vec![];
+        let mut bind_groups = vec![];
+        for (id, list) in runs {
+            let first = order.len() as u32;
+            order.extend_from_slice(&list);
+            bind_groups.push(self.material_bind_group(gpu, &mesh.material(id), &mut textures)?);
+            draws.push((first, list.len() as u32, bind_groups.len() - 1));
+        }
         let vertices = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("mrsl raster vertices"),
             contents: bytemuck::cast_slice(&vertices),
@@ -404,15 +583,59 @@ impl Rasterizer {
         });
         let indices = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("mrsl raster indices"),
-            contents: bytemuck::cast_slice(&mesh.indices),
+            contents: bytemuck::cast_slice(&order),
             usage: wgpu::BufferUsages::INDEX,
         });
-        Ok(GpuMesh {
-            vertices: Some(vertices),
-            indices: Some(indices),
-            index_count: mesh.indices.len() as u32,
-            bounds: mesh.bounds(),
-        })
+        if let Some(error) = pollster::block_on(scope.pop()) {
+            return Err(RasterError::Render(describe(&error)));
+        }
+        Ok(GpuMesh { vertices: Some(vertices), indices: Some(indices), draws, bind_groups, bounds: mesh.bounds() })
+    }
+
+    /// A material's bind group: its factors, its textures (uploaded once
+    /// each, through `cache`) or the 1x1 stand-ins, and a trilinear sampler
+    /// with its wrap modes.
+    fn material_bind_group(
+        &self,
+        gpu: &Gpu,
+        material: &Material,
+        cache: &mut TextureCache,
+    ) -> Result<wgpu::BindGroup, RasterError> {
+        let uniform = MaterialUniform {
+            base_color: material.base_color,
+            params: [
+                material.roughness,
+                material.metallic,
+                material.normal_scale,
+                material.alpha_cutoff.unwrap_or(-1.0),
+            ],
+            flags: [u32::from(material.has_normal_map()), u32::from(material.flip_v), 0, 0],
+        };
+        let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("mrsl raster material"),
+            contents: bytemuck::bytes_of(&uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let mut view =
+            |image: &Option<std::sync::Arc<TextureImage>>, encoding, fallback: &wgpu::TextureView| match image {
+                Some(image) => cache.view(gpu, image, encoding).cloned(),
+                None => Ok(fallback.clone()),
+            };
+        let base = view(&material.base_color_texture, TexelEncoding::Srgb, &self.white_srgb)?;
+        let mr = view(&material.metallic_roughness_texture, TexelEncoding::Linear, &self.white_linear)?;
+        let normal = view(&material.normal_texture, TexelEncoding::Normal, &self.flat_normal)?;
+        let sampler = cache.sampler(gpu, material.wrap);
+        Ok(gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("mrsl raster material"),
+            layout: &self.material_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&base) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&mr) },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&normal) },
+                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::Sampler(&sampler) },
+            ],
+        }))
     }
 
     /// Draws `mesh` from `camera` into new G-buffer textures, named and
@@ -481,8 +704,8 @@ impl Rasterizer {
         let depth_view = depth.create_view(&Default::default());
         let views: Vec<wgpu::TextureView> = channels.iter().map(|(_, t)| t.create_view(&Default::default())).collect();
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mrsl raster") });
-        for (pass, range) in [(0, 0..2), (1, 2..5)] {
-            let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = views[range]
+        for (pass, range) in PASSES.iter().enumerate() {
+            let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = views[range.clone()]
                 .iter()
                 .map(|view| {
                     Some(wgpu::RenderPassColorAttachment {
@@ -496,8 +719,9 @@ impl Rasterizer {
                     })
                 })
                 .collect();
+            let label = format!("mrsl raster pass {}", pass + 1);
             let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(if pass == 0 { "mrsl raster pass 1" } else { "mrsl raster pass 2" }),
+                label: Some(&label),
                 color_attachments: &attachments,
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &depth_view,
@@ -513,12 +737,15 @@ impl Rasterizer {
             });
             rp.set_bind_group(0, &bind_group, &[]);
             if let (Some(vertices), Some(indices)) = (&mesh.vertices, &mesh.indices) {
-                rp.set_pipeline(if pass == 0 { &self.mesh1 } else { &self.mesh2 });
+                rp.set_pipeline(&self.mesh[pass]);
                 rp.set_vertex_buffer(0, vertices.slice(..));
                 rp.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
-                rp.draw_indexed(0..mesh.index_count, 0, 0..1);
+                for &(first, count, group) in &mesh.draws {
+                    rp.set_bind_group(1, &mesh.bind_groups[group], &[]);
+                    rp.draw_indexed(first..first + count, 0, 0..1);
+                }
             }
-            rp.set_pipeline(if pass == 0 { &self.background1 } else { &self.background2 });
+            rp.set_pipeline(&self.background[pass]);
             rp.draw(0..3, 0..1);
         }
         gpu.queue.submit([encoder.finish()]);
@@ -526,6 +753,92 @@ impl Rasterizer {
             return Err(RasterError::Render(describe(&error)));
         }
         Ok(channels)
+    }
+}
+
+/// Textures uploaded for one mesh (each image once per encoding, keyed by
+/// its allocation: materials share images through `Arc`), and samplers per
+/// pair of wrap modes.
+#[derive(Default)]
+struct TextureCache {
+    views: std::collections::HashMap<(usize, TexelEncoding), wgpu::TextureView>,
+    samplers: std::collections::HashMap<[Wrap; 2], wgpu::Sampler>,
+}
+
+impl TextureCache {
+    fn view(
+        &mut self,
+        gpu: &Gpu,
+        image: &std::sync::Arc<TextureImage>,
+        encoding: TexelEncoding,
+    ) -> Result<&wgpu::TextureView, RasterError> {
+        let key = (std::sync::Arc::as_ptr(image) as usize, encoding);
+        let entry = match self.views.entry(key) {
+            std::collections::hash_map::Entry::Occupied(e) => return Ok(e.into_mut()),
+            std::collections::hash_map::Entry::Vacant(e) => e,
+        };
+        {
+            let limit = gpu.device.limits().max_texture_dimension_2d;
+            if image.width > limit || image.height > limit {
+                return Err(RasterError::TextureTooLarge {
+                    image: image.source.clone(),
+                    width: image.width,
+                    height: image.height,
+                    limit,
+                });
+            }
+            let levels = mip_chain(image, encoding);
+            let format = match encoding {
+                TexelEncoding::Srgb => wgpu::TextureFormat::Rgba8UnormSrgb,
+                _ => wgpu::TextureFormat::Rgba8Unorm,
+            };
+            let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(&image.source),
+                size: wgpu::Extent3d { width: image.width, height: image.height, depth_or_array_layers: 1 },
+                mip_level_count: levels.len() as u32,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            });
+            for (level, (w, h, bytes)) in levels.iter().enumerate() {
+                gpu.queue.write_texture(
+                    wgpu::TexelCopyTextureInfo {
+                        texture: &texture,
+                        mip_level: level as u32,
+                        origin: wgpu::Origin3d::ZERO,
+                        aspect: wgpu::TextureAspect::All,
+                    },
+                    bytes,
+                    wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * w), rows_per_image: Some(*h) },
+                    wgpu::Extent3d { width: *w, height: *h, depth_or_array_layers: 1 },
+                );
+            }
+            Ok(entry.insert(texture.create_view(&Default::default())))
+        }
+    }
+
+    fn sampler(&mut self, gpu: &Gpu, wrap: [Wrap; 2]) -> wgpu::Sampler {
+        let mode = |w: Wrap| match w {
+            Wrap::Repeat => wgpu::AddressMode::Repeat,
+            Wrap::MirroredRepeat => wgpu::AddressMode::MirrorRepeat,
+            Wrap::ClampToEdge => wgpu::AddressMode::ClampToEdge,
+        };
+        self.samplers
+            .entry(wrap)
+            .or_insert_with(|| {
+                gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+                    label: Some("mrsl raster material"),
+                    address_mode_u: mode(wrap[0]),
+                    address_mode_v: mode(wrap[1]),
+                    mag_filter: wgpu::FilterMode::Linear,
+                    min_filter: wgpu::FilterMode::Linear,
+                    mipmap_filter: wgpu::MipmapFilterMode::Linear,
+                    ..Default::default()
+                })
+            })
+            .clone()
     }
 }
 

@@ -3,8 +3,10 @@
 //!
 //! Every scene provides the same channels, so any program reading a subset
 //! of them runs on any scene: `position` (float3, world space), `normal`
-//! (float3, unit), `uv` (float2), `material` (uint; 255 is the background)
-//! and `depth` (float, distance from the camera).
+//! (float3, unit), `uv` (float2), `material` (uint; 255 is the background),
+//! `depth` (float, distance from the camera), and the material channels of
+//! a deferred renderer: `albedo` (float4, linear base colour and alpha),
+//! `roughness` and `metallic` (floats in [0, 1]).
 //!
 //! [`Scene::Sponza`] is a real model, rasterised on the GPU by
 //! [`crate::raster`]: build it with [`Scene::render_on`] or
@@ -21,6 +23,11 @@ const SPONZA_EYE: [f32; 3] = [-11.5, 2.2, -0.3];
 const SPONZA_TARGET: [f32; 3] = [10.0, 4.5, 0.4];
 const SPONZA_FOV: f32 = 60.0;
 
+// The dungeon's default camera (see `Scene::dungeon_camera`).
+const DUNGEON_EYE: [f32; 3] = [-8.0, 3.0, 10.0];
+const DUNGEON_TARGET: [f32; 3] = [15.0, 0.5, -4.0];
+const DUNGEON_FOV: f32 = 60.0;
+
 /// Which synthetic scene to make.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Scene {
@@ -35,6 +42,10 @@ pub enum Scene {
     /// The Dabrovic Sponza atrium (a real model, 76k triangles, 35
     /// materials), rasterised on the GPU from [`Scene::sponza_camera`].
     Sponza,
+    /// A textured game level (the Castle Game Engine's dungeon: base colour
+    /// and normal maps), rasterised on the GPU from [`Scene::dungeon_camera`];
+    /// fetched by `scripts/fetch-dungeon.sh` (see docs/scenes.md).
+    Dungeon,
 }
 
 /// Why a scene could not be built.
@@ -63,16 +74,17 @@ impl Scene {
                 Scene::Sinusoid { angle: *angle, frequency: *frequency }
             }
             ("sponza", []) => Scene::Sponza,
+            ("dungeon", []) => Scene::Dungeon,
             _ => return None,
         })
     }
 
     /// The names [`Scene::parse`] accepts.
-    pub const NAMES: [&str; 5] = ["demo", "gradient", "steps", "sinusoid", "sponza"];
+    pub const NAMES: [&str; 6] = ["demo", "gradient", "steps", "sinusoid", "sponza", "dungeon"];
 
     /// Whether the scene is rasterised on the GPU (and so needs [`Scene::render_on`]).
     pub fn needs_gpu(self) -> bool {
-        matches!(self, Scene::Sponza)
+        matches!(self, Scene::Sponza | Scene::Dungeon)
     }
 
     /// The camera the scene is seen from, for scenes that have a free one
@@ -80,6 +92,7 @@ impl Scene {
     pub fn camera(self) -> Option<Camera> {
         match self {
             Scene::Sponza => Some(Scene::sponza_camera()),
+            Scene::Dungeon => Some(Scene::dungeon_camera()),
             _ => None,
         }
     }
@@ -90,11 +103,18 @@ impl Scene {
         Camera { eye: SPONZA_EYE, target: SPONZA_TARGET, up: [0.0, 1.0, 0.0], fov_y_degrees: SPONZA_FOV }
     }
 
-    /// The G-buffer on `gpu`: rasterised for [`Scene::Sponza`], made on the
+    /// The dungeon's default camera (see docs/scenes.md, "Dungeon").
+    pub fn dungeon_camera() -> Camera {
+        Camera { eye: DUNGEON_EYE, target: DUNGEON_TARGET, up: [0.0, 1.0, 0.0], fov_y_degrees: DUNGEON_FOV }
+    }
+
+    /// The G-buffer on `gpu`: rasterised for the mesh scenes, made on the
     /// CPU (as [`Scene::render`]) for the others.
     pub fn render_on(self, gpu: &Gpu, width: u32, height: u32) -> Result<GBuffer, SceneError> {
         match self {
-            Scene::Sponza => Ok(crate::raster::read_gbuffer(gpu, &self.textures_on(gpu, width, height)?)?),
+            Scene::Sponza | Scene::Dungeon => {
+                Ok(crate::raster::read_gbuffer(gpu, &self.textures_on(gpu, width, height)?)?)
+            }
             _ => Ok(self.render(width, height)),
         }
     }
@@ -106,6 +126,10 @@ impl Scene {
             Scene::Sponza => {
                 let mesh = crate::mesh::sponza_shared()?;
                 Ok(Some(MeshScene::new(gpu, &mesh, Scene::sponza_camera())?))
+            }
+            Scene::Dungeon => {
+                let mesh = crate::mesh::dungeon_shared()?;
+                Ok(Some(MeshScene::new(gpu, &mesh, Scene::dungeon_camera())?))
             }
             _ => Ok(None),
         }
@@ -125,14 +149,14 @@ impl Scene {
     ///
     /// # Panics
     ///
-    /// [`Scene::Sponza`] is rasterised on a GPU: here it makes its own device
-    /// and panics if there is none or the model cannot be loaded. Use
+    /// The mesh scenes are rasterised on a GPU: here they make their own
+    /// device and panic if there is none or the model cannot be loaded. Use
     /// [`Scene::render_on`] to get those failures as errors.
     pub fn render(self, width: u32, height: u32) -> GBuffer {
         match self {
-            Scene::Sponza => {
-                let gpu = Gpu::new().unwrap_or_else(|e| panic!("the Sponza scene needs a GPU adapter: {e}"));
-                self.render_on(&gpu, width, height).unwrap_or_else(|e| panic!("cannot render the Sponza scene: {e}"))
+            Scene::Sponza | Scene::Dungeon => {
+                let gpu = Gpu::new().unwrap_or_else(|e| panic!("the mesh scenes need a GPU adapter: {e}"));
+                self.render_on(&gpu, width, height).unwrap_or_else(|e| panic!("cannot render the {self:?} scene: {e}"))
             }
             Scene::Demo => demo(width, height),
             Scene::Gradient => {
@@ -204,7 +228,7 @@ fn surface(width: u32, height: u32, f: impl Fn(f32, f32) -> (u32, [f32; 3], [f32
             let (u, v) = ((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32);
             let (material, position, normal) = f(u, v);
             let depth = 5.0 - position[2];
-            b.push(position, normalize(normal), [u, v], material, depth);
+            b.push(position, normalize(normal), [u, v], material, depth, GREY);
         }
     }
     b.finish()
@@ -218,7 +242,20 @@ struct Builder {
     uv: Vec<f32>,
     material: Vec<u32>,
     depth: Vec<f32>,
+    albedo: Vec<f32>,
+    roughness: Vec<f32>,
+    metallic: Vec<f32>,
 }
+
+/// The surface of a CPU scene's pixel: (albedo, roughness, metallic).
+type Surface = ([f32; 4], f32, f32);
+
+/// The pattern scenes' surface: a light grey dielectric of medium roughness
+/// (the mesh loaders' default material).
+const GREY: Surface = ([0.8, 0.8, 0.8, 1.0], 0.5, 0.0);
+
+/// The background's: no albedo, fully rough, not metallic (the rasteriser's too).
+const BACKGROUND_SURFACE: Surface = ([0.0; 4], 1.0, 0.0);
 
 impl Builder {
     fn new(width: u32, height: u32) -> Builder {
@@ -231,14 +268,28 @@ impl Builder {
             uv: Vec::with_capacity(2 * n),
             material: Vec::with_capacity(n),
             depth: Vec::with_capacity(n),
+            albedo: Vec::with_capacity(4 * n),
+            roughness: Vec::with_capacity(n),
+            metallic: Vec::with_capacity(n),
         }
     }
-    fn push(&mut self, position: [f32; 3], normal: [f32; 3], uv: [f32; 2], material: u32, depth: f32) {
+    fn push(
+        &mut self,
+        position: [f32; 3],
+        normal: [f32; 3],
+        uv: [f32; 2],
+        material: u32,
+        depth: f32,
+        surface: Surface,
+    ) {
         self.position.extend(position);
         self.normal.extend(normal);
         self.uv.extend(uv);
         self.material.push(material);
         self.depth.push(depth);
+        self.albedo.extend(surface.0);
+        self.roughness.push(surface.1);
+        self.metallic.push(surface.2);
     }
     fn finish(self) -> GBuffer {
         GBuffer {
@@ -250,6 +301,9 @@ impl Builder {
                 ("uv".into(), ChannelData::Float { components: 2, data: self.uv }),
                 ("material".into(), ChannelData::Uint(self.material)),
                 ("depth".into(), ChannelData::Float { components: 1, data: self.depth }),
+                ("albedo".into(), ChannelData::Float { components: 4, data: self.albedo }),
+                ("roughness".into(), ChannelData::Float { components: 1, data: self.roughness }),
+                ("metallic".into(), ChannelData::Float { components: 1, data: self.metallic }),
             ],
         }
     }
@@ -312,9 +366,14 @@ fn demo(width: u32, height: u32) -> GBuffer {
                 }
             }
             match best {
-                Some((t, n, uv, material)) => {
-                    b.push([eye[0] + t * dir[0], eye[1] + t * dir[1], eye[2] + t * dir[2]], n, uv, material, t)
-                }
+                Some((t, n, uv, material)) => b.push(
+                    [eye[0] + t * dir[0], eye[1] + t * dir[1], eye[2] + t * dir[2]],
+                    n,
+                    uv,
+                    material,
+                    t,
+                    demo_surface(material, uv),
+                ),
                 None => {
                     let t = 50.0;
                     b.push(
@@ -323,10 +382,26 @@ fn demo(width: u32, height: u32) -> GBuffer {
                         [0.0, 0.0],
                         BACKGROUND,
                         t,
+                        BACKGROUND_SURFACE,
                     )
                 }
             }
         }
     }
     b.finish()
+}
+
+/// The demo scene's materials: a ground of light and dark tiles (8 per uv
+/// unit), a red plastic, a gold, a glossy blue and a rough white sphere.
+fn demo_surface(material: u32, uv: [f32; 2]) -> Surface {
+    match material {
+        0 => {
+            let light = ((uv[0] * 8.0).floor() + (uv[1] * 8.0).floor()).rem_euclid(2.0) == 0.0;
+            (if light { [0.75, 0.72, 0.66, 1.0] } else { [0.2, 0.19, 0.18, 1.0] }, 0.7, 0.0)
+        }
+        1 => ([0.8, 0.12, 0.08, 1.0], 0.45, 0.0),
+        2 => ([1.0, 0.77, 0.34, 1.0], 0.3, 1.0),
+        3 => ([0.1, 0.3, 0.8, 1.0], 0.15, 0.0),
+        _ => ([0.9, 0.9, 0.88, 1.0], 0.85, 0.0),
+    }
 }

@@ -13,6 +13,7 @@ mod binding;
 mod errors;
 mod modes;
 mod sponza;
+mod textures;
 
 pub use harness::*;
 use libtest_mimic::{Arguments, Trial};
@@ -64,6 +65,14 @@ const GPU_TESTS: &[GpuTest] = &[
     ("sponza::rasterised_quads_match_the_analytic_gbuffer", sponza::rasterised_quads_match_the_analytic_gbuffer),
     ("sponza::sponza_lights_workload_matches_its_reference", sponza::sponza_lights_workload_matches_its_reference),
     ("sponza::scene_files_parse_and_name_their_mistakes", sponza::scene_files_parse_and_name_their_mistakes),
+    ("textures::textured_quads_show_their_texels", textures::textured_quads_show_their_texels),
+    ("textures::minified_textures_average_linear_light", textures::minified_textures_average_linear_light),
+    ("textures::material_maps_reach_the_gbuffer", textures::material_maps_reach_the_gbuffer),
+    ("textures::missing_material_channels_are_typed_errors", textures::missing_material_channels_are_typed_errors),
+    (
+        "textures::pbr_example_renders_textured_content_in_every_mode",
+        textures::pbr_example_renders_textured_content_in_every_mode,
+    ),
 ];
 
 /// Tests that run on the CPU only.
@@ -78,7 +87,13 @@ const CPU_TESTS: &[(&str, fn())] = &[
     ("sponza::obj_written_to_a_temp_dir_loads", sponza::obj_written_to_a_temp_dir_loads),
     ("sponza::gltf_and_glb_written_to_a_temp_dir_load", sponza::gltf_and_glb_written_to_a_temp_dir_load),
     ("sponza::bad_mesh_files_are_typed_errors", sponza::bad_mesh_files_are_typed_errors),
+    ("textures::loaders_report_what_they_skip", textures::loaders_report_what_they_skip),
 ];
+
+/// GPU tests over the textured dungeon, which is fetched separately
+/// (scripts/fetch-dungeon.sh): listed as ignored, after a line saying why,
+/// where it is not there.
+const DUNGEON_TESTS: &[GpuTest] = &[("textures::pbr_example_over_the_dungeon", textures::pbr_example_over_the_dungeon)];
 
 fn main() {
     // Before the test threads and the Vulkan loader start: without it, Mesa
@@ -87,7 +102,11 @@ fn main() {
     // SAFETY: no other thread exists yet.
     unsafe { mrsl_lab::runtime_dir::ensure_xdg_runtime_dir() };
     let args = Arguments::from_args();
-    let gpu = harness::gpu(GPU_TESTS.len());
+    let gpu = harness::gpu(GPU_TESTS.len() + DUNGEON_TESTS.len());
+    let dungeon = mrsl_lab::mesh::dungeon_path();
+    if let (Some(_), Err(e)) = (gpu, &dungeon) {
+        println!("SKIPPING {} render test(s) over the dungeon (reported as ignored below): {e}", DUNGEON_TESTS.len());
+    }
     let mut trials: Vec<Trial> = GPU_TESTS
         .iter()
         .map(|&(name, test)| match gpu {
@@ -98,6 +117,13 @@ fn main() {
             None => Trial::test(name, || Ok(())).with_ignored_flag(true),
         })
         .collect();
+    trials.extend(DUNGEON_TESTS.iter().map(|&(name, test)| match (gpu, &dungeon) {
+        (Some(gpu), Ok(_)) => Trial::test(name, move || {
+            test(gpu);
+            Ok(())
+        }),
+        _ => Trial::test(name, || Ok(())).with_ignored_flag(true),
+    }));
     trials.extend(CPU_TESTS.iter().map(|&(name, test)| {
         Trial::test(name, move || {
             test();

@@ -183,7 +183,7 @@ fn tilted_quads(with_normals: bool) -> Mesh {
     mesh
 }
 
-fn floats<'a>(g: &'a GBuffer, name: &str) -> (&'a [f32], usize) {
+pub fn floats<'a>(g: &'a GBuffer, name: &str) -> (&'a [f32], usize) {
     match g.channel(name) {
         Some(ChannelData::Float { components, data }) => (data, *components as usize),
         other => panic!("{name}: {other:?}"),
@@ -203,7 +203,7 @@ pub fn rasterised_quads_match_the_analytic_gbuffer(gpu: &Gpu) {
         let g = raster::rasterize_gbuffer(gpu, &mesh, &camera, (w, h)).unwrap();
         assert_eq!((g.width, g.height), (w, h));
         let names: Vec<&str> = g.channels.iter().map(|(n, _)| n.as_str()).collect();
-        assert_eq!(names, ["position", "normal", "uv", "material", "depth"]);
+        assert_eq!(names, ["position", "normal", "uv", "material", "depth", "albedo", "roughness", "metallic"]);
         let (position, _) = floats(&g, "position");
         let (normal, _) = floats(&g, "normal");
         let (uv, _) = floats(&g, "uv");
@@ -261,7 +261,7 @@ pub fn rasterised_quads_match_the_analytic_gbuffer(gpu: &Gpu) {
 }
 
 /// A folder of its own under the system's temporary folder.
-fn temp_dir(name: &str) -> PathBuf {
+pub fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mrsl-tests-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
@@ -405,7 +405,7 @@ pub fn gltf_and_glb_written_to_a_temp_dir_load() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-fn base64(bytes: &[u8]) -> String {
+pub fn base64(bytes: &[u8]) -> String {
     const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut out = String::new();
     for chunk in bytes.chunks(3) {
