@@ -629,10 +629,11 @@ pub fn pbr_example_over_the_dungeon(gpu: &Gpu) {
             "dungeon {}x{} {mode}: PSNR {:.2} dB, shaded fraction {:.3}",
             size.0, size.1, m.psnr, adaptive.stats.shaded_fraction
         );
-        // Measured on lavapipe (Mesa 22.3): coarse2x2 49.9 dB at shaded
-        // fraction 0.781, coarse4x4 51.6 at 0.672, dynamic 48.5 at 0.828,
-        // hierarchical 57.2 at 0.624, checkerboard 39.2 at 0.636. The bar is
-        // 4 dB below the lowest, for another driver's rounding.
+        // Measured on lavapipe (Mesa 22.3): coarse2x2 47.8 dB at shaded
+        // fraction 0.766, coarse4x4 43.5 at 0.652, dynamic 42.8 at 0.812,
+        // hierarchical 52.6 at 0.616, checkerboard 36.4 at 0.625. The bar is
+        // 1.3 dB below the lowest, for another driver's rounding (a few
+        // flipped refine decisions cost well under that at this size).
         assert!(m.psnr >= 35.0, "{mode}: PSNR {:.1} dB", m.psnr);
         assert!(adaptive.stats.shaded_fraction < 0.9, "{mode}: shaded {}", adaptive.stats.shaded_fraction);
     }
