@@ -640,13 +640,13 @@ pub fn sponza_lights_workload_matches_its_reference(gpu: &Gpu) {
         assert!(forced.pixels == reference.pixels, "{mode}: forced refinement differs from the reference");
     }
     // Adaptive quality at the program's defaults, measured on lavapipe
-    // (Mesa 22.3) at 192x108: coarse4x4 52.7 dB at shaded fraction 0.980,
-    // hierarchical 59.1 dB at 0.816 (at this size almost every 4x4 block
+    // (Mesa 22.3) at 192x108: coarse4x4 52.7 dB at shaded fraction 0.967,
+    // hierarchical 56.0 dB at 0.751 (at this size almost every 4x4 block
     // holds a silhouette or a crease, which the position and normal keys
     // refine). The bars are 3 dB below, as in the test above: threshold
     // comparisons may flip a few blocks on another driver.
     // (20,427 of 20,504 visible points agreed with the shadow map.)
-    for (mode, bar) in [(Mode::Coarse4x4, 49.7), (Mode::Hierarchical, 56.1)] {
+    for (mode, bar) in [(Mode::Coarse4x4, 49.7), (Mode::Hierarchical, 53.0)] {
         let out = run(mode, false);
         let db = psnr(&out.pixels, &reference.pixels);
         eprintln!("sponza_lights 192x108 {mode}: PSNR {db:.2} dB, shaded fraction {:.4}", out.stats.shaded_fraction);
