@@ -1,0 +1,39 @@
+//! Well-typed programs from the grammar-aware generator
+//! (compiler/tests/it/wellformed.rs), driven by the fuzzer's bytes: each must
+//! pass every check with no diagnostic at all and compile (one block size) to
+//! kernels naga accepts, with no warning.
+#![no_main]
+
+#[path = "../../tests/it/wellformed.rs"]
+mod wellformed;
+
+use arbitrary::Unstructured;
+use libfuzzer_sys::fuzz_target;
+use mrsl::Options;
+
+struct Bytes<'a, 'b>(&'b mut Unstructured<'a>);
+
+impl wellformed::Choices for Bytes<'_, '_> {
+    fn below(&mut self, n: usize) -> usize {
+        if n <= 1 { 0 } else { self.0.choose_index(n).unwrap_or(0) }
+    }
+}
+
+fuzz_target!(|data: &[u8]| {
+    let mut u = Unstructured::new(data);
+    let source = wellformed::program(&mut Bytes(&mut u)).source;
+    let diagnostics = mrsl::check(&source);
+    assert!(
+        diagnostics.is_empty(),
+        "a generated program has diagnostics:\n{source}\n{}",
+        mrsl::render_all(&diagnostics, "generated.mrsl", &source)
+    );
+    let options = Options { block_sizes: vec![4], ..Options::default() };
+    match mrsl::compile(&source, &options) {
+        Ok(program) => assert!(program.warnings.is_empty(), "a generated program warns:\n{source}"),
+        Err(diagnostics) => panic!(
+            "a generated program does not compile:\n{source}\n{}",
+            mrsl::render_all(&diagnostics, "generated.mrsl", &source)
+        ),
+    }
+});
