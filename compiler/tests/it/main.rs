@@ -5,6 +5,7 @@ mod corpus;
 mod examples;
 mod fuzz;
 mod interface;
+mod wellformed;
 
 use mrsl::KernelKind;
 
