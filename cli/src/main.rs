@@ -303,8 +303,24 @@ fn written(result: Result<Vec<PathBuf>, String>) -> ExitCode {
 }
 
 fn read(file: &Path) -> Result<(String, String), String> {
-    let source = std::fs::read_to_string(file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
-    Ok((file.display().to_string(), source))
+    Ok((file.display().to_string(), read_source(file)?))
+}
+
+/// Reads a program. A file that is not UTF-8 is refused with the place of
+/// its first bad byte: "FILE: not valid UTF-8 at byte N (line L, column C)".
+pub(crate) fn read_source(file: &Path) -> Result<String, String> {
+    let bytes = std::fs::read(file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
+    String::from_utf8(bytes).map_err(|e| not_utf8(&file.display().to_string(), e.as_bytes(), e.utf8_error()))
+}
+
+/// The message for a file whose bytes are not UTF-8; the line and the column
+/// (in characters, from 1) are those of the first bad byte.
+fn not_utf8(name: &str, bytes: &[u8], error: std::str::Utf8Error) -> String {
+    let offset = error.valid_up_to();
+    let valid = std::str::from_utf8(&bytes[..offset]).expect("valid up to the error");
+    let line = valid.matches('\n').count() + 1;
+    let column = valid.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    format!("{name}: not valid UTF-8 at byte {offset} (line {line}, column {column})")
 }
 
 fn plural(n: usize) -> &'static str {
@@ -326,5 +342,36 @@ fn report(color: Color, diagnostics: &[Diagnostic], name: &str, source: &str) {
         let _ = mrsl::emit_colored(&mut stream, diagnostics, name, source);
     } else {
         eprint!("{}", mrsl::render_all(diagnostics, name, source));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_file_that_is_not_utf8_is_refused_with_the_place_of_its_first_bad_byte() {
+        let bytes: &[u8] = b"in float3 normal;\nfine out float4 c\xe9 = float4(normal, 1.0);\n";
+        let error = String::from_utf8(bytes.to_vec()).unwrap_err().utf8_error();
+        assert_eq!(not_utf8("a.mrsl", bytes, error), "a.mrsl: not valid UTF-8 at byte 35 (line 2, column 18)");
+        // Columns count characters, not bytes.
+        let mut bytes = "// é\n// λλ ".as_bytes().to_vec();
+        bytes.push(0xFF);
+        let error = std::str::from_utf8(&bytes).unwrap_err();
+        assert_eq!(not_utf8("b.mrsl", &bytes, error), "b.mrsl: not valid UTF-8 at byte 14 (line 2, column 7)");
+    }
+
+    #[test]
+    fn read_source_reports_invalid_utf8_and_keeps_a_byte_order_mark() {
+        let dir = std::env::temp_dir().join(format!("mrslc-read-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let bad = dir.join("bad.mrsl");
+        std::fs::write(&bad, b"in float3 n\xff;\n").unwrap();
+        let message = read_source(&bad).unwrap_err();
+        assert!(message.ends_with(": not valid UTF-8 at byte 11 (line 1, column 12)"), "{message}");
+        let bom = dir.join("bom.mrsl");
+        std::fs::write(&bom, "\u{FEFF}in float3 n;\n").unwrap();
+        assert_eq!(read_source(&bom).unwrap(), "\u{FEFF}in float3 n;\n");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

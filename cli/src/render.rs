@@ -52,10 +52,7 @@ fn progress(what: &str, start: Instant) {
 /// or the diagnostics rendered.
 pub fn compile_program(path: Option<&Path>, builtin: (&str, &str)) -> Result<(String, mrsl::Program), String> {
     let (name, source) = match path {
-        Some(path) => (
-            path.display().to_string(),
-            std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?,
-        ),
+        Some(path) => (path.display().to_string(), crate::read_source(path)?),
         None => (format!("{} (built in)", builtin.0), builtin.1.to_string()),
     };
     let options = Options { file_name: name.clone(), ..Options::default() };

@@ -18,7 +18,11 @@ macro_rules! builtins {
             $($variant,)*
         }
 
-        impl Builtin {
+        /// Whether constant components `x` (and `y`, for two-argument builtins) lie
+/// inside a builtin's domain.
+pub type Domain = fn(f64, f64) -> bool;
+
+impl Builtin {
             /// Every builtin.
             pub const ALL: &[Builtin] = &[$(Builtin::$variant,)*];
 
@@ -246,6 +250,31 @@ impl Builtin {
     /// Whether the builtin is a derivative (see [`Builtin::derivative_operand`]).
     pub fn is_derivative(self) -> bool {
         self.derivative_operand().is_some()
+    }
+
+    /// Where the builtin is defined on constant arguments, as WGSL's constant
+    /// evaluation (naga's) checks it when the shader is created: `None` for
+    /// builtins without such a check, else whether the components `x` (and
+    /// `y`, the second argument's, for `pow`) are inside the domain, and the
+    /// domain in words.
+    pub fn constant_domain(self) -> Option<(Domain, &'static str)> {
+        use Builtin::*;
+        Some(match self {
+            Asin | Acos => (|x, _| x.abs() <= 1.0, "-1 <= x <= 1"),
+            Log | Log2 => (|x, _| x > 0.0, "x > 0"),
+            Sqrt => (|x, _| x >= 0.0, "x >= 0"),
+            InverseSqrt => (|x, _| x > 0.0, "x > 0"),
+            Pow => (
+                |x, y| {
+                    !(x < 0.0
+                        || (x == 1.0 && y.is_infinite())
+                        || (x.is_infinite() && y == 0.0)
+                        || (x == 0.0 && y <= 0.0))
+                },
+                "x >= 0, and y > 0 where x = 0",
+            ),
+            _ => return None,
+        })
     }
 
     /// The WGSL function a call becomes. The derivatives name WGSL's own,

@@ -90,14 +90,19 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
                 checked,
                 facts: &facts,
                 callee,
+                call: call.span,
+                body: &body,
+                rate: effect.rate,
                 statement,
                 params: BTreeSet::new(),
                 effects: BTreeSet::new(),
-                visiting: vec![],
+                visiting: HashSet::new(),
+                path: vec![],
+                walked: HashSet::new(),
                 reported: HashSet::new(),
                 diagnostics: &mut diagnostics,
             };
-            walk.expr(operand, None);
+            walk.expr(operand);
             let (params, effects) = (walk.params, walk.effects);
             info.effects_at_neighbours.extend(effects.iter().copied());
             info.site_of.insert(call.id, info.sites.len());
@@ -361,85 +366,266 @@ fn collect_assignments<'a>(
 }
 
 /// Walks a derivative operand, inlining single definitions and collecting
-/// the invariant locals and effects it needs.
+/// the invariant locals and effects it needs. The definitions are followed
+/// depth-first with an explicit stack, each once: a chain of any length
+/// neither recurses nor, when locals are read more than once, repeats work.
 struct OperandWalk<'w, 'a> {
     checked: &'w Checked<'a>,
     facts: &'w LocalFacts<'a>,
     callee: &'w Ident,
+    /// The derivative call, and the effect body and rate it is in (for diagnostics).
+    call: Span,
+    body: &'w [&'a Stmt],
+    rate: Rate,
     /// Top-level statement holding the derivative.
     statement: usize,
     params: BTreeSet<LocalId>,
     effects: BTreeSet<EffectId>,
-    visiting: Vec<LocalId>,
+    /// Single-definition locals whose definition is being walked: the current path.
+    visiting: HashSet<LocalId>,
+    /// The same path in order, for diagnostics: the operand's own local first.
+    path: Vec<LocalId>,
+    /// Single-definition locals whose definition has been walked.
+    walked: HashSet<LocalId>,
     reported: HashSet<LocalId>,
     diagnostics: &'w mut Vec<Diagnostic>,
 }
 
-impl OperandWalk<'_, '_> {
-    /// `through`: the single-definition local whose definition is being walked.
-    fn expr(&mut self, e: &Expr, through: Option<LocalId>) {
+/// A name read by an expression being walked: its span, text and symbol.
+type NameRead = (Span, String, Option<Symbol>);
+
+impl<'a> OperandWalk<'_, 'a> {
+    /// Walks the operand `e`, then the definitions it leads to.
+    fn expr(&mut self, e: &'a Expr) {
+        // Each frame: the local whose definition it walks (none for the
+        // operand), the names that definition reads, and the next to visit.
+        let mut stack: Vec<(Option<LocalId>, Vec<NameRead>, usize)> = vec![(None, self.names(e), 0)];
+        while let Some((through, names, next)) = stack.last_mut() {
+            let Some((span, name, symbol)) = names.get(*next).cloned() else {
+                if let Some(done) = *through {
+                    self.visiting.remove(&done);
+                    self.path.pop();
+                    self.walked.insert(done);
+                }
+                stack.pop();
+                continue;
+            };
+            *next += 1;
+            let through = *through;
+            match symbol {
+                Some(Symbol::Effect(id)) => {
+                    self.effects.insert(id);
+                }
+                Some(Symbol::Local(local)) => {
+                    if let Some(definition) = self.local(local, span, &name, through) {
+                        self.visiting.insert(local);
+                        self.path.push(local);
+                        stack.push((Some(local), self.names(definition), 0));
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// The names `e` reads, in source order.
+    fn names(&self, e: &'a Expr) -> Vec<NameRead> {
         let mut names = vec![];
         visit_expr(e, &mut |x| {
             if let ExprKind::Name(name) = &x.kind {
                 names.push((x.span, name.clone(), self.checked.symbols.get(&x.id).copied()));
             }
         });
-        for (span, name, symbol) in names {
-            match symbol {
-                Some(Symbol::Effect(id)) => {
-                    self.effects.insert(id);
-                }
-                Some(Symbol::Local(local)) => self.local(local, span, &name, through),
-                _ => {}
-            }
-        }
+        names
     }
 
-    fn local(&mut self, local: LocalId, span: Span, name: &str, through: Option<LocalId>) {
+    /// Checks a local the operand reads (`through`: the single-definition
+    /// local whose definition reads it); returns its definition when that
+    /// must be walked next.
+    fn local(&mut self, local: LocalId, span: Span, name: &str, through: Option<LocalId>) -> Option<&'a Expr> {
         let facts = self.facts;
         if facts.is_invariant(local) {
             if through.is_some() && !facts.is_stable(local) {
-                let via = through.map(|l| self.checked.locals[l.index()].name.clone()).unwrap_or_default();
-                self.error(local, span, name, format!("`{name}` is assigned again after `{via}` is computed from it, so its value at the neighbour is not known"));
-                return;
+                self.error(local, span, name, Why::Stale);
+                return None;
             }
             self.params.insert(local);
-            return;
+            return None;
         }
         match facts.definitions.get(&local) {
             Some((_, Some(defined_at))) if *defined_at >= self.statement => {
-                self.error(local, span, name, format!("`{name}` is differentiated before it is assigned"));
+                self.error(local, span, name, Why::Before);
+                None
             }
-            Some((definition, _)) => {
-                if self.visiting.contains(&local) {
-                    return;
-                }
-                self.visiting.push(local);
-                self.expr(definition, Some(local));
-                self.visiting.pop();
+            // Read again through its own definition: a definition that reads
+            // the local it assigns (`a = a + x;`), directly or through others,
+            // reads the value from before the assignment, which inlining
+            // cannot give (and would never finish).
+            Some(_) if self.visiting.contains(&local) => {
+                self.error(local, span, name, Why::SelfRead);
+                None
             }
-            None => self.error(
-                local,
-                span,
-                name,
-                format!("`{name}` is assigned more than once or inside a branch or loop, so it cannot be recomputed at the neighbouring sample"),
-            ),
+            Some(_) if self.walked.contains(&local) => None,
+            Some((definition, _)) => Some(*definition),
+            None => {
+                self.error(local, span, name, Why::Unstable);
+                None
+            }
         }
     }
 
-    fn error(&mut self, local: LocalId, span: Span, name: &str, why: String) {
+    fn error(&mut self, local: LocalId, span: Span, name: &str, why: Why) {
         if !self.reported.insert(local) {
             return;
         }
+        const NOTE: &str = "a derivative re-evaluates its operand at the neighbouring sample: differentiate locals \
+                            that are assigned exactly once, where they are declared, or the expression they are built from";
         let decl = self.checked.locals[local.index()].span;
-        self.diagnostics.push(
-            Diagnostic::error("E0503", format!("`{}` cannot differentiate `{name}`", self.callee.name))
-                .with_label(Label::primary(span, why))
-                .with_label(Label::secondary(decl, "declared here"))
-                .with_note(
-                    "a derivative re-evaluates its operand at the neighbouring sample: differentiate locals that are \
-                     assigned exactly once, where they are declared, or the expression they are built from",
-                ),
+        let unstable = format!(
+            "`{name}` is assigned more than once or inside a branch or loop, so it cannot be recomputed at the neighbouring sample"
         );
+        // Reached through an inlined definition: `span` is in that definition,
+        // away from the derivative, so the derivative is the primary label
+        // and the labels below it trace the operand to `name`.
+        let (Some(&first), Some(&through)) = (self.path.first(), self.path.last()) else {
+            let why = match why {
+                Why::Before => format!("`{name}` is differentiated before it is assigned"),
+                Why::SelfRead => format!("`{name}` is read by its own definition, before it is assigned"),
+                Why::Stale | Why::Unstable => unstable,
+            };
+            self.diagnostics.push(
+                Diagnostic::error("E0503", format!("`{}` cannot differentiate `{name}`", self.callee.name))
+                    .with_label(Label::primary(span, why))
+                    .with_label(Label::secondary(decl, "declared here"))
+                    .with_note(NOTE),
+            );
+            return;
+        };
+        let operand = &self.checked.locals[first.index()].name;
+        let via = &self.checked.locals[through.index()].name;
+        let callee = &self.callee.name;
+        let site = match why {
+            Why::Before | Why::SelfRead => None,
+            Why::Stale | Why::Unstable => assignment_site(self.body, self.checked, local),
+        };
+        let used = match (why, site) {
+            (Why::Before, _) => {
+                format!("`{via}` is computed from `{name}`, which is assigned only after the derivative")
+            }
+            (Why::SelfRead, _) if via == name => {
+                format!("`{name}` is read by its own definition, before it is assigned")
+            }
+            (Why::SelfRead, _) => {
+                format!("`{via}` is computed from `{name}`, which reads `{via}` before it is assigned")
+            }
+            (Why::Stale, _) => format!(
+                "`{via}` is computed from `{name}`, which is assigned more than once, so its value at the neighbouring \
+                 sample is not known"
+            ),
+            (Why::Unstable, Some(_)) => {
+                format!("`{via}` is computed from `{name}`, which cannot be recomputed at the neighbouring sample")
+            }
+            (Why::Unstable, None) => format!("`{via}` is computed from `{name}`: {unstable}"),
+        };
+        let mut d = Diagnostic::error("E0503", format!("`{callee}` cannot differentiate `{operand}`"))
+            .with_label(Label::primary(
+                self.call,
+                format!("`{callee}` re-evaluates `{operand}` at the neighbouring sample"),
+            ))
+            .with_label(Label::secondary(span, used));
+        d = match site {
+            Some((at, nesting)) => d.with_label(Label::secondary(
+                at,
+                match nesting {
+                    Nesting::Loop => format!("`{name}` is assigned inside a loop"),
+                    Nesting::Branch => format!("`{name}` is assigned inside a branch"),
+                    Nesting::Again => format!("`{name}` is assigned again here"),
+                },
+            )),
+            None => d.with_label(Label::secondary(decl, "declared here")),
+        };
+        d = d.with_note(NOTE);
+        if let (Why::Unstable, Some((_, Nesting::Loop | Nesting::Branch))) = (why, site) {
+            let rate = match self.rate {
+                Rate::Coarse => "coarse effect",
+                Rate::Fine | Rate::Out => "fine effect",
+            };
+            let ty = &self.checked.locals[local.index()].ty;
+            d = d.with_note(format!(
+                "help: or build `{name}` in an effect of its own, `{rate} {ty} {name}_effect {{ ... }}`, and read \
+                 that: an effect is recomputed at the neighbouring sample however it is built"
+            ));
+        }
+        self.diagnostics.push(d);
     }
+}
+
+/// Why a local in a derivative operand cannot be recomputed at a neighbour.
+#[derive(Clone, Copy)]
+enum Why {
+    /// Invariant, but assigned again: an inlined definition may have read another value.
+    Stale,
+    /// Its single assignment comes after the derivative.
+    Before,
+    /// Neither invariant nor single-definition.
+    Unstable,
+    /// Read by its own definition, directly or through others (`a = a + x;`):
+    /// the value from before the assignment, which inlining cannot give.
+    SelfRead,
+}
+
+/// Why an assignment makes a local impossible to recompute at a neighbour.
+#[derive(Clone, Copy, PartialEq)]
+enum Nesting {
+    Loop,
+    Branch,
+    /// A second assignment at the top level of the body.
+    Again,
+}
+
+/// For diagnostics: the assignment to `local` that stops it from being
+/// recomputed at a neighbour, the first one inside a loop, else inside a
+/// branch, else the second one.
+fn assignment_site(body: &[&Stmt], checked: &Checked, local: LocalId) -> Option<(Span, Nesting)> {
+    fn walk(
+        s: &Stmt,
+        checked: &Checked,
+        local: LocalId,
+        nesting: Option<Nesting>,
+        out: &mut Vec<(Span, Option<Nesting>)>,
+    ) {
+        match &s.kind {
+            StmtKind::Local { init: Some(_), .. } if checked.local_decls.get(&s.id) == Some(&local) => {
+                out.push((s.span, nesting))
+            }
+            StmtKind::Assign { target, .. } | StmtKind::Step { target, .. }
+                if root_local(target, checked) == Some(local) =>
+            {
+                out.push((s.span, nesting))
+            }
+            StmtKind::If { then, otherwise, .. } => {
+                let inner = nesting.or(Some(Nesting::Branch));
+                walk(then, checked, local, inner, out);
+                if let Some(o) = otherwise {
+                    walk(o, checked, local, inner, out);
+                }
+            }
+            StmtKind::For { step, body, .. } => {
+                if let Some(st) = step {
+                    walk(st, checked, local, Some(Nesting::Loop), out);
+                }
+                walk(body, checked, local, Some(Nesting::Loop), out);
+            }
+            StmtKind::Block(b) => b.stmts.iter().for_each(|s| walk(s, checked, local, nesting, out)),
+            _ => {}
+        }
+    }
+    let mut sites = vec![];
+    for s in body {
+        walk(s, checked, local, None, &mut sites);
+    }
+    let find = |n: Nesting| sites.iter().find(|(_, k)| *k == Some(n)).map(|(span, _)| (*span, n));
+    find(Nesting::Loop)
+        .or_else(|| find(Nesting::Branch))
+        .or_else(|| sites.get(1).map(|(span, _)| (*span, Nesting::Again)))
 }

@@ -97,11 +97,12 @@ impl Diagnostic {
 
 /// Renders several diagnostics, without colour, one after another.
 pub fn render_all(diagnostics: &[Diagnostic], file_name: &str, source: &str) -> String {
-    let file = SimpleFile::new(file_name, clamp_source(source));
+    let (shown, skipped) = shown_source(source);
     let config = term::Config::default();
     let mut out = String::new();
     for diagnostic in diagnostics {
-        let d = clamp_spans(diagnostic, source);
+        let d = clamp_spans(diagnostic, shown, skipped);
+        let file = SimpleFile::new(file_name, visible_at_labels(shown, &d));
         let one = term::emit_into_string(&config, &file, &d.to_codespan())
             .unwrap_or_else(|_| format!("{}[{}]: {}\n", severity_word(d.severity), d.code, d.message));
         out.push_str(&one);
@@ -116,10 +117,11 @@ pub fn emit_colored(
     file_name: &str,
     source: &str,
 ) -> std::io::Result<()> {
-    let file = SimpleFile::new(file_name, clamp_source(source));
+    let (shown, skipped) = shown_source(source);
     let config = term::Config::default();
     for diagnostic in diagnostics {
-        let d = clamp_spans(diagnostic, source);
+        let d = clamp_spans(diagnostic, shown, skipped);
+        let file = SimpleFile::new(file_name, visible_at_labels(shown, &d));
         term::emit_to_write_style(writer, &config, &file, &d.to_codespan()).map_err(std::io::Error::other)?;
     }
     Ok(())
@@ -133,14 +135,48 @@ fn severity_word(severity: Severity) -> &'static str {
     }
 }
 
-fn clamp_source(source: &str) -> &str {
-    source
+/// The text diagnostics show, and how many bytes were cut from its start:
+/// a byte order mark is not shown, so that it moves no column on line 1.
+fn shown_source(source: &str) -> (&str, usize) {
+    match source.strip_prefix('\u{FEFF}') {
+        Some(rest) => (rest, source.len() - rest.len()),
+        None => (source, 0),
+    }
 }
 
-/// Keeps every span inside the source and on char boundaries, so rendering never fails.
-fn clamp_spans(diagnostic: &Diagnostic, source: &str) -> Diagnostic {
+/// The source with every character a label starts at and that takes no
+/// column on a terminal (NUL, a zero-width space, a combining mark) replaced
+/// by a visible stand-in of the same length in bytes, so that the label's
+/// caret shows. Columns count characters, so they do not move.
+fn visible_at_labels<'s>(source: &'s str, diagnostic: &Diagnostic) -> std::borrow::Cow<'s, str> {
+    let mut text = std::borrow::Cow::Borrowed(source);
+    for label in &diagnostic.labels {
+        let at = label.span.start as usize;
+        let Some(c) = source[at..].chars().next() else { continue };
+        let combining =
+            !c.is_ascii() && unicode_ident::is_xid_continue(c) && !unicode_ident::is_xid_start(c) && !c.is_numeric();
+        let invisible = (c.is_control() && !matches!(c, '\t' | '\n' | '\r'))
+            || combining
+            || matches!(c, '\u{AD}' | '\u{200B}'..='\u{200F}' | '\u{2028}'..='\u{202E}' | '\u{2060}'..='\u{2064}' | '\u{FEFF}');
+        let stand_in = match c.len_utf8() {
+            1 => " ",
+            2 => "\u{B7}",
+            3 => "\u{25CC}",
+            _ => continue,
+        };
+        if invisible {
+            text.to_mut().replace_range(at..at + c.len_utf8(), stand_in);
+        }
+    }
+    text
+}
+
+/// Moves every span into the shown source (spans are offsets into the whole
+/// source, `skipped` bytes longer) and keeps it inside and on char
+/// boundaries, so rendering never fails.
+fn clamp_spans(diagnostic: &Diagnostic, source: &str, skipped: usize) -> Diagnostic {
     let floor = |mut i: usize| {
-        i = i.min(source.len());
+        i = i.saturating_sub(skipped).min(source.len());
         while !source.is_char_boundary(i) {
             i -= 1;
         }

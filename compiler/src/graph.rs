@@ -3,8 +3,9 @@
 use crate::check::{Checked, EffectId};
 use crate::diagnostic::{Diagnostic, Label};
 use crate::syntax::ast::{Rate, Span};
-use petgraph::algo::tarjan_scc;
+use petgraph::algo::kosaraju_scc;
 use petgraph::graph::{DiGraph, NodeIndex};
+use std::collections::HashSet;
 
 /// What the later stages need of the graph whose nodes are effects and
 /// outputs and whose edges are uses (from the used effect to its user); the
@@ -65,8 +66,10 @@ pub fn build(checked: &Checked) -> (EffectGraph, Vec<Diagnostic>) {
         }
     }
     // Phase 3: strongly connected components; each non-trivial one is a cycle.
+    // (Kosaraju's algorithm in petgraph is iterative; its Tarjan recurses
+    // once per effect along a chain of dependencies.)
     let mut cyclic = false;
-    for scc in tarjan_scc(&graph) {
+    for scc in kosaraju_scc(&graph) {
         let is_cycle = scc.len() > 1 || graph.contains_edge(scc[0], scc[0]);
         if !is_cycle {
             continue;
@@ -111,38 +114,35 @@ pub fn build(checked: &Checked) -> (EffectGraph, Vec<Diagnostic>) {
 }
 
 /// A simple cycle through the nodes of one strongly connected component,
-/// starting from its first declared effect.
+/// starting from its first declared effect: the first path back to it that a
+/// depth-first search finds, taking neighbours in id order (with an explicit
+/// stack, as a component may be a cycle of any length).
 fn cycle_path(graph: &DiGraph<EffectId, Span>, scc: &[NodeIndex]) -> Vec<NodeIndex> {
     let start = *scc.iter().min().expect("an SCC is never empty");
-    let in_scc = |n: NodeIndex| scc.contains(&n);
-    // Depth-first search for a path back to `start` within the component.
-    let mut path = vec![start];
-    let mut visited = vec![start];
-    fn dfs(
-        graph: &DiGraph<EffectId, Span>,
-        start: NodeIndex,
-        path: &mut Vec<NodeIndex>,
-        visited: &mut Vec<NodeIndex>,
-        in_scc: &dyn Fn(NodeIndex) -> bool,
-    ) -> bool {
-        let current = *path.last().expect("path starts non-empty");
-        let mut next: Vec<NodeIndex> = graph.neighbors(current).collect();
+    let in_scc: HashSet<NodeIndex> = scc.iter().copied().collect();
+    let sorted_neighbours = |n: NodeIndex| {
+        let mut next: Vec<NodeIndex> = graph.neighbors(n).collect();
         next.sort();
-        for n in next {
-            if n == start {
-                return true;
-            }
-            if in_scc(n) && !visited.contains(&n) {
-                visited.push(n);
-                path.push(n);
-                if dfs(graph, start, path, visited, in_scc) {
-                    return true;
-                }
-                path.pop();
-            }
+        next.reverse();
+        next
+    };
+    let mut path = vec![start];
+    let mut visited: HashSet<NodeIndex> = HashSet::from([start]);
+    // The neighbours still to try from each node of `path`, last first.
+    let mut untried = vec![sorted_neighbours(start)];
+    while let Some(candidates) = untried.last_mut() {
+        let Some(n) = candidates.pop() else {
+            untried.pop();
+            path.pop();
+            continue;
+        };
+        if n == start {
+            break;
         }
-        false
+        if in_scc.contains(&n) && visited.insert(n) {
+            path.push(n);
+            untried.push(sorted_neighbours(n));
+        }
     }
-    dfs(graph, start, &mut path, &mut visited, &in_scc);
     path
 }

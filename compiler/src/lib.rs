@@ -34,11 +34,14 @@ mod diagnostic;
 mod graph;
 mod interface;
 mod layout;
+mod limits;
 mod syntax;
 mod types;
+mod validate;
 
 pub use diagnostic::{Diagnostic, Label, Severity, emit_colored, render_all};
 pub use mrsl_abi::{CompiledProgram, Kernel, KernelKind, Layout};
+use validate::{NagaFailure, generated_context, join_validation, naga_validate, spawn_validation, with_stack};
 
 /// The stages behind [`compile`], for the compiler's own benchmarks and tests
 /// only: not part of the API, and free to change with the stages.
@@ -103,8 +106,11 @@ impl std::ops::Deref for Program {
 
 /// Parses and checks a program without generating code: every diagnostic,
 /// errors and warnings, in source order.
+///
+/// Like [`compile`], it runs on a thread of its own with a large stack, so
+/// it works the same from any thread (see `validate::STACK`).
 pub fn check(source: &str) -> Vec<Diagnostic> {
-    front_end(source, |_, _, _, warnings| warnings).unwrap_or_else(|errors| errors)
+    with_stack(|| front_end(source, |_, _, _, warnings| warnings).unwrap_or_else(|errors| errors))
 }
 
 /// Compiles a program to kernels and a layout, or returns its diagnostics
@@ -116,18 +122,17 @@ pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnosti
                 .with_note("supported block sizes: 2, 4"),
         ]);
     }
-    front_end(source, |checked, graph, deriv, diagnostics| {
-        generate(source, options, checked, graph, deriv, diagnostics)
-    })?
+    with_stack(|| {
+        front_end(source, |checked, graph, deriv, diagnostics| {
+            generate(source, options, checked, graph, deriv, diagnostics)
+        })?
+    })
 }
 
-/// Parses and validates WGSL with naga, as WebGPU requires (no optional capabilities).
+/// Parses and validates WGSL with naga, as WebGPU requires (no optional
+/// capabilities), on a thread with a large stack (see `validate::STACK`).
 pub fn validate_wgsl(wgsl: &str) -> Result<(), String> {
-    let module = naga::front::wgsl::parse_str(wgsl).map_err(|e| e.emit_to_string_with_path(wgsl, "generated.wgsl"))?;
-    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
-        .validate(&module)
-        .map_err(|e| e.emit_to_string_with_path(wgsl, "generated.wgsl"))?;
-    Ok(())
+    with_stack(|| naga_validate(wgsl)).map_err(|f| f.report)
 }
 
 /// Block sizes the generated kernels support.
@@ -186,12 +191,12 @@ fn generate(
         .collect();
     // naga validation dominates compile time; the kernels are independent, so
     // they are validated on as many threads as there are kernels.
-    let verdicts: Vec<Result<(), String>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = texts.iter().map(|(_, _, wgsl)| scope.spawn(move || validate_wgsl(wgsl))).collect();
-        handles.into_iter().map(|h| h.join().unwrap_or_else(|_| Err("naga panicked while validating".into()))).collect()
+    let verdicts: Vec<Result<(), NagaFailure>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = texts.iter().map(|(_, _, wgsl)| spawn_validation(scope, wgsl)).collect();
+        handles.into_iter().map(join_validation).collect()
     });
     for ((kind, block, wgsl), verdict) in texts.into_iter().zip(verdicts) {
-        if let Err(message) = verdict {
+        if let Err(failure) = verdict {
             let what = match block {
                 Some(b) => format!("{} kernel ({b}x{b})", kind.name()),
                 None => format!("{} kernel", kind.name()),
@@ -201,7 +206,8 @@ fn generate(
                     .with_note(
                         "the program passed every check, so this is a bug in mrsl; please report it with the program",
                     )
-                    .with_note(message),
+                    .with_note(format!("naga: {}", failure.message))
+                    .with_note(generated_context(&wgsl, failure.offset)),
             ]);
         }
         kernels.push(Kernel { kind, block_size: block, wgsl });
@@ -216,11 +222,20 @@ fn front_end<R>(
     then: impl FnOnce(&check::Checked, &graph::EffectGraph, &deriv::DerivInfo, Vec<Diagnostic>) -> R,
 ) -> Result<R, Vec<Diagnostic>> {
     let program = syntax::parse(source).map_err(|d| vec![d])?;
+    // Before anything recurses over the tree: past the nesting limits, stop.
+    let mut too_deep = limits::nesting(&program);
+    if !too_deep.is_empty() {
+        sort(&mut too_deep);
+        return Err(too_deep);
+    }
     let (checked, mut diagnostics) = check::check(&program);
     let (graph, graph_diagnostics) = graph::build(&checked);
     diagnostics.extend(graph_diagnostics);
     let (deriv, deriv_diagnostics) = deriv::analyse(&checked);
     diagnostics.extend(deriv_diagnostics);
+    if !diagnostics.iter().any(|d| d.is_error()) {
+        diagnostics.extend(limits::derivatives(&checked, &deriv));
+    }
     sort(&mut diagnostics);
     if diagnostics.iter().any(|d| d.is_error()) {
         return Err(diagnostics);
@@ -230,4 +245,53 @@ fn front_end<R>(
 
 fn sort(diagnostics: &mut [Diagnostic]) {
     diagnostics.sort_by_key(|d| (d.span().map(|s| s.start).unwrap_or(u32::MAX), d.code));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The codes `front_end` reports for `source`, run on a 256 KiB stack
+    /// rather than the one `check` and `compile` provide.
+    fn front_end_on_a_small_stack(source: String) -> Vec<&'static str> {
+        let run = move || {
+            let diagnostics = front_end(&source, |_, _, _, warnings| warnings).unwrap_or_else(|errors| errors);
+            diagnostics.iter().map(|d| d.code).collect()
+        };
+        std::thread::Builder::new().stack_size(256 << 10).spawn(run).expect("a thread starts").join().expect("no panic")
+    }
+
+    /// Nothing in the front end recurses along what the nesting limits do
+    /// not bound (`tests/it/limits.rs` tests the limits themselves): a tree
+    /// past them is measured and dropped without recursion, and chains of
+    /// constants, effects and locals, which do not nest in the source, are
+    /// followed without recursion, each link once.
+    #[test]
+    fn the_front_end_takes_long_inputs_on_a_small_stack() {
+        let header = "in float3 normal;\n";
+        let unary = format!("{header}fine out float o = {}normal.x;\n", "- + ".repeat(50_000));
+        assert_eq!(front_end_on_a_small_stack(unary), ["E0602"]);
+        let blocks =
+            format!("{header}fine out float o {{\n o = 0.0;\n{}{}}}\n", "{\n".repeat(100_000), "}\n".repeat(100_000));
+        assert_eq!(front_end_on_a_small_stack(blocks), ["E0603"]);
+        let n = 3_000;
+        let consts: String = (0..n).map(|k| format!("const float c{k} = c{} + 1.0;\n", k + 1)).collect();
+        let consts = format!("{header}{consts}const float c{n} = 1.0;\nfine out float o = c0 * normal.x;\n");
+        assert_eq!(front_end_on_a_small_stack(consts), [""; 0]);
+        let chain: String = (1..n).map(|k| format!("fine effect float e{k} = e{} + 1.0;\n", k - 1)).collect();
+        let chain = format!("{header}fine effect float e0 = normal.x;\n{chain}fine out float o = e{};\n", n - 1);
+        assert_eq!(front_end_on_a_small_stack(chain), [""; 0]);
+        let cycle: String = (0..n).map(|k| format!("fine effect float e{k} = e{} + 1.0;\n", (k + 1) % n)).collect();
+        assert_eq!(front_end_on_a_small_stack(format!("{header}{cycle}fine out float o = e0;\n")), ["E0311"]);
+        let derivative = |n: usize, step: &str| {
+            let locals: String = (1..=n)
+                .map(|k| format!("float a{k} = {};\n", step.replace("{prev}", &format!("a{}", k - 1))))
+                .collect();
+            format!(
+                "{header}coarse effect float s {{\nfloat a0 = normal.x;\n{locals}s = ddx(a{n});\n}}\nfine out float o = s;\n"
+            )
+        };
+        assert_eq!(front_end_on_a_small_stack(derivative(n, "{prev} * normal.y")), ["E0604"]);
+        assert_eq!(front_end_on_a_small_stack(derivative(60, "{prev} * {prev}")), ["E0604"]);
+    }
 }

@@ -47,7 +47,7 @@ impl Type {
         if let Some(s) = scalar(name) {
             return Some(Type::Scalar(s));
         }
-        let (base, n) = name.split_at(name.len().checked_sub(1)?);
+        let (base, n) = name.split_at_checked(name.len().checked_sub(1)?)?;
         let n: u8 = n.parse().ok()?;
         if (2..=4).contains(&n) {
             return scalar(base).map(|s| Type::Vector(s, n));

@@ -95,7 +95,9 @@ fn generic(name: &str, args: &[Type], widen: &[usize], accept: &Accept) -> Resul
     };
     for &p in widen {
         let a = &args[p];
-        if a.components() == 1 && t.vector_len().is_some() && !elements_unify(a, &t) {
+        // A scalar in a widened position must still be of T's element type
+        // (WGSL converts literals, never `int` to `float`).
+        if a.components() == 1 && !elements_unify(a, &t) {
             return Err(Types(format!("`{name}`: `{a}` does not match `{t}`")));
         }
     }

@@ -3,15 +3,64 @@
 //! when the shader is created (so that such programs fail here, not in naga).
 
 use super::{Checker, ConstId, ConstValue, Ctx, Global, err};
+use crate::builtins::Builtin;
 use crate::syntax::ast::*;
 use crate::syntax::visit_expr;
 use crate::types::{self, Scalar, Type};
 use std::collections::HashMap;
 
 impl Checker<'_> {
+    /// The value of a constant, evaluated once (a failure, too, is reported
+    /// once). The constants it reads are evaluated first, deepest first and
+    /// without recursion, so that a chain of constants of any length, in any
+    /// declaration order, is evaluated in constant stack space.
     pub(super) fn const_value(&mut self, id: ConstId) -> Option<ConstValue> {
-        if let Some(v) = &self.out.consts[id.index()].value {
-            return Some(v.clone());
+        if self.evaluated_consts.contains(&id.0) || self.evaluating_consts.contains(&id.0) {
+            return self.evaluate_const(id);
+        }
+        // Depth-first over the constants each initialiser names; a constant
+        // is evaluated when those it names are. A constant met again on the
+        // current path is left to `evaluate_const`, which reports the cycle.
+        let mut stack = vec![(id, self.consts_named(id))];
+        self.evaluating_consts.insert(id.0);
+        while let Some((c, named)) = stack.last_mut() {
+            match named.pop() {
+                Some(next) => {
+                    if !self.evaluated_consts.contains(&next.0) && self.evaluating_consts.insert(next.0) {
+                        let named = self.consts_named(next);
+                        stack.push((next, named));
+                    }
+                }
+                None => {
+                    let c = *c;
+                    stack.pop();
+                    self.evaluating_consts.remove(&c.0);
+                    self.evaluate_const(c);
+                }
+            }
+        }
+        self.out.consts[id.index()].value.clone()
+    }
+
+    /// The constants the initialiser of `id` names, last first.
+    fn consts_named(&self, id: ConstId) -> Vec<ConstId> {
+        let mut named = vec![];
+        visit_expr(&self.out.const_decl(id).value, &mut |x| {
+            if let ExprKind::Name(name) = &x.kind
+                && let Some((Global::Const(c), _)) = self.globals.get(name)
+            {
+                named.push(*c);
+            }
+        });
+        named.reverse();
+        named
+    }
+
+    /// Evaluates one constant whose named constants are evaluated already
+    /// (see [`Checker::const_value`]), or returns its value if it is.
+    fn evaluate_const(&mut self, id: ConstId) -> Option<ConstValue> {
+        if self.evaluated_consts.contains(&id.0) {
+            return self.out.consts[id.index()].value.clone();
         }
         if !self.evaluating_consts.insert(id.0) {
             let decl = self.out.const_decl(id);
@@ -52,6 +101,7 @@ impl Checker<'_> {
         };
         self.out.consts[id.index()].value = value.clone();
         self.evaluating_consts.remove(&id.0);
+        self.evaluated_consts.insert(id.0);
         value
     }
 
@@ -165,5 +215,34 @@ impl Checker<'_> {
         };
         self.error(err("E0205", format!("constant expression out of range for `{}`", ty.concretize()), e.span, what));
         false
+    }
+
+    /// Reports a builtin call on constant arguments outside the builtin's
+    /// domain (`log(-1)`, `sqrt(-1)`, `pow(-1, 2)`): WGSL evaluates such a
+    /// call when the shader is created and rejects it there.
+    pub(super) fn constant_arguments_in_domain(&mut self, builtin: Builtin, call: &Expr, args: &[Expr]) {
+        let Some((inside, domain)) = builtin.constant_domain() else { return };
+        let Some(x) = args.first().and_then(|a| self.const_eval(a)) else { return };
+        let y = match args.get(1) {
+            Some(a) => match self.const_eval(a) {
+                Some(y) => y.values,
+                None => return,
+            },
+            None => vec![0.0],
+        };
+        let at = |values: &[f64], i: usize| values[if values.len() == 1 { 0 } else { i.min(values.len() - 1) }];
+        let n = x.values.len().max(y.len());
+        let Some(bad) = (0..n).find(|&i| !inside(at(&x.values, i), at(&y, i))) else { return };
+        let shown = if args.len() == 2 {
+            format!("x = {}, y = {}", at(&x.values, bad), at(&y, bad))
+        } else {
+            format!("x = {}", at(&x.values, bad))
+        };
+        let name = builtin.name();
+        self.error(
+            err("E0213", format!("`{name}` of constant arguments outside its domain"), call.span, shown)
+                .with_note(format!("`{name}` is defined for {domain}"))
+                .with_note("WGSL evaluates calls on constants when the shader is created, and rejects this one"),
+        );
     }
 }

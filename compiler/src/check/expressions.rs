@@ -3,10 +3,10 @@
 //! constructors, user functions and builtins.
 
 use super::builtins::{BuiltinError, builtin_type};
-use super::names::{TYPE_NAMES, suggest};
+use super::names::{TYPE_NAMES, suggest, well_known_uniform};
 use super::typing::{binary_type, construct_check, unify};
 use super::{Callee, Checker, Ctx, Global, LocalId, Symbol, err};
-use crate::builtins::Builtin;
+use crate::builtins::{Builtin, Rule};
 use crate::diagnostic::{Diagnostic, Label};
 use crate::syntax::ast::*;
 use crate::types::{self, Scalar, Type};
@@ -161,6 +161,8 @@ impl Checker<'_> {
                 self.globals.keys().cloned().chain(self.scopes.iter().flat_map(|s| s.keys().cloned())).collect();
             if let Some(s) = suggest(name, candidates.iter().map(|s| s.as_str())) {
                 d = d.with_note(format!("did you mean `{s}`?"));
+            } else if let Some(ty) = well_known_uniform(name).filter(|_| self.ctx != Ctx::Global) {
+                d = d.with_note(format!("help: declare it: `uniform {ty} {name};`"));
             }
             self.error(d);
             return Type::Error;
@@ -408,6 +410,18 @@ impl Checker<'_> {
             self.out.callees.insert(e.id, Callee::Builtin(builtin));
             return match builtin_type(builtin, &arg_types) {
                 Ok((ret, splat_to)) => {
+                    self.constant_arguments_in_domain(builtin, e, args);
+                    // Literal arguments take the type of the concrete ones (`min(2u, -1)`
+                    // makes `-1` a `uint`), so they must fit it, as WGSL checks.
+                    let concrete =
+                        arg_types.iter().find(|t| !t.is_abstract() && !t.is_error()).and_then(|t| t.scalar());
+                    if let (Some(scalar), Rule::Generic { .. }) = (concrete, builtin.signature().rule) {
+                        for (arg, at) in args.iter().zip(&arg_types) {
+                            if at.is_abstract() {
+                                self.constant_in_range(arg, &Type::Scalar(scalar));
+                            }
+                        }
+                    }
                     if let Some(target) = splat_to {
                         for (arg, at) in args.iter().zip(&arg_types) {
                             if at.components() == 1 && target.vector_len().is_some() {

@@ -243,6 +243,8 @@ struct Checker<'a> {
     /// Set while checking the operand of a derivative call.
     in_derivative: bool,
     evaluating_consts: HashSet<u32>,
+    /// Constants evaluated, successfully or not.
+    evaluated_consts: HashSet<u32>,
 }
 
 /// An error with one primary label, the shape of most check diagnostics.
@@ -275,6 +277,7 @@ impl<'a> Checker<'a> {
             loop_depth: 0,
             in_derivative: false,
             evaluating_consts: HashSet::new(),
+            evaluated_consts: HashSet::new(),
         }
     }
 

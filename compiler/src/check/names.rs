@@ -1,4 +1,5 @@
-//! "Did you mean" suggestions for unknown names and types.
+//! "Did you mean" suggestions for unknown names and types, and the uniforms
+//! an unknown name may have been meant to declare.
 
 pub(super) const TYPE_NAMES: &[&str] = &[
     "bool",
@@ -23,6 +24,31 @@ pub(super) const TYPE_NAMES: &[&str] = &[
     "texture2d",
     "sampler",
 ];
+
+/// Uniforms that the programs in `examples/` declare, each with the one type
+/// they all give it, and that at least two of them declare: an unknown name
+/// in this table gets the help "declare it: `uniform float3 light_dir;`".
+/// A test checks the table against the examples.
+const WELL_KNOWN_UNIFORMS: &[(&str, &str)] = &[
+    ("albedo_map", "texture2d"),
+    ("ambient", "float"),
+    ("blocker_edge", "float"),
+    ("camera_pos", "float3"),
+    ("checker_scale", "float"),
+    ("curvature_threshold", "float"),
+    ("diffuse_threshold", "float"),
+    ("light_count", "int"),
+    ("light_dir", "float3"),
+    ("linear", "sampler"),
+    ("shadow_map", "texture2d"),
+    ("shininess", "float"),
+    ("sky_color", "float3"),
+];
+
+/// The type the examples give the uniform `name`, if it is well known.
+pub(super) fn well_known_uniform(name: &str) -> Option<&'static str> {
+    WELL_KNOWN_UNIFORMS.iter().find(|(n, _)| *n == name).map(|(_, ty)| *ty)
+}
 
 /// The closest candidate within a small edit distance, for "did you mean".
 pub(super) fn suggest<'s>(name: &str, candidates: impl Iterator<Item = &'s str>) -> Option<&'s str> {
@@ -51,4 +77,37 @@ fn edit_distance(a: &str, b: &str) -> usize {
         prev = cur;
     }
     prev[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::BTreeMap;
+
+    /// Every well-known uniform is declared, with that type and as no array,
+    /// by at least two examples, and with no other type by any.
+    #[test]
+    fn well_known_uniforms_are_those_of_the_examples() {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples");
+        let mut declared: BTreeMap<String, Vec<String>> = BTreeMap::new();
+        for entry in std::fs::read_dir(dir).expect("examples/ exists") {
+            let path = entry.unwrap().path();
+            if path.extension().is_none_or(|e| e != "mrsl") {
+                continue;
+            }
+            for line in std::fs::read_to_string(&path).unwrap().lines() {
+                let words: Vec<&str> = line.split_whitespace().collect();
+                if let ["uniform", ty, name, ..] = words.as_slice() {
+                    let name = name.trim_end_matches(';');
+                    let ty = if name.contains('[') { format!("{ty}[]") } else { ty.to_string() };
+                    declared.entry(name.split('[').next().unwrap().to_string()).or_default().push(ty);
+                }
+            }
+        }
+        for (name, ty) in WELL_KNOWN_UNIFORMS {
+            let types = declared.get(*name).unwrap_or_else(|| panic!("no example declares `{name}`"));
+            assert!(types.len() >= 2, "`{name}` is declared by one example only");
+            assert!(types.iter().all(|t| t == ty), "`{name}` is declared as {types:?}, not always as `{ty}`");
+        }
+    }
 }

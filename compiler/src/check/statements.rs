@@ -274,12 +274,27 @@ impl Checker<'_> {
                             Symbol::Effect(_) => "another effect",
                             Symbol::Local(_) => unreachable!(),
                         };
-                        self.error(err(
+                        let mut d = err(
                             "E0203",
                             format!("cannot assign to `{name}`"),
                             target.span,
                             format!("`{name}` is {what}"),
-                        ));
+                        );
+                        if let Symbol::Input(_) = sym
+                            && !t.is_error()
+                        {
+                            // A name for the copy that is free here: the input's initial, else `NAME_copy`.
+                            let free = |n: &str| {
+                                !self.scopes.iter().any(|s| s.contains_key(n)) && !self.globals.contains_key(n)
+                            };
+                            let initial: String = name.chars().take(1).collect();
+                            let copy =
+                                if initial != *name && free(&initial) { initial } else { format!("{name}_copy") };
+                            d = d.with_note(format!(
+                                "help: copy it into a local first, and assign to the local: `{t} {copy} = {name};`"
+                            ));
+                        }
+                        self.error(d);
                         Type::Error
                     }
                     None => Type::Error,

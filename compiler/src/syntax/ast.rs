@@ -2,6 +2,12 @@
 //!
 //! The tree is never rewritten after parsing: analyses keep their results in
 //! side tables keyed by [`NodeId`] (see `check`), as naga's `ModuleInfo` does.
+//!
+//! Expressions and statements are dropped iteratively (see [`Expr`]'s and
+//! [`Stmt`]'s `Drop`): a tree of any depth, such as a sum of 100,000 terms,
+//! can be freed, even one that the nesting limits (`crate::limits`) reject.
+//! Everything else that walks the tree recursively runs only after those
+//! limits have bounded its depth.
 
 use serde::Serialize;
 
@@ -283,6 +289,95 @@ pub struct Expr {
     pub id: NodeId,
     pub span: Span,
     pub kind: ExprKind,
+}
+
+/// Frees the children of deep trees without recursion: each node's children
+/// are moved onto an explicit stack before the node itself is dropped, so the
+/// derived recursive drop only ever sees childless nodes.
+impl Drop for Expr {
+    fn drop(&mut self) {
+        let mut pending = Orphans::default();
+        pending.take_expr(&mut self.kind);
+        pending.drain();
+    }
+}
+
+impl Drop for Stmt {
+    fn drop(&mut self) {
+        let mut pending = Orphans::default();
+        pending.take_stmt(&mut self.kind);
+        pending.drain();
+    }
+}
+
+/// The children taken out of nodes being dropped, waiting to be dropped.
+#[derive(Default)]
+struct Orphans {
+    exprs: Vec<Expr>,
+    stmts: Vec<Stmt>,
+}
+
+impl Orphans {
+    fn take_expr(&mut self, kind: &mut ExprKind) {
+        if matches!(kind, ExprKind::Int(..) | ExprKind::Float(_) | ExprKind::Bool(_) | ExprKind::Name(_)) {
+            return;
+        }
+        match std::mem::replace(kind, ExprKind::Bool(false)) {
+            ExprKind::Unary(_, a) | ExprKind::Field { base: a, .. } => self.exprs.push(*a),
+            ExprKind::Binary(_, a, b) | ExprKind::Index { base: a, index: b } => {
+                self.exprs.push(*a);
+                self.exprs.push(*b);
+            }
+            ExprKind::Ternary(a, b, c) => {
+                self.exprs.push(*a);
+                self.exprs.push(*b);
+                self.exprs.push(*c);
+            }
+            ExprKind::Call { args, .. } => self.exprs.extend(args),
+            ExprKind::Int(..) | ExprKind::Float(_) | ExprKind::Bool(_) | ExprKind::Name(_) => {}
+        }
+    }
+
+    fn take_stmt(&mut self, kind: &mut StmtKind) {
+        if matches!(kind, StmtKind::Refine | StmtKind::Break | StmtKind::Continue | StmtKind::Return(None)) {
+            return;
+        }
+        match std::mem::replace(kind, StmtKind::Break) {
+            StmtKind::Local { init, .. } => self.exprs.extend(init),
+            StmtKind::Assign { target, value, .. } => {
+                self.exprs.push(target);
+                self.exprs.push(value);
+            }
+            StmtKind::Step { target, .. } => self.exprs.push(target),
+            StmtKind::If { cond, then, otherwise } => {
+                self.exprs.push(cond);
+                self.stmts.push(*then);
+                self.stmts.extend(otherwise.map(|o| *o));
+            }
+            StmtKind::For { init, cond, step, body } => {
+                self.stmts.extend(init.map(|s| *s));
+                self.exprs.extend(cond);
+                self.stmts.extend(step.map(|s| *s));
+                self.stmts.push(*body);
+            }
+            StmtKind::Block(b) => self.stmts.extend(b.stmts),
+            StmtKind::Return(e) => self.exprs.extend(e),
+            StmtKind::Refine | StmtKind::Break | StmtKind::Continue => {}
+        }
+    }
+
+    /// Drops everything taken, taking the children of each node first.
+    fn drain(&mut self) {
+        loop {
+            if let Some(mut e) = self.exprs.pop() {
+                self.take_expr(&mut e.kind);
+            } else if let Some(mut s) = self.stmts.pop() {
+                self.take_stmt(&mut s.kind);
+            } else {
+                break;
+            }
+        }
+    }
 }
 
 #[derive(Debug, Clone, PartialEq)]

@@ -117,6 +117,7 @@ fn headers_name_codes_in_the_opening_comment() {
         Ok(Some(vec!["E0205".into(), "E0205".into(), "W0001".into()]))
     );
     assert_eq!(read("// expect: E0100"), Ok(Some(vec!["E0100".into()])));
+    assert_eq!(read("\u{FEFF}// expect: E0100"), Ok(Some(vec!["E0100".into()])), "after a byte order mark");
     assert_eq!(read("// just a comment\nin float x;"), Ok(None));
     assert_eq!(read("// expect-warning: W0001: unused"), Ok(None));
     assert!(read("// expect: unknown name `nromal`").is_err(), "prose without codes");
@@ -145,6 +146,8 @@ fn codes(diagnostics: &[Diagnostic]) -> Vec<String> {
 /// spaces, run up to the first `:` or the end of the line, and there is at least one.
 fn header_codes(source: &str, key: &str) -> Result<Option<Vec<String>>, String> {
     let prefix = format!("// {key}:");
+    // A byte order mark may open a file, as the compiler accepts it.
+    let source = source.strip_prefix('\u{FEFF}').unwrap_or(source);
     let opening = source.lines().take_while(|line| line.trim_start().starts_with("//")).count();
     let mut found = None;
     for (index, line) in source.lines().enumerate() {

@@ -5,6 +5,7 @@ mod corpus;
 mod examples;
 mod fuzz;
 mod interface;
+mod limits;
 mod wellformed;
 
 use mrsl::KernelKind;
