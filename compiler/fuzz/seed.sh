@@ -8,8 +8,10 @@ here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 for target in lex parse check compile; do
     mkdir -p "$here/corpus/$target"
+    n=0
     for f in "$root"/compiler/tests/data/ok/*.mrsl "$root"/compiler/tests/data/err/*.mrsl "$root"/examples/*.mrsl; do
         cp "$f" "$here/corpus/$target/seed_$(basename "$(dirname "$f")")_$(basename "$f")"
+        n=$((n + 1))
     done
 done
-echo "seeded $(ls "$here/corpus/lex" | wc -l) files into each of corpus/{lex,parse,check,compile}"
+echo "copied $n seed programs into each of corpus/{lex,parse,check,compile}"

@@ -17,7 +17,10 @@ fuzz_target!(|data: &[u8]| {
             Err(e) => (e.start, e.end),
         };
         assert!(last_end <= start && start <= end && end <= source.len(), "span {start}..{end} after {last_end}");
-        assert!(source.is_char_boundary(start) && source.is_char_boundary(end), "span {start}..{end} splits a character");
+        assert!(
+            source.is_char_boundary(start) && source.is_char_boundary(end),
+            "span {start}..{end} splits a character"
+        );
         last_end = end;
     }
 });

@@ -192,12 +192,7 @@ impl E {
         E { text: text.into(), konst: true, dsafe: true, literal: true }
     }
     fn new(text: String, parts: &[&E]) -> E {
-        E {
-            text,
-            konst: parts.iter().all(|p| p.konst),
-            dsafe: parts.iter().all(|p| p.dsafe),
-            literal: false,
-        }
+        E { text, konst: parts.iter().all(|p| p.konst), dsafe: parts.iter().all(|p| p.dsafe), literal: false }
     }
 }
 
@@ -229,9 +224,41 @@ const MAX_STMT_DEPTH: u32 = 3;
 /// points, which the compiler must rename (a numeric suffix is added unless
 /// the bare word is free).
 const STEMS: &[&str] = &[
-    "a", "b", "c", "light", "shade", "tint", "x", "y", "t", "var", "loop", "fn", "let", "struct", "override", "u", "pos",
-    "k", "li", "qx", "qy", "wg", "coarse_main", "fine_main", "hier_t", "cb_t", "mrsl_t", "MrslT", "vec3", "f32",
-    "select", "array", "ptr", "bitcast", "workgroup",
+    "a",
+    "b",
+    "c",
+    "light",
+    "shade",
+    "tint",
+    "x",
+    "y",
+    "t",
+    "var",
+    "loop",
+    "fn",
+    "let",
+    "struct",
+    "override",
+    "u",
+    "pos",
+    "k",
+    "li",
+    "qx",
+    "qy",
+    "wg",
+    "coarse_main",
+    "fine_main",
+    "hier_t",
+    "cb_t",
+    "mrsl_t",
+    "MrslT",
+    "vec3",
+    "f32",
+    "select",
+    "array",
+    "ptr",
+    "bitcast",
+    "workgroup",
 ];
 
 struct Gen<'c> {
@@ -488,7 +515,9 @@ impl<'c> Gen<'c> {
                     _ => E::lit(c),
                 }
             }
-            1 if matches!(ty, Ty::S(S::F) | Ty::S(S::I)) => E::lit(format!("-{}", self.positive_literal(ty.scalar().unwrap()))),
+            1 if matches!(ty, Ty::S(S::F) | Ty::S(S::I)) => {
+                E::lit(format!("-{}", self.positive_literal(ty.scalar().unwrap())))
+            }
             _ => self.literal(ty),
         }
     }
@@ -635,7 +664,8 @@ impl<'c> Gen<'c> {
 
     /// `if (fwidth(...) > t) refine;` and its relatives.
     fn refine_predicate(&mut self, ctx: &mut Ctx, body: &mut String, own: &str, ty: Ty) {
-        let own_ok = ctx.scopes[0].iter().any(|v| v.name == own && v.kind == Kind::Own { mutable: false, deriv_ok: true });
+        let own_ok =
+            ctx.scopes[0].iter().any(|v| v.name == own && v.kind == Kind::Own { mutable: false, deriv_ok: true });
         let threshold = if self.chance(1, 2) { "gain".to_string() } else { self.pick(&["0.05", "0.1", "0.01"]).into() };
         let f = self.pick(&["fwidth", "ddx", "ddy"]);
         self.feat("refine");
@@ -645,7 +675,8 @@ impl<'c> Gen<'c> {
                 if ty.width() == 1 {
                     let _ = writeln!(body, "    if (abs({f}({own})) > {threshold})\n        refine;");
                 } else {
-                    let _ = writeln!(body, "    if (any(abs({f}({own})) > {}({threshold})))\n        refine;", ty.name());
+                    let _ =
+                        writeln!(body, "    if (any(abs({f}({own})) > {}({threshold})))\n        refine;", ty.name());
                 }
             }
             1 => {
@@ -703,10 +734,7 @@ impl<'c> Gen<'c> {
             if seen.contains(&v.name) {
                 continue;
             }
-            let ok = match (ctx.body, v.kind) {
-                (Body::Function, Kind::Input) => false,
-                _ => true,
-            };
+            let ok = !(ctx.body == Body::Function && v.kind == Kind::Input);
             if ok {
                 out.push(v.clone());
             }
@@ -799,7 +827,11 @@ impl<'c> Gen<'c> {
         let value = self.expr(ctx, ty, 0, false);
         let deriv_ok = !mutable && value.dsafe && matches!(ctx.body, Body::Effect(_));
         let _ = writeln!(out, "{pad}{} {name} = {};", ty.name(), value.text);
-        ctx.scopes.last_mut().unwrap().push(Var { name, ty, kind: Kind::Local { mutable, deriv_ok, konst: value.konst } });
+        ctx.scopes.last_mut().unwrap().push(Var {
+            name,
+            ty,
+            kind: Kind::Local { mutable, deriv_ok, konst: value.konst },
+        });
     }
 
     /// Assignable variables: mutable locals, parameters, the effect's own name.
@@ -874,7 +906,8 @@ impl<'c> Gen<'c> {
 
     fn step(&mut self, ctx: &mut Ctx, out: &mut String, depth: usize) {
         let pad = Self::indent(depth);
-        let targets: Vec<Var> = self.targets(ctx).into_iter().filter(|v| matches!(v.ty, Ty::S(S::F | S::I | S::U))).collect();
+        let targets: Vec<Var> =
+            self.targets(ctx).into_iter().filter(|v| matches!(v.ty, Ty::S(S::F | S::I | S::U))).collect();
         if targets.is_empty() {
             return self.assign(ctx, out, depth);
         }
@@ -994,10 +1027,7 @@ impl<'c> Gen<'c> {
 
     /// Variables usable as a leaf here.
     fn leaves(&self, ctx: &Ctx) -> Vec<Var> {
-        self.visible(ctx)
-            .into_iter()
-            .filter(|v| !ctx.deriv || dsafe(v))
-            .collect()
+        self.visible(ctx).into_iter().filter(|v| !ctx.deriv || dsafe(v)).collect()
     }
 
     fn var_expr(&mut self, v: &Var) -> E {
@@ -1021,8 +1051,11 @@ impl<'c> Gen<'c> {
     /// (effects) or `gain` (everywhere).
     fn nonconst(&mut self, ctx: &Ctx, ty: Ty, depth: u32) -> E {
         let leaves = self.leaves(ctx);
-        let direct: Vec<Var> =
-            leaves.iter().filter(|v| v.ty == ty && !matches!(v.kind, Kind::Const | Kind::Local { konst: true, .. })).cloned().collect();
+        let direct: Vec<Var> = leaves
+            .iter()
+            .filter(|v| v.ty == ty && !matches!(v.kind, Kind::Const | Kind::Local { konst: true, .. }))
+            .cloned()
+            .collect();
         if !direct.is_empty() && self.chance(2, 3) {
             let v = self.pick(&direct);
             return self.var_expr(&v);
@@ -1216,9 +1249,31 @@ impl<'c> Gen<'c> {
             0..=2 => self.arith(ctx, ty, depth, &["+", "-", "*", "/", "%"]),
             3 => {
                 let f = self.pick(&[
-                    "sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh", "tanh", "exp", "exp2", "log", "log2",
-                    "sqrt", "inversesqrt", "floor", "ceil", "fract", "round", "trunc", "saturate", "radians",
-                    "degrees", "abs", "sign",
+                    "sin",
+                    "cos",
+                    "tan",
+                    "asin",
+                    "acos",
+                    "atan",
+                    "sinh",
+                    "cosh",
+                    "tanh",
+                    "exp",
+                    "exp2",
+                    "log",
+                    "log2",
+                    "sqrt",
+                    "inversesqrt",
+                    "floor",
+                    "ceil",
+                    "fract",
+                    "round",
+                    "trunc",
+                    "saturate",
+                    "radians",
+                    "degrees",
+                    "abs",
+                    "sign",
                 ]);
                 let a = self.expr(ctx, ty, depth + 1, true);
                 self.call(f, vec![a])
@@ -1419,7 +1474,11 @@ impl<'c> Gen<'c> {
                 }
             }
             6 => {
-                let f = if s == S::I { self.pick(&["abs", "sign", "min", "max", "clamp"]) } else { self.pick(&["abs", "min", "max", "clamp"]) };
+                let f = if s == S::I {
+                    self.pick(&["abs", "sign", "min", "max", "clamp"])
+                } else {
+                    self.pick(&["abs", "min", "max", "clamp"])
+                };
                 let a = self.expr(ctx, ty, depth + 1, true);
                 match f {
                     "abs" | "sign" => self.call(f, vec![a]),
@@ -1468,7 +1527,8 @@ impl<'c> Gen<'c> {
             0 | 1 => {
                 self.feat("comparison");
                 let t = if self.chance(1, 2) { FLOAT } else { self.pick(&[INT, UINT, BOOL]) };
-                let op = if t == BOOL { self.pick(&["==", "!="]) } else { self.pick(&["<", "<=", ">", ">=", "==", "!="]) };
+                let op =
+                    if t == BOOL { self.pick(&["==", "!="]) } else { self.pick(&["<", "<=", ">", ">=", "==", "!="]) };
                 let a = self.expr(ctx, t, depth + 1, false);
                 let b = self.expr(ctx, t, depth + 1, false);
                 E::new(format!("({} {op} {})", a.text, b.text), &[&a, &b])
@@ -1595,15 +1655,13 @@ impl<'c> Gen<'c> {
     }
 
     fn texture_names(&self, ctx: &Ctx) -> Vec<String> {
-        let mut out: Vec<String> =
-            self.visible(ctx).into_iter().filter(|v| v.ty == Ty::Tex).map(|v| v.name).collect();
+        let mut out: Vec<String> = self.visible(ctx).into_iter().filter(|v| v.ty == Ty::Tex).map(|v| v.name).collect();
         out.extend(self.textures.iter().cloned());
         out
     }
 
     fn sampler_names(&self, ctx: &Ctx) -> Vec<String> {
-        let mut out: Vec<String> =
-            self.visible(ctx).into_iter().filter(|v| v.ty == Ty::Smp).map(|v| v.name).collect();
+        let mut out: Vec<String> = self.visible(ctx).into_iter().filter(|v| v.ty == Ty::Smp).map(|v| v.name).collect();
         out.extend(self.samplers.iter().cloned());
         out
     }
