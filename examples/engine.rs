@@ -117,7 +117,12 @@ fn load_program() -> Result<CompiledProgram, Box<dyn std::error::Error>> {
     #[cfg(feature = "compile")]
     {
         println!("no kernel directory given: compiling the built-in demo program");
-        Ok(mrsl_runtime::compile(include_str!("demo.mrsl"), "examples/demo.mrsl")?)
+        // The kernels of the two modes this engine runs.
+        Ok(mrsl_runtime::compile_modes(
+            include_str!("demo.mrsl"),
+            "examples/demo.mrsl",
+            &[Mode::Dynamic, Mode::Reference],
+        )?)
     }
     #[cfg(not(feature = "compile"))]
     Err("usage: engine KERNEL_DIR\n\

@@ -131,7 +131,10 @@ fn plan(args: &BenchArgs, has_knob: bool) -> Vec<(Mode, Option<f64>, bool)> {
 
 /// Runs the benchmark; returns the files written.
 pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
-    let (name, program) = compile_program(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM))?;
+    // The kernels of the modes measured, and of the reference every point is compared with.
+    let mut modes = vec![Mode::Reference];
+    modes.extend(args.modes.iter().copied().filter(|m| *m != Mode::Reference));
+    let (name, program) = compile_program(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &modes)?;
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
     let device_name = format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
     eprintln!("bench: {name} on {device_name}, {}x{}, {} runs per point (median)", args.size.0, args.size.1, args.runs);

@@ -1,7 +1,7 @@
 //! `mrslc render`: runs a program over a scene with the wgpu runtime and
 //! writes the image, a refinement heatmap and statistics.
 
-use mrsl::{KernelKind, Options};
+use mrsl::Options;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::mesh_scene::MeshScene;
 use mrsl_lab::scene::Scene;
@@ -47,15 +47,19 @@ fn progress(what: &str, start: Instant) {
     eprintln!("{what} ({:.0} ms)", start.elapsed().as_secs_f64() * 1e3);
 }
 
-/// Reads and compiles the program at `path` (default options), or the
-/// built-in `(name, source)`; returns its name for messages and the program,
-/// or the diagnostics rendered.
-pub fn compile_program(path: Option<&Path>, builtin: (&str, &str)) -> Result<(String, mrsl::Program), String> {
+/// Reads and compiles the program at `path`, or the built-in `(name,
+/// source)`, to the kernels of `modes` alone; returns its name for messages
+/// and the program, or the diagnostics rendered.
+pub fn compile_program(
+    path: Option<&Path>,
+    builtin: (&str, &str),
+    modes: &[Mode],
+) -> Result<(String, mrsl::Program), String> {
     let (name, source) = match path {
         Some(path) => (path.display().to_string(), crate::read_source(path)?),
         None => (format!("{} (built in)", builtin.0), builtin.1.to_string()),
     };
-    let options = Options { file_name: name.clone(), ..Options::default() };
+    let options = Options { file_name: name.clone(), ..mrsl_runtime::compile_options(modes) };
     let program = mrsl::compile(&source, &options).map_err(|d| mrsl::render_all(&d, &name, &source))?;
     Ok((name, program))
 }
@@ -64,7 +68,12 @@ pub fn compile_program(path: Option<&Path>, builtin: (&str, &str)) -> Result<(St
 pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
     let stem = args.program.as_ref().and_then(|p| p.file_stem()).and_then(|s| s.to_str()).unwrap_or("demo").to_string();
     let start = Instant::now();
-    let (name, program) = compile_program(args.program.as_deref(), ("demo.mrsl", DEMO_PROGRAM))?;
+    // The kernels of the modes that run: those asked for, and the reference to compare with.
+    let mut modes = args.modes.clone();
+    if args.compare && !modes.contains(&Mode::Reference) {
+        modes.push(Mode::Reference);
+    }
+    let (name, program) = compile_program(args.program.as_deref(), ("demo.mrsl", DEMO_PROGRAM), &modes)?;
     progress(&format!("compiled {name}: {} kernels", program.kernels.len()), start);
 
     let start = Instant::now();
@@ -158,10 +167,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
             save_output(&gpu, texture, &path)?;
             written.push(path);
         }
-        if mode != Mode::Reference
-            && program.kernel(KernelKind::Fine, 4).is_some()
-            && !shader.layout().stats.counters.is_empty()
-        {
+        if mode != Mode::Reference && !shader.layout().stats.counters.is_empty() {
             let path = match &args.heatmap {
                 Some(p) => with_suffix(p, if args.modes.len() > 1 { &suffix } else { "" }),
                 None => PathBuf::from(format!("{stem}.{mode}.heatmap.png")),

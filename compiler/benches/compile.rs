@@ -1,6 +1,6 @@
 //! Compile-time benchmarks for mrsl (see docs/performance.md).
 //!
-//! Run with `cargo bench -p mrsl --bench compile`. Three groups:
+//! Run with `cargo bench -p mrsl --bench compile [-- FILTER]`. Groups:
 //!
 //! * `examples`: full [`mrsl::compile`] (default options: the nine kernels,
 //!   coarse and fine for block sizes 2 and 4, reference, dynamic coarse and
@@ -8,11 +8,19 @@
 //!   `examples/*.mrsl`.
 //! * `generated`: a generated program of N effects (N = 25 .. 400) mixing
 //!   refining coarse effects, chains, blocker/shadow pairs, fine effects and one
-//!   output, measured at four depths: `check` (front end only), `interface`
+//!   output, measured at several depths: `check` (front end only), `interface`
 //!   (slot allocation alone, on a pre-built checked program and graph),
-//!   `compile_b4` (one block size: 7 kernels), `compile_default` (9 kernels),
-//!   and `naga_validate` (naga parsing + validation of the 9 kernels alone, the
-//!   part of `compile_default` that is not mrsl's own code).
+//!   `compile_reference` (one mode: the reference kernel), `compile_coarse4x4`
+//!   (one mode: the coarse and fine 4x4 kernels), `compile_default` (the nine
+//!   kernels), and `naga_validate` (naga parsing + validation of the nine
+//!   kernels alone, one after the other: the part of `compile_default` that is
+//!   not mrsl's own code).
+//! * `growth`: the same program at N = 1,000 and 3,000 (`check`,
+//!   `compile_reference`, `compile_coarse4x4`, `compile_default`): slow, run it
+//!   on its own (`-- growth`).
+//! * `chain`: `compile_default` of the derivative chain
+//!   (`mrsl::internals::derivative_chain`) of length 2 to 12, whose neighbour
+//!   evaluations once grew exponentially.
 //! * `colouring`: [`mrsl::internals::colour`] alone on deterministic random
 //!   graphs (~30% edge density) around the exact/heuristic cut-off
 //!   ([`mrsl::internals::EXACT_LIMIT`]).
@@ -25,6 +33,10 @@ use std::time::Duration;
 
 /// Effect counts of the generated programs.
 const EFFECT_COUNTS: [usize; 5] = [25, 50, 100, 200, 400];
+/// Effect counts of the growth curve.
+const GROWTH_COUNTS: [usize; 2] = [1000, 3000];
+/// Lengths of the derivative chains.
+const CHAIN_LENGTHS: [usize; 6] = [2, 4, 6, 8, 10, 12];
 /// Node counts of the colouring graphs: 24 is the last exact size, 25 the first heuristic one.
 const COLOUR_SIZES: [usize; 6] = [10, 20, 24, 25, 100, 400];
 
@@ -163,12 +175,31 @@ fn generate(n: usize) -> String {
             _ => e.name.clone(),
         })
         .collect();
-    src.push_str(&format!("fine out float4 color = float4({}, 1.0);\n", leaves.join(" + ")));
+    src.push_str(&format!("fine out float4 color = float4({}, 1.0);\n", balanced_sum(&leaves)));
     src
 }
 
-fn options_b4() -> mrsl::Options {
-    mrsl::Options { block_sizes: vec![4], ..Default::default() }
+/// `terms` summed as a balanced tree, `((a + b) + (c + d))`, so that the
+/// expression nests only logarithmically deep however many leaves there are.
+fn balanced_sum(terms: &[String]) -> String {
+    match terms {
+        [] => "float3(0.0)".to_string(),
+        [one] => one.clone(),
+        _ => {
+            let (left, right) = terms.split_at(terms.len() / 2);
+            format!("({} + {})", balanced_sum(left), balanced_sum(right))
+        }
+    }
+}
+
+/// One mode's kernels: the reference mode.
+fn options_reference() -> mrsl::Options {
+    mrsl::Options { reference: true, ..mrsl::Options::none() }
+}
+
+/// One mode's kernels: the coarse 4x4 mode (coarse and fine kernels for 4x4 blocks).
+fn options_coarse4x4() -> mrsl::Options {
+    mrsl::Options { block_sizes: vec![4], coarse: true, fine: true, ..mrsl::Options::none() }
 }
 
 /// Panics with the rendered diagnostics if `source` does not compile.
@@ -195,7 +226,8 @@ fn bench_examples(c: &mut Criterion) {
 
 fn bench_generated(c: &mut Criterion) {
     let default = mrsl::Options::default();
-    let b4 = options_b4();
+    let reference = options_reference();
+    let coarse4x4 = options_coarse4x4();
     let mut group = c.benchmark_group("generated");
     configure(&mut group);
     for n in EFFECT_COUNTS {
@@ -225,12 +257,13 @@ fn bench_generated(c: &mut Criterion) {
             bench.iter(|| mrsl::internals::allocate_interface(black_box(&checked), black_box(&graph)))
         });
 
-        group.bench_with_input(BenchmarkId::new("compile_b4", n), &source, |bench, source| {
-            bench.iter(|| mrsl::compile(black_box(source), black_box(&b4)))
-        });
-        group.bench_with_input(BenchmarkId::new("compile_default", n), &source, |bench, source| {
-            bench.iter(|| mrsl::compile(black_box(source), black_box(&default)))
-        });
+        for (what, options) in
+            [("compile_reference", &reference), ("compile_coarse4x4", &coarse4x4), ("compile_default", &default)]
+        {
+            group.bench_with_input(BenchmarkId::new(what, n), &source, |bench, source| {
+                bench.iter(|| mrsl::compile(black_box(source), black_box(options)))
+            });
+        }
 
         // naga's share of `compile_default`: parsing and validating the nine kernels.
         let kernels: Vec<String> = mrsl::compile(&source, &default)
@@ -240,12 +273,52 @@ fn bench_generated(c: &mut Criterion) {
             .into_iter()
             .map(|k| k.wgsl)
             .collect();
+        eprintln!("generated/{n}: {} bytes of WGSL in 9 kernels", kernels.iter().map(String::len).sum::<usize>());
         group.bench_with_input(BenchmarkId::new("naga_validate", n), &kernels, |bench, kernels| {
             bench.iter(|| {
                 for wgsl in kernels {
                     mrsl::validate_wgsl(black_box(wgsl)).expect("valid WGSL");
                 }
             })
+        });
+    }
+    group.finish();
+}
+
+/// The growth curve: the generated program at 1,000 and 3,000 effects.
+fn bench_growth(c: &mut Criterion) {
+    let mut group = c.benchmark_group("growth");
+    group.sample_size(10);
+    group.warm_up_time(Duration::from_millis(100));
+    group.measurement_time(Duration::from_millis(1000));
+    for n in GROWTH_COUNTS {
+        let source = generate(n);
+        group.bench_with_input(BenchmarkId::new("check", n), &source, |bench, source| {
+            bench.iter(|| mrsl::check(black_box(source)))
+        });
+        for (what, options) in [
+            ("compile_reference", options_reference()),
+            ("compile_coarse4x4", options_coarse4x4()),
+            ("compile_default", mrsl::Options::default()),
+        ] {
+            group.bench_with_input(BenchmarkId::new(what, n), &source, |bench, source| {
+                bench.iter(|| mrsl::compile(black_box(source), black_box(&options)))
+            });
+        }
+    }
+    group.finish();
+}
+
+/// The derivative chain of each length, all nine kernels.
+fn bench_chain(c: &mut Criterion) {
+    let options = mrsl::Options::default();
+    let mut group = c.benchmark_group("chain");
+    configure(&mut group);
+    for n in CHAIN_LENGTHS {
+        let source = mrsl::internals::derivative_chain(n);
+        assert_compiles(&format!("chain_{n}"), &source, &options);
+        group.bench_with_input(BenchmarkId::new("compile_default", n), &source, |bench, source| {
+            bench.iter(|| mrsl::compile(black_box(source), black_box(&options)))
         });
     }
     group.finish();
@@ -290,5 +363,5 @@ fn bench_colouring(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_examples, bench_generated, bench_colouring);
+criterion_group!(benches, bench_examples, bench_generated, bench_chain, bench_colouring, bench_growth);
 criterion_main!(benches);

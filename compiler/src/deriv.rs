@@ -49,6 +49,11 @@ pub struct DerivInfo<'a> {
     pub definitions: HashMap<LocalId, &'a Expr>,
     /// Effects whose value is needed at a neighbour (by some operand).
     pub effects_at_neighbours: BTreeSet<EffectId>,
+    /// For each effect with a `refine` statement, the statements of its body
+    /// that its value does not need (the `refine`s and whatever only decides
+    /// them): a neighbour evaluation discards the refine flag, so it leaves
+    /// them out (see [`value_skips`]).
+    pub value_skips: HashMap<EffectId, HashSet<NodeId>>,
 }
 
 pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
@@ -56,11 +61,16 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
     let mut diagnostics = vec![];
     let program = checked.program;
     let mut effect_index = 0u32;
+    let differentiating: HashSet<EffectId> = checked.derivative_calls.iter().map(|(e, _)| *e).collect();
     for item in &program.items {
         let Item::Effect(effect) = item else { continue };
         let id = EffectId(effect_index);
         effect_index += 1;
-        if !checked.derivative_calls.iter().any(|(e, _)| *e == id) {
+        let effect_info = &checked.effects[id.index()];
+        if let (true, Some(result), EffectBody::Block(b)) = (effect_info.has_refine, effect_info.result, &effect.body) {
+            info.value_skips.insert(id, value_skips(checked, result, &b.stmts));
+        }
+        if !differentiating.contains(&id) {
             continue;
         }
         let body: Vec<&Stmt> = match &effect.body {
@@ -557,6 +567,144 @@ impl<'a> OperandWalk<'_, 'a> {
             ));
         }
         self.diagnostics.push(d);
+    }
+}
+
+// ---- Value-only evaluation ------------------------------------------------------
+
+/// The statements of a block effect body that its value, the final value of
+/// `result`, does not need: `refine;` and the statements that only decide
+/// it, and any other statement whose only effect is on locals the value never
+/// reads.
+///
+/// `refine;` sets the effect's refine flag and nothing else: it does not end
+/// the body, and no expression reads the flag. Expressions have no side
+/// effects (functions are pure, loops have static bounds), so a statement
+/// that assigns no needed local can be left out without changing the value.
+/// A neighbour evaluation discards the refine flag, so it evaluates the body
+/// without these statements, and with them the derivatives of the refine
+/// predicates, which would otherwise re-evaluate neighbours of neighbours.
+///
+/// A statement is kept when it assigns a needed local (the result, or a local
+/// a kept statement reads) or holds a `break` or `continue` of an enclosing
+/// loop; a kept `if` or `for` keeps the kept statements inside it. Needed
+/// locals are found by a backward fixed point over the body (loops can carry
+/// values from one iteration to the next).
+pub fn value_skips(checked: &Checked, result: LocalId, body: &[Stmt]) -> HashSet<NodeId> {
+    let mut needed = HashSet::from([result]);
+    loop {
+        let before = needed.len();
+        for s in body.iter().rev() {
+            mark_needed(s, checked, &mut needed);
+        }
+        if needed.len() == before {
+            break;
+        }
+    }
+    let mut skipped = HashSet::new();
+    for s in body {
+        collect_skipped(s, checked, &needed, &mut skipped);
+    }
+    skipped
+}
+
+/// Whether statement `s` is kept in a value-only evaluation, given the needed locals.
+fn kept(s: &Stmt, checked: &Checked, needed: &HashSet<LocalId>) -> bool {
+    affects(s, checked, needed) || escapes(s)
+}
+
+/// Whether `s` assigns a needed local.
+fn affects(s: &Stmt, checked: &Checked, needed: &HashSet<LocalId>) -> bool {
+    match &s.kind {
+        StmtKind::Local { .. } => checked.local_decls.get(&s.id).is_none_or(|l| needed.contains(l)),
+        StmtKind::Assign { target, .. } | StmtKind::Step { target, .. } => {
+            root_local(target, checked).is_none_or(|l| needed.contains(&l))
+        }
+        StmtKind::If { then, otherwise, .. } => {
+            affects(then, checked, needed) || otherwise.as_ref().is_some_and(|o| affects(o, checked, needed))
+        }
+        StmtKind::For { body, .. } => affects(body, checked, needed),
+        StmtKind::Block(b) => b.stmts.iter().any(|s| affects(s, checked, needed)),
+        StmtKind::Refine | StmtKind::Break | StmtKind::Continue => false,
+        // Effects cannot return (E0305); keep one anyway.
+        StmtKind::Return(_) => true,
+    }
+}
+
+/// Whether `s` holds a `break` or `continue` of a loop around it.
+fn escapes(s: &Stmt) -> bool {
+    match &s.kind {
+        StmtKind::Break | StmtKind::Continue => true,
+        StmtKind::If { then, otherwise, .. } => escapes(then) || otherwise.as_ref().is_some_and(|o| escapes(o)),
+        StmtKind::Block(b) => b.stmts.iter().any(escapes),
+        _ => false,
+    }
+}
+
+/// Adds the locals that `s` reads, if it is kept, to `needed` (sub-statements
+/// last to first).
+fn mark_needed(s: &Stmt, checked: &Checked, needed: &mut HashSet<LocalId>) {
+    if !kept(s, checked, needed) {
+        return;
+    }
+    let read = |e: &Expr, needed: &mut HashSet<LocalId>| {
+        visit_expr(e, &mut |x| {
+            if let Some(Symbol::Local(l)) = checked.symbols.get(&x.id) {
+                needed.insert(*l);
+            }
+        })
+    };
+    match &s.kind {
+        StmtKind::Local { init, .. } => {
+            if let Some(e) = init {
+                read(e, needed);
+            }
+        }
+        StmtKind::Assign { target, value, .. } => {
+            read(target, needed);
+            read(value, needed);
+        }
+        StmtKind::Step { target, .. } => read(target, needed),
+        StmtKind::Return(Some(e)) => read(e, needed),
+        StmtKind::If { cond, then, otherwise } => {
+            read(cond, needed);
+            if let Some(o) = otherwise {
+                mark_needed(o, checked, needed);
+            }
+            mark_needed(then, checked, needed);
+        }
+        StmtKind::For { init, cond, step, body } => {
+            // A kept loop is kept whole: its header reads what it reads.
+            for header in [init, step].into_iter().flatten() {
+                visit_stmt_exprs(header, &mut |e| read(e, needed));
+            }
+            if let Some(c) = cond {
+                read(c, needed);
+            }
+            mark_needed(body, checked, needed);
+        }
+        StmtKind::Block(b) => b.stmts.iter().rev().for_each(|s| mark_needed(s, checked, needed)),
+        StmtKind::Return(None) | StmtKind::Refine | StmtKind::Break | StmtKind::Continue => {}
+    }
+}
+
+/// Collects the statements of `s` (itself, or inside it when it is kept)
+/// that are not kept.
+fn collect_skipped(s: &Stmt, checked: &Checked, needed: &HashSet<LocalId>, skipped: &mut HashSet<NodeId>) {
+    if !kept(s, checked, needed) {
+        skipped.insert(s.id);
+        return;
+    }
+    match &s.kind {
+        StmtKind::If { then, otherwise, .. } => {
+            collect_skipped(then, checked, needed, skipped);
+            if let Some(o) = otherwise {
+                collect_skipped(o, checked, needed, skipped);
+            }
+        }
+        StmtKind::For { body, .. } => collect_skipped(body, checked, needed, skipped),
+        StmtKind::Block(b) => b.stmts.iter().for_each(|s| collect_skipped(s, checked, needed, skipped)),
+        _ => {}
     }
 }
 

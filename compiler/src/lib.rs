@@ -26,6 +26,7 @@
 //!
 //! The crate does no I/O and touches no GPU: everything here runs anywhere.
 
+mod budget;
 mod builtins;
 mod check;
 mod codegen;
@@ -47,14 +48,58 @@ use validate::{NagaFailure, generated_context, join_validation, naga_validate, s
 /// only: not part of the API, and free to change with the stages.
 #[doc(hidden)]
 pub mod internals {
+    pub use crate::budget::{MAX_EFFECT_OPERATIONS, MAX_PROGRAM_OPERATIONS};
     pub use crate::check::{EffectId, check as check_ast};
     pub use crate::graph::build as build_graph;
     pub use crate::interface::{EXACT_LIMIT, allocate as allocate_interface, colour};
     pub use crate::syntax::lexer::Lexer;
     pub use crate::syntax::parse;
+
+    /// The operations of the program's fully inlined code, as the size
+    /// budget (E0701) counts them: the whole program's and its costliest
+    /// effect's; `None` if the program has errors before the budget is checked.
+    pub fn inlined_operations(source: &str) -> Option<(u64, u64)> {
+        let program = crate::syntax::parse(source).ok()?;
+        let (checked, diagnostics) = crate::check::check(&program);
+        let (graph, graph_diagnostics) = crate::graph::build(&checked);
+        let (deriv, deriv_diagnostics) = crate::deriv::analyse(&checked);
+        let errors = diagnostics.iter().chain(&graph_diagnostics).chain(&deriv_diagnostics).any(|d| d.is_error());
+        (!errors).then(|| {
+            let costs = crate::budget::costs(&checked, &graph, &deriv);
+            (costs.total, costs.effects.iter().map(|(_, cost)| *cost).max().unwrap_or(0))
+        })
+    }
+
+    /// A chain of `n` coarse effects `e0` .. `e{n-1}` (n >= 1), each reading
+    /// the previous one and refining where its own `fwidth` is large, and
+    /// one output reading the last: the program whose neighbour evaluations
+    /// once grew exponentially with `n` (see docs/performance.md).
+    pub fn derivative_chain(n: usize) -> String {
+        let mut source = String::from("in float3 normal;\nin float2 uv;\nuniform float t = 0.05;\n\n");
+        source.push_str(
+            "coarse effect float e0 {\n    e0 = saturate(dot(normal, float3(0.0, 1.0, 0.0)));\n    if (fwidth(e0) > t) refine;\n}\n",
+        );
+        for k in 1..n.max(1) {
+            source.push_str(&format!(
+                "coarse effect float e{k} {{\n    e{k} = e{} * 0.5 + uv.x * 0.25;\n    if (fwidth(e{k}) > t) refine;\n}}\n",
+                k - 1
+            ));
+        }
+        source.push_str(&format!("fine out float4 color = float4(float3(e{}), 1.0);\n", n.max(1) - 1));
+        source
+    }
 }
 
 /// Which kernels to generate, and for which block sizes.
+///
+/// [`compile`] generates and validates only the kernels these options ask
+/// for ([`Options::kernels`]). The default asks for all nine: coarse and
+/// fine for blocks 2 and 4, the reference, the dynamic mode's coarse (2x2)
+/// and fine (4x4) kernels, the hierarchical and the checkerboard kernel.
+/// A caller that runs fewer modes asks for their kernels alone, which takes
+/// a fraction of the time: `Options { block_sizes: vec![4], coarse: true,
+/// fine: true, ..Options::none() }` for the coarse 4x4 mode (the runtime's
+/// `compile_modes` does this from its modes).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Options {
     /// Coarse block sizes to generate coarse and fine kernels for (2 and/or 4).
@@ -83,6 +128,58 @@ impl Default for Options {
             hierarchical: true,
             checkerboard: true,
             file_name: "program.mrsl".into(),
+        }
+    }
+}
+
+impl Options {
+    /// The kernels [`compile`] generates with these options, in generation
+    /// order: per block size the coarse and fine kernels, then the
+    /// reference, the dynamic mode's (its 4x4 level is the ordinary 4x4
+    /// coarse kernel, added if not asked for already), the hierarchical and
+    /// the checkerboard kernel. The block size is `None` for the kinds that
+    /// exist once per program.
+    pub fn kernels(&self) -> Vec<(KernelKind, Option<u32>)> {
+        let mut wanted = vec![];
+        for &b in &self.block_sizes {
+            if self.coarse {
+                wanted.push((KernelKind::Coarse, Some(b)));
+            }
+            if self.fine {
+                wanted.push((KernelKind::Fine, Some(b)));
+            }
+        }
+        if self.reference {
+            wanted.push((KernelKind::Reference, None));
+        }
+        if self.dynamic {
+            let (outer, inner) = (mrsl_abi::geometry::DYNAMIC_OUTER_BLOCK, mrsl_abi::geometry::DYNAMIC_INNER_BLOCK);
+            if !wanted.contains(&(KernelKind::Coarse, Some(outer))) {
+                wanted.push((KernelKind::Coarse, Some(outer)));
+            }
+            wanted.push((KernelKind::DynamicCoarse, Some(inner)));
+            wanted.push((KernelKind::DynamicFine, Some(outer)));
+        }
+        if self.hierarchical {
+            wanted.push((KernelKind::Hierarchical, None));
+        }
+        if self.checkerboard {
+            wanted.push((KernelKind::Checkerboard, None));
+        }
+        wanted
+    }
+
+    /// Options that ask for no kernel at all; set the flags of the kernels wanted.
+    pub fn none() -> Options {
+        Options {
+            block_sizes: vec![],
+            coarse: false,
+            fine: false,
+            reference: false,
+            dynamic: false,
+            hierarchical: false,
+            checkerboard: false,
+            ..Options::default()
         }
     }
 }
@@ -157,34 +254,10 @@ fn generate(
         layout: &layout,
         file_name: &options.file_name,
         source,
+        cache: codegen::Cache::new(source),
     };
     let mut kernels = vec![];
-    let mut wanted = vec![];
-    for &b in &options.block_sizes {
-        if options.coarse {
-            wanted.push((KernelKind::Coarse, Some(b)));
-        }
-        if options.fine {
-            wanted.push((KernelKind::Fine, Some(b)));
-        }
-    }
-    if options.reference {
-        wanted.push((KernelKind::Reference, None));
-    }
-    if options.dynamic {
-        // The 4x4 level is the ordinary 4x4 coarse kernel.
-        if !wanted.contains(&(KernelKind::Coarse, Some(4))) {
-            wanted.push((KernelKind::Coarse, Some(4)));
-        }
-        wanted.push((KernelKind::DynamicCoarse, Some(2)));
-        wanted.push((KernelKind::DynamicFine, Some(4)));
-    }
-    if options.hierarchical {
-        wanted.push((KernelKind::Hierarchical, None));
-    }
-    if options.checkerboard {
-        wanted.push((KernelKind::Checkerboard, None));
-    }
+    let wanted = options.kernels();
     let texts: Vec<(KernelKind, Option<u32>, String)> = wanted
         .into_iter()
         .map(|(kind, block)| (kind, block, codegen::write_string(&inputs, kind, block.unwrap_or(1))))
@@ -235,6 +308,11 @@ fn front_end<R>(
     diagnostics.extend(deriv_diagnostics);
     if !diagnostics.iter().any(|d| d.is_error()) {
         diagnostics.extend(limits::derivatives(&checked, &deriv));
+    }
+    // The size budget needs an acyclic, well-typed program whose derivative
+    // operands are within the limits (which bound how deep it recurses).
+    if !diagnostics.iter().any(|d| d.is_error()) {
+        diagnostics.extend(budget::check(&checked, &graph, &deriv));
     }
     sort(&mut diagnostics);
     if diagnostics.iter().any(|d| d.is_error()) {
@@ -293,5 +371,18 @@ mod tests {
         };
         assert_eq!(front_end_on_a_small_stack(derivative(n, "{prev} * normal.y")), ["E0604"]);
         assert_eq!(front_end_on_a_small_stack(derivative(60, "{prev} * {prev}")), ["E0604"]);
+        // The size budget counts along chains of functions and of effects
+        // that differentiate the one before without recursing along them.
+        let functions: String =
+            (1..n).map(|k| format!("float f{k}(float x) {{ return f{}(x) + 1.0; }}\n", k - 1)).collect();
+        let functions =
+            format!("{header}float f0(float x) {{ return x; }}\n{functions}fine out float o = f{}(normal.x);\n", n - 1);
+        // (3,000 calls inlined into one another exceed the budget.)
+        assert_eq!(front_end_on_a_small_stack(functions), ["E0701"]);
+        let differentiating: String =
+            (1..n).map(|k| format!("coarse effect float e{k} = ddx(e{}) + e{};\n", k - 1, k - 1)).collect();
+        let differentiating =
+            format!("{header}coarse effect float e0 = normal.x;\n{differentiating}fine out float o = e{};\n", n - 1);
+        assert_eq!(front_end_on_a_small_stack(differentiating), ["E0701"]);
     }
 }

@@ -39,14 +39,49 @@ pub use mrsl_abi::{CompiledProgram, KernelKind, Layout, ReadError};
 pub use shader::{Bindings, DispatchOptions, Shader, wgpu_format};
 pub use stats::{EffectStats, Stats, Timings};
 
-/// Compiles mrsl source into the kernels and layout [`Shader::new`] takes;
-/// errors are the rendered diagnostics (`file_name` names the source in them).
+/// Compiles mrsl source into the kernels and layout [`Shader::new`] takes,
+/// for every mode; errors are the rendered diagnostics (`file_name` names
+/// the source in them). An engine that runs fewer modes compiles faster
+/// with [`compile_modes`].
 #[cfg(feature = "compile")]
 pub fn compile(source: &str, file_name: &str) -> Result<CompiledProgram, Error> {
-    let options = mrsl::Options { file_name: file_name.into(), ..mrsl::Options::default() };
+    compile_modes(source, file_name, &Mode::ALL)
+}
+
+/// Compiles mrsl source into the kernels of `modes` alone (the union of
+/// their [`Mode::kernels`]) and the layout; [`Shader::encode`] refuses the
+/// other modes with [`Error::UnsupportedMode`].
+#[cfg(feature = "compile")]
+pub fn compile_modes(source: &str, file_name: &str, modes: &[Mode]) -> Result<CompiledProgram, Error> {
+    let options = mrsl::Options { file_name: file_name.into(), ..compile_options(modes) };
     mrsl::compile(source, &options)
         .map(|program| program.compiled)
         .map_err(|diagnostics| Error::Compile(mrsl::render_all(&diagnostics, file_name, source)))
+}
+
+/// The compiler options that generate exactly the kernels of `modes`.
+#[cfg(feature = "compile")]
+pub fn compile_options(modes: &[Mode]) -> mrsl::Options {
+    let mut options = mrsl::Options::none();
+    for &mode in modes {
+        match mode {
+            Mode::Reference => options.reference = true,
+            Mode::Coarse2x2 | Mode::Coarse4x4 => {
+                let block = mode.block_size().expect("block modes have a block size");
+                if !options.block_sizes.contains(&block) {
+                    options.block_sizes.push(block);
+                }
+                options.coarse = true;
+                options.fine = true;
+            }
+            // Its 4x4 level is the ordinary 4x4 coarse kernel, which the flag adds.
+            Mode::Dynamic => options.dynamic = true,
+            Mode::Hierarchical => options.hierarchical = true,
+            Mode::Checkerboard => options.checkerboard = true,
+        }
+    }
+    options.block_sizes.sort();
+    options
 }
 
 /// How a program is dispatched.

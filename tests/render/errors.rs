@@ -139,3 +139,28 @@ pub fn modes_without_kernels_are_unsupported(gpu: &Gpu) {
     }
     run(gpu, &program, &gbuffer, Mode::Coarse4x4, false).unwrap();
 }
+
+/// `mrsl_runtime::compile_modes` generates exactly the kernels its modes
+/// dispatch (the union of their `Mode::kernels`), for every set of modes;
+/// `compile` those of all six.
+pub fn compiled_kernels_are_those_of_the_modes() {
+    let source = "in float3 normal;\ncoarse effect float d = normal.y;\nfine out float4 color = float4(d);\n";
+    let kernels = |program: &CompiledProgram| {
+        let mut kernels: Vec<(mrsl::KernelKind, Option<u32>)> =
+            program.kernels.iter().map(|k| (k.kind, k.block_size)).collect();
+        kernels.sort();
+        kernels
+    };
+    for subset in 1u32..1 << Mode::ALL.len() {
+        let modes: Vec<Mode> =
+            Mode::ALL.iter().enumerate().filter(|(k, _)| subset >> k & 1 == 1).map(|(_, m)| *m).collect();
+        let mut wanted: Vec<(mrsl::KernelKind, Option<u32>)> =
+            modes.iter().flat_map(|m| m.kernels().iter().copied()).collect();
+        wanted.sort();
+        wanted.dedup();
+        let program = mrsl_runtime::compile_modes(source, "modes.mrsl", &modes).unwrap();
+        assert_eq!(kernels(&program), wanted, "{modes:?}");
+    }
+    let all = mrsl_runtime::compile(source, "modes.mrsl").unwrap();
+    assert_eq!(kernels(&all).len(), 9);
+}

@@ -33,6 +33,7 @@ const GPU_TESTS: &[GpuTest] = &[
         "modes::gradient_is_reconstructed_at_one_sixteenth_of_the_cost",
         modes::gradient_is_reconstructed_at_one_sixteenth_of_the_cost,
     ),
+    ("modes::derivative_chains_render_in_every_mode", modes::derivative_chains_render_in_every_mode),
     ("modes::steps_keep_their_edges", modes::steps_keep_their_edges),
     ("modes::silhouettes_are_never_blended", modes::silhouettes_are_never_blended),
     ("modes::odd_sizes_cover_every_pixel", modes::odd_sizes_cover_every_pixel),
@@ -63,6 +64,7 @@ const GPU_TESTS: &[GpuTest] = &[
 /// Tests that run on the CPU only.
 const CPU_TESTS: &[(&str, fn())] = &[
     ("errors::unknown_modes_are_named", errors::unknown_modes_are_named),
+    ("errors::compiled_kernels_are_those_of_the_modes", errors::compiled_kernels_are_those_of_the_modes),
     ("sponza::sponza_loads_with_its_35_materials", sponza::sponza_loads_with_its_35_materials),
     ("sponza::obj_written_to_a_temp_dir_loads", sponza::obj_written_to_a_temp_dir_loads),
     ("sponza::gltf_and_glb_written_to_a_temp_dir_load", sponza::gltf_and_glb_written_to_a_temp_dir_load),

@@ -292,3 +292,42 @@ pub fn checkerboard_reconstructs_a_gradient_at_half_rate(gpu: &Gpu) {
     let ramp = &out.stats.effects[0];
     assert!((0.5..0.55).contains(&ramp.shaded_fraction), "{ramp:?}");
 }
+
+/// The derivative chain of length 8 (`mrsl::internals::derivative_chain`:
+/// each coarse effect reads the previous one and refines on its own
+/// `fwidth`; its neighbour evaluations once grew fivefold per effect), and
+/// the program whose neighbour evaluations leave out the most statements
+/// (`compiler/tests/data/ok/0070_neighbour_value_alone.mrsl`), in every
+/// mode, each compiled for that mode alone: forced refinement is
+/// bit-identical to the reference, and the chain's adaptive refinement stays
+/// close to it.
+pub fn derivative_chains_render_in_every_mode(gpu: &Gpu) {
+    let value_alone = include_str!("../../compiler/tests/data/ok/0070_neighbour_value_alone.mrsl");
+    let gbuffer = Scene::Demo.render(75, 43);
+    let programs = [("chain 8", mrsl::internals::derivative_chain(8), true), ("0070", value_alone.to_string(), false)];
+    for (name, source, adaptive_bound) in programs {
+        let compile = |modes: &[Mode]| mrsl_runtime::compile_modes(&source, "chain.mrsl", modes).unwrap();
+        let reference = run(gpu, &compile(&[Mode::Reference]), &gbuffer, Mode::Reference, false).unwrap();
+        for mode in COARSE_MODES {
+            let program = compile(&[mode]);
+            let forced = run(gpu, &program, &gbuffer, mode, true).unwrap();
+            let worst = forced
+                .pixels
+                .iter()
+                .zip(&reference.pixels)
+                .flat_map(|(a, b)| (0..4).map(move |c| ulps(a[c], b[c])))
+                .max()
+                .unwrap();
+            assert_eq!(worst, 0, "{name} {mode}: forced refinement differs from the reference by up to {worst} ulps");
+            // The chain refines where its values change fast. The checkerboard
+            // baseline does not refine: across the scene's silhouettes (no `@key`
+            // here) it blends, so only the adaptive modes are held to a bound.
+            if !adaptive_bound || mode == Mode::Checkerboard {
+                continue;
+            }
+            let adaptive = run(gpu, &program, &gbuffer, mode, false).unwrap();
+            let diff = max_abs_diff(&adaptive.pixels, &reference.pixels);
+            assert!(diff < 0.15, "{name} {mode}: adaptive refinement differs from the reference by {diff}");
+        }
+    }
+}

@@ -14,6 +14,7 @@ use crate::layout;
 use crate::syntax::ast::Rate;
 use mrsl_abi::KernelKind;
 use mrsl_abi::geometry::DYNAMIC_TAG_WORDS;
+use std::collections::{BTreeSet, HashMap};
 
 /// One level of coarse samples as a fine kernel reads it.
 pub(super) struct Level {
@@ -163,10 +164,18 @@ impl Writer<'_, '_, '_> {
         }
     }
 
-    /// `mrsl_resolve{suffix}` and the getters and resamplers of one level of coarse samples.
-    fn fine_level(&mut self, level: &Level) {
+    /// `mrsl_resolve{suffix}`: where a pixel takes its coarse values from at
+    /// one level, and which coarse effects it evaluates per pixel. With
+    /// `only`, `mrsl_resolve{suffix}_<effect>` for the neighbour function of
+    /// that effect: the same function deciding only the given effects (the
+    /// coarse effects the neighbour evaluation reads, and the users their
+    /// decisions depend on, [`Writer::neighbour_decisions`]), so that a
+    /// derivative does not decide every coarse effect of the program again
+    /// at each neighbour. Their decisions are those of the full function.
+    pub(super) fn resolve_function(&mut self, level: &Level, only: Option<(&str, &BTreeSet<EffectId>)>) {
         let c = self.checked();
-        let coarse = self.coarse_live();
+        let coarse: Vec<EffectId> =
+            self.coarse_live().into_iter().filter(|e| only.is_none_or(|(_, set)| set.contains(e))).collect();
         let iface = self.i.interface;
         let (sfx, bk, buf) = (level.suffix, level.block, level.buffer);
         let stride = if level.parent { iface.stride + DYNAMIC_TAG_WORDS } else { iface.stride };
@@ -177,7 +186,11 @@ impl Writer<'_, '_, '_> {
         } else {
             "pos: vec2<i32>"
         };
-        self.template(0, head, &[("SUFFIX", &sfx), ("PARAMS", &params), ("GRID", &sample_grid(bk)), ("BLOCK", &bk)]);
+        let name = match only {
+            Some((effect, _)) => format!("{sfx}_{effect}"),
+            None => sfx.to_string(),
+        };
+        self.template(0, head, &[("SUFFIX", &name), ("PARAMS", &params), ("GRID", &sample_grid(bk)), ("BLOCK", &bk)]);
         if level.parent {
             self.stale_corners(buf, stride);
         }
@@ -194,11 +207,13 @@ impl Writer<'_, '_, '_> {
                 &[("NAME", &name), ("TESTS", &tests.join(" || "))],
             );
         }
-        if iface.flag_words > 0 {
-            for (ci, corner) in ["x", "y", "z", "w"].iter().enumerate() {
-                for w in 0..iface.flag_words {
-                    self.line(1, format!("let f{ci}_{w} = {buf}[b.corners.{corner} * {stride}u + {w}u];"));
-                }
+        let words: Vec<u32> = match only {
+            None => (0..iface.flag_words).collect(),
+            Some(_) => self.flag_words_read(&coarse).into_iter().collect(),
+        };
+        for (ci, corner) in ["x", "y", "z", "w"].iter().enumerate() {
+            for &w in &words {
+                self.line(1, format!("let f{ci}_{w} = {buf}[b.corners.{corner} * {stride}u + {w}u];"));
             }
         }
         self.template(0, corners, &[]);
@@ -243,6 +258,88 @@ impl Writer<'_, '_, '_> {
             self.line(1, format!("if (mrsl_r{k}) {{ b.refined{word} |= {mask}u; }}"));
         }
         self.template(0, refined, &[]);
+    }
+
+    /// The flag words the decisions of `effects` read: their own refine
+    /// bits, and for a shared slot the bits of its pass condition.
+    fn flag_words_read(&self, effects: &[EffectId]) -> BTreeSet<u32> {
+        let iface = self.i.interface;
+        let mut words = BTreeSet::new();
+        for &e in effects {
+            let mut bits: Vec<u32> = iface.refine_bit[e.index()].into_iter().collect();
+            if iface.is_passed(e) && iface.is_shared(e) {
+                let cond = iface.conditions[e.index()].as_ref().expect("passed effects have a condition");
+                bits.extend(cond.refining_users.iter().filter_map(|u| iface.refine_bit[u.index()]));
+            }
+            words.extend(bits.into_iter().map(|b| bit(b).0));
+        }
+        words
+    }
+
+    /// The resolvers of the neighbour function of effect `e`, which
+    /// evaluates `chain` (in a fine kernel): `mrsl_resolve_<e>`, and in the
+    /// dynamic fine kernel `mrsl_resolve2_<e>`, unless an earlier neighbour
+    /// function's decide the same effects, or they decide every coarse
+    /// effect (then the kernel's own resolvers serve). Returns the suffix of
+    /// the resolvers to call: `_<name>` or empty.
+    pub(super) fn neighbour_resolvers(
+        &mut self,
+        e: EffectId,
+        chain: &[EffectId],
+        written: &mut HashMap<BTreeSet<EffectId>, String>,
+    ) -> String {
+        let decisions = self.neighbour_decisions(chain);
+        if decisions.len() == self.coarse_live().len() {
+            return String::new();
+        }
+        if let Some(suffix) = written.get(&decisions) {
+            return suffix.clone();
+        }
+        let name = &self.checked().effects[e.index()].name;
+        self.line(0, format!("// Where neighbour evaluations of `{name}` take their coarse values from."));
+        if self.kind == KernelKind::DynamicFine {
+            self.resolve_function(&Level::DYNAMIC_OUTER, Some((name, &decisions)));
+            self.resolve_function(&Level::DYNAMIC_INNER, Some((name, &decisions)));
+        } else {
+            let level = Level { suffix: "", block: self.block, buffer: "mrsl_interface", parent: false };
+            self.resolve_function(&level, Some((name, &decisions)));
+        }
+        let suffix = format!("_{name}");
+        written.insert(decisions, suffix.clone());
+        suffix
+    }
+
+    /// The coarse effects whose decisions a neighbour evaluation of `chain`
+    /// needs: its coarse effects, and, where a decision reads its users'
+    /// (an effect not passed, or in a shared slot: rule 4 of
+    /// docs/language.md, section 8.3), those users, transitively.
+    pub(super) fn neighbour_decisions(&self, chain: &[EffectId]) -> BTreeSet<EffectId> {
+        let c = self.checked();
+        let iface = self.i.interface;
+        let mut set: BTreeSet<EffectId> =
+            chain.iter().copied().filter(|e| c.effects[e.index()].rate == Rate::Coarse).collect();
+        let mut stack: Vec<EffectId> = set.iter().copied().collect();
+        while let Some(e) = stack.pop() {
+            if iface.is_passed(e) && !iface.is_shared(e) {
+                continue;
+            }
+            for &u in &self.i.graph.users[e.index()] {
+                if self.i.graph.live[u.index()] && c.effects[u.index()].rate == Rate::Coarse && set.insert(u) {
+                    stack.push(u);
+                }
+            }
+        }
+        set
+    }
+
+    /// `mrsl_resolve{suffix}` and the getters and resamplers of one level of coarse samples.
+    fn fine_level(&mut self, level: &Level) {
+        self.resolve_function(level, None);
+        let c = self.checked();
+        let coarse = self.coarse_live();
+        let iface = self.i.interface;
+        let (sfx, buf) = (level.suffix, level.buffer);
+        let stride = if level.parent { iface.stride + DYNAMIC_TAG_WORDS } else { iface.stride };
         for &e in &coarse {
             let Some(slot) = iface.slot_of[e.index()].map(|s| &iface.slots[s]) else {
                 continue;
@@ -274,12 +371,13 @@ impl Writer<'_, '_, '_> {
     }
 
     /// Declares `mrsl_b` (and in the dynamic mode `mrsl_b2`) for the pixel at
-    /// `mrsl_pos` in the fine kernels; nothing elsewhere.
-    pub(super) fn resolve_preamble(&mut self, indent: usize) {
+    /// `mrsl_pos` in the fine kernels; nothing elsewhere. `name` is the suffix
+    /// of a neighbour function's own resolvers (`mrsl_resolve_<effect>`), or empty.
+    pub(super) fn resolve_preamble(&mut self, indent: usize, name: &str) {
         if self.kind.is_fine() {
-            self.line(indent, "let mrsl_b = mrsl_resolve(mrsl_pos);");
+            self.line(indent, format!("let mrsl_b = mrsl_resolve{name}(mrsl_pos);"));
             if self.kind == KernelKind::DynamicFine {
-                self.resolve_inner(indent);
+                self.resolve_inner(indent, name);
             }
         }
     }
@@ -313,7 +411,7 @@ impl Writer<'_, '_, '_> {
                 if !counted {
                     return;
                 }
-                w.resolve_preamble(2);
+                w.resolve_preamble(2, "");
                 // `mrsl_last` holds the innermost level: effects refined there are evaluated per pixel.
                 let (last, from_inner) = if w.kind == KernelKind::DynamicFine {
                     ("mrsl_b2", "mrsl_b.refined0 & ~mrsl_b2.refined0")

@@ -16,8 +16,12 @@ use mrsl_abi::{KernelKind, entry};
 /// Renames user identifiers that collide with WGSL keywords, WGSL builtins or
 /// the generated `mrsl_` namespace, so source names survive everywhere else.
 pub(super) fn wgsl_ident(name: &str) -> String {
-    let reserved = naga::keywords::wgsl::RESERVED.contains(&name)
-        || naga::keywords::wgsl::BUILTIN_IDENTIFIERS.contains(&name)
+    // WGSL's reserved words and builtin names, looked up in a set: the
+    // generator asks for every name it writes.
+    static WGSL_NAMES: std::sync::LazyLock<std::collections::HashSet<&'static str>> = std::sync::LazyLock::new(|| {
+        naga::keywords::wgsl::RESERVED.iter().chain(naga::keywords::wgsl::BUILTIN_IDENTIFIERS).copied().collect()
+    });
+    let reserved = WGSL_NAMES.contains(name)
         || name.to_ascii_lowercase().starts_with("mrsl")
         || KernelKind::ALL.iter().any(|k| k.entry_points().contains(&name))
         || entry::RESERVED_PREFIXES.iter().any(|p| name.starts_with(p))
@@ -76,6 +80,9 @@ impl Writer<'_, '_, '_> {
     }
 
     pub(super) fn stmt(&mut self, s: &Stmt, indent: usize) {
+        if self.skipped.is_some_and(|skipped| skipped.contains(&s.id)) {
+            return;
+        }
         let c = self.checked();
         match &s.kind {
             StmtKind::Local { init, .. } => {

@@ -110,8 +110,9 @@ impl Writer<'_, '_, '_> {
     }
 
     /// After `mrsl_b`: `mrsl_b2`, the inner level, resolved only where the outer one refined.
-    pub(super) fn resolve_inner(&mut self, indent: usize) {
-        self.template(indent, include_str!("templates/resolve_inner.wgsl"), &[]);
+    /// `name` is the suffix of a neighbour function's own resolver, or empty.
+    pub(super) fn resolve_inner(&mut self, indent: usize, name: &str) {
+        self.template(indent, include_str!("templates/resolve_inner.wgsl"), &[("NAME", &name)]);
     }
 
     /// A coarse effect in `dynamic_fine_main`, into its declared variable:

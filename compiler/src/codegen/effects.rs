@@ -13,7 +13,7 @@ use crate::check::{EffectId, KeyCompare, Symbol};
 use crate::syntax::ast::*;
 use crate::syntax::{visit_expr, visit_stmt_exprs};
 use mrsl_abi::{CONTROL_FIELDS, KernelKind};
-use std::collections::BTreeSet;
+use std::collections::{BTreeSet, HashMap, HashSet};
 
 /// A discontinuity key: an input that, where its values at two positions
 /// differ, keeps them from sharing coarse values.
@@ -163,20 +163,24 @@ impl<'b> Writer<'_, '_, 'b> {
         self.checked().effects[e.index()].deps.iter().map(|(d, _)| *d).collect()
     }
 
-    fn eval_signature(&self, e: EffectId) -> String {
+    /// The signature of `mrsl_eval_<effect>`, or of `mrsl_val_<effect>`
+    /// (`value_only`), which has no refine flag.
+    fn eval_signature(&self, e: EffectId, value_only: bool) -> String {
         let c = self.checked();
         let info = &c.effects[e.index()];
         let mut params = vec!["mrsl_pos: vec2<i32>".to_string()];
-        if info.has_refine {
+        if info.has_refine && !value_only {
             params.push("mrsl_refine: ptr<function, bool>".into());
         }
         for d in self.deps_params(e) {
             params.push(format!("{}: {}", self.effect_name(d), c.effects[d.index()].ty.wgsl()));
         }
-        format!("fn mrsl_eval_{}({}) -> {}", info.name, params.join(", "), info.ty.wgsl())
+        let prefix = if value_only { "val" } else { "eval" };
+        format!("fn mrsl_{prefix}_{}({}) -> {}", info.name, params.join(", "), info.ty.wgsl())
     }
 
-    /// Inputs an effect body reads directly.
+    /// Inputs an effect body reads directly (outside the statements the
+    /// function being written leaves out).
     fn inputs_read(&self, decl: &EffectDecl) -> BTreeSet<usize> {
         let c = self.checked();
         let mut read = BTreeSet::new();
@@ -189,24 +193,38 @@ impl<'b> Writer<'_, '_, 'b> {
         };
         match &decl.body {
             EffectBody::Expr(e) => visit(e),
-            EffectBody::Block(b) => b.stmts.iter().for_each(|s| visit_stmt_exprs(s, &mut visit)),
+            EffectBody::Block(b) => match self.skipped {
+                None => b.stmts.iter().for_each(|s| visit_stmt_exprs(s, &mut visit)),
+                Some(skipped) => b.stmts.iter().for_each(|s| visit_kept_exprs(s, skipped, &mut visit)),
+            },
         }
         read
     }
 
     /// `mrsl_eval_<effect>`: the effect's body at `mrsl_pos`, given its
     /// dependencies' values (and a refine flag to set, if it can refine).
-    pub(super) fn eval_function(&mut self, e: EffectId) {
+    /// With `value_only`, `mrsl_val_<effect>` of an effect that can refine:
+    /// the same value, without the statements that only decide the refine
+    /// flag (`DerivInfo::value_skips`), for evaluations that discard it.
+    pub(super) fn eval_function(&mut self, e: EffectId, value_only: bool) {
         let c = self.checked();
         let info = &c.effects[e.index()];
         let decl = c.effect_decl(e);
-        let rate = match info.rate {
-            Rate::Coarse => "coarse effect",
-            Rate::Fine => "fine effect",
-            Rate::Out => "fine out",
-        };
-        self.line(0, format!("// ---- {rate} `{}` (line {}) ----", info.name, self.line_of(decl.span)));
-        let sig = self.eval_signature(e);
+        if value_only {
+            self.skipped = self.i.deriv.value_skips.get(&e);
+            self.line(
+                0,
+                format!("// `{}`'s value alone, without the statements that only decide its refine flag", info.name),
+            );
+        } else {
+            let rate = match info.rate {
+                Rate::Coarse => "coarse effect",
+                Rate::Fine => "fine effect",
+                Rate::Out => "fine out",
+            };
+            self.line(0, format!("// ---- {rate} `{}` (line {}) ----", info.name, self.line_of(decl.span)));
+        }
+        let sig = self.eval_signature(e, value_only);
         self.line(0, format!("{sig} {{"));
         for i in self.inputs_read(decl) {
             let name = &c.inputs[i].name;
@@ -231,20 +249,30 @@ impl<'b> Writer<'_, '_, 'b> {
         }
         self.line(0, "}");
         self.line(0, "");
+        self.skipped = None;
     }
 
     // ---- Derivatives and values at other positions ------------------------------
 
     fn live_sites(&self) -> Vec<usize> {
-        let effects = self.kernel_effects();
-        (0..self.i.deriv.sites.len()).filter(|&k| effects.contains(&self.i.deriv.sites[k].effect)).collect()
+        let mut computed = vec![false; self.checked().effects.len()];
+        for e in self.kernel_effects() {
+            computed[e.index()] = true;
+        }
+        (0..self.i.deriv.sites.len()).filter(|&k| computed[self.i.deriv.sites[k].effect.index()]).collect()
     }
 
     /// `mrsl_d<k>` (the operand of derivative site k at a position) and its
     /// differences across the position's quad, `mrsl_ddx_<k>` and `mrsl_ddy_<k>`.
     pub(super) fn derivative_helpers(&mut self) {
-        let c = self.checked();
         for k in self.live_sites() {
+            self.cached(super::Piece::Derivative(k), |w| w.derivative_helper(k));
+        }
+    }
+
+    fn derivative_helper(&mut self, k: usize) {
+        let c = self.checked();
+        {
             let site = &self.i.deriv.sites[k];
             let ty = c.ty(site.operand).concretize();
             let mut params = vec!["mrsl_pos: vec2<i32>".to_string()];
@@ -271,16 +299,42 @@ impl<'b> Writer<'_, '_, 'b> {
         }
     }
 
-    /// `mrsl_at_<effect>(pos)`: the effect's value at another position, as this kernel sees it.
-    pub(super) fn neighbour_functions(&mut self) {
-        let c = self.checked();
+    /// Effects this kernel needs at other positions (for derivatives).
+    fn effects_at_neighbours(&self) -> BTreeSet<EffectId> {
         let mut needed: BTreeSet<EffectId> = BTreeSet::new();
         for k in self.live_sites() {
             let site = &self.i.deriv.sites[k];
             needed.extend(site.effects.iter().copied().filter(|e| self.i.graph.live[e.index()]));
         }
-        for e in needed {
+        needed
+    }
+
+    /// Effects with a refine flag that the neighbour functions evaluate, and
+    /// so get a value-only function `mrsl_val_<effect>`.
+    pub(super) fn value_only_effects(&self) -> BTreeSet<EffectId> {
+        let c = self.checked();
+        let mut effects = BTreeSet::new();
+        for e in self.effects_at_neighbours() {
+            effects.extend(self.i.graph.closure(e, c).into_iter().filter(|x| c.effects[x.index()].has_refine));
+        }
+        effects
+    }
+
+    /// `mrsl_at_<effect>(pos)`: the effect's value at another position, as
+    /// this kernel sees it there. Its refine flags are discarded, so effects
+    /// are evaluated for their value alone.
+    pub(super) fn neighbour_functions(&mut self) {
+        let c = self.checked();
+        let mut resolvers = HashMap::new();
+        for e in self.effects_at_neighbours() {
             let info = &c.effects[e.index()];
+            let chain = self.i.graph.closure(e, c);
+            let coarse = chain.iter().any(|x| c.effects[x.index()].rate == Rate::Coarse);
+            let resolver = if coarse && self.kind.is_fine() {
+                self.neighbour_resolvers(e, &chain, &mut resolvers)
+            } else {
+                String::new()
+            };
             self.line(
                 0,
                 format!(
@@ -290,11 +344,12 @@ impl<'b> Writer<'_, '_, 'b> {
                 ),
             );
             self.line(0, format!("fn mrsl_at_{}(mrsl_pos: vec2<i32>) -> {} {{", info.name, info.ty.wgsl()));
-            let chain = self.i.graph.closure(e, c);
-            if chain.iter().any(|x| c.effects[x.index()].rate == Rate::Coarse) {
-                self.resolve_preamble(1);
+            if coarse {
+                self.resolve_preamble(1, &resolver);
             }
+            self.value_only = true;
             self.effect_chain(&chain, 1);
+            self.value_only = false;
             self.line(1, format!("return {};", self.effect_name(e)));
             self.line(0, "}");
             self.line(0, "");
@@ -319,15 +374,25 @@ impl<'b> Writer<'_, '_, 'b> {
     /// Evaluates effect `e` at `mrsl_pos` into `{declare}{name}` (`declare`
     /// is `"let "`, or empty for a variable already declared), declaring its
     /// refine flag first if it has one.
+    /// In the neighbour functions (`value_only`), an effect that can refine
+    /// is evaluated by `mrsl_val_<effect>`, with no flag.
     pub(super) fn evaluate(&mut self, e: EffectId, indent: usize, declare: &str) {
         let info = &self.checked().effects[e.index()];
         let mut args = vec!["mrsl_pos".to_string()];
-        if info.has_refine {
-            self.line(indent, format!("var mrsl_r_{} = false;", info.name));
-            args.push(format!("&mrsl_r_{}", info.name));
-        }
+        let function = if info.has_refine && self.value_only {
+            "val"
+        } else {
+            if info.has_refine {
+                self.line(indent, format!("var mrsl_r_{} = false;", info.name));
+                args.push(format!("&mrsl_r_{}", info.name));
+            }
+            "eval"
+        };
         args.extend(self.deps_params(e).into_iter().map(|d| self.effect_name(d)));
-        self.line(indent, format!("{declare}{} = mrsl_eval_{}({});", self.effect_name(e), info.name, args.join(", ")));
+        self.line(
+            indent,
+            format!("{declare}{} = mrsl_{function}_{}({});", self.effect_name(e), info.name, args.join(", ")),
+        );
     }
 
     // ---- Refine flags ----------------------------------------------------------------
@@ -353,5 +418,34 @@ impl<'b> Writer<'_, '_, 'b> {
         for w in 0..words {
             self.line(1, format!("{buffer}[{base} + {w}u] = mrsl_flags{w};"));
         }
+    }
+}
+
+/// Calls `f` on the top-level expressions of `s` and its sub-statements, like
+/// `visit_stmt_exprs`, except inside the statements in `skipped`.
+fn visit_kept_exprs<'a>(s: &'a Stmt, skipped: &HashSet<NodeId>, f: &mut dyn FnMut(&'a Expr)) {
+    if skipped.contains(&s.id) {
+        return;
+    }
+    match &s.kind {
+        StmtKind::If { cond, then, otherwise } => {
+            f(cond);
+            visit_kept_exprs(then, skipped, f);
+            if let Some(o) = otherwise {
+                visit_kept_exprs(o, skipped, f);
+            }
+        }
+        StmtKind::For { init, cond, step, body } => {
+            // A kept loop's header is kept whole.
+            for header in [init, step].into_iter().flatten() {
+                visit_stmt_exprs(header, f);
+            }
+            if let Some(c) = cond {
+                f(c);
+            }
+            visit_kept_exprs(body, skipped, f);
+        }
+        StmtKind::Block(b) => b.stmts.iter().for_each(|s| visit_kept_exprs(s, skipped, f)),
+        _ => visit_stmt_exprs(s, f),
     }
 }

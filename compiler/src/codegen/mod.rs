@@ -56,15 +56,17 @@ mod records;
 mod words;
 mod writer;
 
-use crate::check::{Checked, EffectId};
+use crate::check::{Checked, EffectId, FunctionId};
 use crate::deriv::DerivInfo;
 use crate::graph::EffectGraph;
 use crate::interface::Interface;
+use crate::syntax::ast::NodeId;
 use crate::syntax::ast::{Rate, Span};
 use body::{Mode, wgsl_ident};
 use mrsl_abi::geometry::{DYNAMIC_INNER_BLOCK, DYNAMIC_OUTER_BLOCK, DYNAMIC_TAG_WORDS, HIERARCHICAL_LEVEL0};
 use mrsl_abi::{KernelKind, Layout};
-use std::collections::HashMap;
+use std::cell::RefCell;
+use std::collections::{HashMap, HashSet};
 use writer::{Code, Values};
 
 /// Everything the writer reads.
@@ -76,6 +78,40 @@ pub(crate) struct Inputs<'a, 'b> {
     pub layout: &'b Layout,
     pub file_name: &'b str,
     pub source: &'b str,
+    /// What the kernels of one compile share: build it once with
+    /// [`Cache::new`] and write every kernel with the same inputs.
+    pub cache: Cache,
+}
+
+/// What the kernels of one compile share, computed once: where the source's
+/// lines start, and the text of the functions every kernel that has them
+/// writes identically (effect, value-only and user functions, derivative
+/// helpers), written by the first kernel that needs each.
+pub(crate) struct Cache {
+    line_starts: Vec<usize>,
+    pieces: RefCell<HashMap<Piece, String>>,
+}
+
+/// A function whose text is the same in every kernel.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+enum Piece {
+    /// `mrsl_eval_<effect>`, or (`true`) `mrsl_val_<effect>`.
+    Effect(EffectId, bool),
+    /// `mrsl_d<k>`, `mrsl_ddx_<k>` and `mrsl_ddy_<k>`.
+    Derivative(usize),
+    Function(FunctionId),
+}
+
+impl Cache {
+    pub(crate) fn new(source: &str) -> Cache {
+        let line_starts = std::iter::once(0).chain(source.match_indices('\n').map(|(k, _)| k + 1)).collect();
+        Cache { line_starts, pieces: RefCell::default() }
+    }
+
+    /// The 1-based line of byte `offset`.
+    fn line_of(&self, offset: usize) -> usize {
+        self.line_starts.partition_point(|&start| start <= offset)
+    }
 }
 
 /// Writes one kernel. `block` is the coarse block size (ignored by the reference kernel).
@@ -93,6 +129,12 @@ struct Writer<'i, 'a, 'b> {
     code: Code,
     /// Live coarse effects, numbered for refine masks, statistics counters and records.
     coarse_index: HashMap<EffectId, u32>,
+    /// While writing a value-only function (`mrsl_val_<effect>`): the body's
+    /// statements it leaves out.
+    skipped: Option<&'i HashSet<NodeId>>,
+    /// While writing the neighbour functions: effects are evaluated for their
+    /// value alone, with `mrsl_val_<effect>` where the effect can refine.
+    value_only: bool,
 }
 
 impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
@@ -105,11 +147,25 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             .enumerate()
             .map(|(k, e)| (*e, k as u32))
             .collect();
-        Writer { i, kind, block, code: Code::default(), coarse_index }
+        Writer { i, kind, block, code: Code::default(), coarse_index, skipped: None, value_only: false }
     }
 
     fn checked(&self) -> &'b Checked<'a> {
         self.i.checked
+    }
+
+    /// Writes `piece` as `write` writes it, or, when an earlier kernel of
+    /// this compile wrote it, the same text again.
+    fn cached(&mut self, piece: Piece, write: impl FnOnce(&mut Self)) {
+        if let Some(text) = self.i.cache.pieces.borrow().get(&piece) {
+            self.code.push_str(text);
+            return;
+        }
+        let outer = std::mem::take(&mut self.code);
+        write(self);
+        let text = std::mem::replace(&mut self.code, outer).into_string();
+        self.code.push_str(&text);
+        self.i.cache.pieces.borrow_mut().insert(piece, text);
     }
 
     fn line(&mut self, indent: usize, text: impl AsRef<str>) {
@@ -126,7 +182,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
     }
 
     fn line_of(&self, span: Span) -> usize {
-        self.i.source[..(span.start as usize).min(self.i.source.len())].matches('\n').count() + 1
+        self.i.cache.line_of(span.start as usize)
     }
 
     /// The live coarse effects in dependency order (numbered by `coarse_index`).
@@ -176,11 +232,16 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         }
         self.position_helpers();
         self.input_loaders();
-        for (k, _) in c.functions.iter().enumerate() {
-            self.function(crate::check::FunctionId(k as u32));
+        for k in 0..c.functions.len() {
+            let f = FunctionId(k as u32);
+            self.cached(Piece::Function(f), |w| w.function(f));
         }
+        let value_only = self.value_only_effects();
         for e in self.kernel_effects() {
-            self.eval_function(e);
+            self.cached(Piece::Effect(e, false), |w| w.eval_function(e, false));
+            if value_only.contains(&e) {
+                self.cached(Piece::Effect(e, true), |w| w.eval_function(e, true));
+            }
         }
         self.derivative_helpers();
         self.neighbour_functions();

@@ -60,6 +60,11 @@ impl Code {
         }
     }
 
+    /// Appends text written earlier (whole lines).
+    pub(super) fn push_str(&mut self, text: &str) {
+        self.text.push_str(text);
+    }
+
     pub(super) fn into_string(self) -> String {
         self.text
     }
