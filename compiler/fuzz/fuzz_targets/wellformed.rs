@@ -1,15 +1,16 @@
 //! Well-typed programs from the grammar-aware generator
 //! (compiler/tests/it/wellformed.rs), driven by the fuzzer's bytes: each must
-//! pass every check with no diagnostic at all and compile (one block size) to
-//! kernels naga accepts, with no warning.
+//! pass every check with no diagnostic at all and compile to kernels naga
+//! accepts, with no warning. The first input byte picks the kernels of one
+//! mode to build (see `kernels.rs`); the rest drive the generator.
 #![no_main]
 
+mod kernels;
 #[path = "../../tests/it/wellformed.rs"]
 mod wellformed;
 
 use arbitrary::Unstructured;
 use libfuzzer_sys::fuzz_target;
-use mrsl::Options;
 
 struct Bytes<'a, 'b>(&'b mut Unstructured<'a>);
 
@@ -20,7 +21,9 @@ impl wellformed::Choices for Bytes<'_, '_> {
 }
 
 fuzz_target!(|data: &[u8]| {
-    let mut u = Unstructured::new(data);
+    let (choice, rest) = data.split_first().map_or((0, data), |(&b, rest)| (b as usize, rest));
+    let options = kernels::options(choice);
+    let mut u = Unstructured::new(rest);
     let source = wellformed::program(&mut Bytes(&mut u)).source;
     let diagnostics = mrsl::check(&source);
     assert!(
@@ -28,7 +31,6 @@ fuzz_target!(|data: &[u8]| {
         "a generated program has diagnostics:\n{source}\n{}",
         mrsl::render_all(&diagnostics, "generated.mrsl", &source)
     );
-    let options = Options { block_sizes: vec![4], ..Options::default() };
     match mrsl::compile(&source, &options) {
         Ok(program) => assert!(program.warnings.is_empty(), "a generated program warns:\n{source}"),
         Err(diagnostics) => panic!(
