@@ -212,6 +212,11 @@ impl Writer<'_, '_, '_> {
     }
 
     fn body(&mut self, s: &Stmt, indent: usize) {
+        // A branch or loop body left out of a value-only function as a
+        // whole: its statements are not in the skipped set themselves.
+        if self.skipped.is_some_and(|skipped| skipped.contains(&s.id)) {
+            return;
+        }
         match &s.kind {
             StmtKind::Block(b) => b.stmts.iter().for_each(|s| self.stmt(s, indent)),
             _ => self.stmt(s, indent),

@@ -287,6 +287,17 @@ const GENERATOR_FEATURES: &[&str] = &[
     "any/all",
     "dot",
     "?:",
+    // What earlier fuzzing found mishandled (docs/fuzzing.md, findings).
+    "?: on matrices",
+    "@nearest matrix",
+    "name WGSL reserves or escapes",
+    "local shadowing a constant or function",
+    "constant operation",
+    "constant index expression",
+    "constant shift amount expression",
+    "local holding a constant as index",
+    "local holding a constant as divisor",
+    "local holding a constant as shift amount",
 ];
 
 #[test]

@@ -13,12 +13,16 @@
 //! through single-definition locals), texture reads, every operator, swizzles,
 //! indexing, constructors, conversions and the builtins.
 //!
-//! It stays inside the space the compiler supports today and leaves out, on
-//! purpose, the classes of programs that pass `check` but make naga reject a
-//! kernel (docs/fuzzing.md lists them): builtin calls and `% / <<` on
-//! constant arguments only, constant indices out of range, constant shift
-//! amounts of 32 or more, integer division by a constant (or `let`-bound)
-//! zero, user names ending in `_` or `_l`, and deep nesting.
+//! It also writes what the fuzzing found the compiler mishandling before
+//! (docs/fuzzing.md, findings): `?:` on matrices and `@nearest` matrix
+//! effects, names WGSL reserves or that collide with escaped names, locals
+//! that shadow constants and functions, operations whose operands are all
+//! constant (builtins, `%`, shifts, indexing, within the ranges WGSL
+//! allows), and locals holding constants used as divisors (zero included),
+//! shift amounts and indices (out of range included), which are run-time
+//! values. It leaves out what the checks reject (E0205, E0213, E0214: a
+//! constant division by zero, a constant index out of range, ...) and
+//! nesting past the limits (E0602-E0604).
 //!
 //! The module has no dependencies: it draws its decisions from a [`Choices`].
 //! The `wellformed` cargo-fuzz target (compiler/fuzz) implements it over
@@ -259,6 +263,15 @@ const STEMS: &[&str] = &[
     "ptr",
     "bitcast",
     "workgroup",
+    // WGSL reserves names starting with `__`, and `_` alone; names ending in
+    // `_` or `_l` are what escaped names look like; `mrsl_eval_x` is a
+    // generated function's name.
+    "__t",
+    "_",
+    "x_",
+    "var_",
+    "k_l",
+    "mrsl_eval_x",
 ];
 
 struct Gen<'c> {
@@ -270,8 +283,8 @@ struct Gen<'c> {
     textures: Vec<String>,
     samplers: Vec<String>,
     functions: Vec<Func>,
-    /// Effects written so far and whether something reads them.
-    effects: Vec<(Var, bool)>,
+    /// Effects written so far, each with where its declaration ends in `out`.
+    effects: Vec<(Var, usize)>,
     used: BTreeSet<String>,
     /// Nodes left: bounds the program's size.
     budget: i64,
@@ -323,6 +336,9 @@ impl<'c> Gen<'c> {
                 i += 1;
             }
         };
+        if name.starts_with('_') || name.ends_with('_') || name.ends_with("_l") || name.starts_with("mrsl") {
+            self.feat("name WGSL reserves or escapes");
+        }
         self.used.insert(name.clone());
         name
     }
@@ -587,10 +603,8 @@ impl<'c> Gen<'c> {
         };
         let name = self.fresh();
         let mut attr = String::new();
-        // No `@nearest` on matrices: nearest resampling selects with WGSL's
-        // `select`, which takes no matrix (docs/fuzzing.md, finding F3).
-        if rate == Rate::Coarse && !matches!(ty, M(_)) && self.chance(1, 4) {
-            self.feat("@nearest");
+        if rate == Rate::Coarse && self.chance(1, 4) {
+            self.feat(if matches!(ty, M(_)) { "@nearest matrix" } else { "@nearest" });
             attr = "@nearest ".into();
         }
         if rate == Rate::Out && self.chance(1, 3) {
@@ -659,7 +673,7 @@ impl<'c> Gen<'c> {
             }
             let _ = writeln!(self.out, "{header} {{\n{body}}}");
         }
-        self.effects.push((Var { name, ty, kind: Kind::Effect(rate) }, false));
+        self.effects.push((Var { name, ty, kind: Kind::Effect(rate) }, self.out.len()));
     }
 
     /// `if (fwidth(...) > t) refine;` and its relatives.
@@ -698,10 +712,18 @@ impl<'c> Gen<'c> {
     }
 
     /// The last output: reads every effect nothing has read yet, so that
-    /// every effect is live (no W0001).
+    /// every effect is live (no W0001). An effect is read when its name
+    /// stands in a later declaration: it is found in the text rather than
+    /// recorded when an expression reads it, since the generator sometimes
+    /// writes an expression and throws it away.
     fn final_output(&mut self) {
         let mut terms = vec![];
-        let unread: Vec<Var> = self.effects.iter().filter(|(_, r)| !r).map(|(v, _)| v.clone()).collect();
+        let unread: Vec<Var> = self
+            .effects
+            .iter()
+            .filter(|(v, end)| !names_in(&self.out[*end..]).contains(v.name.as_str()))
+            .map(|(v, _)| v.clone())
+            .collect();
         for v in unread {
             if v.kind == Kind::Effect(Rate::Out) {
                 continue;
@@ -811,7 +833,24 @@ impl<'c> Gen<'c> {
     fn local(&mut self, ctx: &mut Ctx, out: &mut String, depth: usize) {
         let pad = Self::indent(depth);
         let ty = self.value_type();
-        let name = self.fresh();
+        // Now and then a local shadows a constant or a function, which WGSL
+        // would then hide: the compiler renames the local (`_l`). Not one a
+        // local of this body already has (that would be E0101 in one scope).
+        let mut shadowed: Vec<String> = self
+            .globals
+            .iter()
+            .filter(|v| v.kind == Kind::Const)
+            .map(|v| v.name.clone())
+            .chain(self.functions.iter().map(|f| f.name.clone()))
+            .filter(|n| !ctx.scopes.iter().flatten().any(|v| &v.name == n))
+            .collect();
+        shadowed.sort();
+        let name = if !shadowed.is_empty() && self.chance(1, 8) {
+            self.feat("local shadowing a constant or function");
+            self.pick(&shadowed)
+        } else {
+            self.fresh()
+        };
         self.feat("local");
         if self.chance(1, 5) {
             self.feat("local without initialiser");
@@ -824,7 +863,9 @@ impl<'c> Gen<'c> {
             return;
         }
         let mutable = self.chance(1, 2);
-        let value = self.expr(ctx, ty, 0, false);
+        // Often a plain constant: such locals serve as run-time divisors,
+        // shift amounts and indices (`konst_local`).
+        let value = if self.chance(1, 4) { self.literal(ty) } else { self.expr(ctx, ty, 0, false) };
         let deriv_ok = !mutable && value.dsafe && matches!(ctx.body, Body::Effect(_));
         let _ = writeln!(out, "{pad}{} {name} = {};", ty.name(), value.text);
         ctx.scopes.last_mut().unwrap().push(Var {
@@ -1012,11 +1053,25 @@ impl<'c> Gen<'c> {
         (0..len).map(|_| set.as_bytes()[self.below(n as usize)] as char).collect()
     }
 
-    /// An index below `n`: a constant in range, or a non-constant `int`/`uint`.
+    /// An index below `n`: a constant in range (a literal or an operation on
+    /// literals), or a non-constant `int`/`uint`, which may be a local
+    /// holding a constant of any value (a run-time index, out of range or not).
     fn index(&mut self, ctx: &Ctx, n: u8) -> E {
-        match self.below(4) {
+        match self.below(6) {
             0 | 1 => E::lit(format!("{}", self.below(n as usize))),
             2 => E::lit(format!("{}u", self.below(n as usize))),
+            3 => {
+                self.feat("constant index expression");
+                let k = self.below(10);
+                E { text: format!("({k} % {n})"), konst: true, dsafe: true, literal: false }
+            }
+            4 if !ctx.deriv => match self.konst_local(ctx, &[INT, UINT]) {
+                Some(e) => {
+                    self.feat("local holding a constant as index");
+                    e
+                }
+                None => E::lit(format!("{}", self.below(n as usize))),
+            },
             _ => {
                 self.feat("dynamic index");
                 let ty = if self.chance(1, 2) { INT } else { UINT };
@@ -1033,11 +1088,6 @@ impl<'c> Gen<'c> {
     fn var_expr(&mut self, v: &Var) -> E {
         if let Kind::Effect(_) = v.kind {
             self.feat("effect read");
-            for (e, read) in self.effects.iter_mut() {
-                if e.name == v.name {
-                    *read = true;
-                }
-            }
         }
         let konst = match v.kind {
             Kind::Const => true,
@@ -1153,7 +1203,12 @@ impl<'c> Gen<'c> {
                 if !arrays.is_empty() {
                     self.feat("uniform array index");
                     let (name, len) = self.pick(&arrays);
-                    let i = if self.chance(1, 2) {
+                    let local = if ctx.deriv || self.chance(1, 2) { None } else { self.konst_local(ctx, &[INT, UINT]) };
+                    let i = if let Some(local) = local {
+                        // Any value: an index read at run time, out of range or not.
+                        self.feat("local holding a constant as index");
+                        local
+                    } else if self.chance(1, 2) {
                         E::lit(format!("{}", self.below(len as usize)))
                     } else {
                         self.feat("dynamic index");
@@ -1180,7 +1235,153 @@ impl<'c> Gen<'c> {
     }
 
     fn leaf_fallback(&mut self, ctx: &Ctx, ty: Ty, nc: bool) -> E {
-        if nc || self.chance(1, 3) { self.nonconst(ctx, ty, MAX_EXPR_DEPTH) } else { self.literal(ty) }
+        if nc || self.chance(1, 3) {
+            self.nonconst(ctx, ty, MAX_EXPR_DEPTH)
+        } else if self.chance(1, 3) {
+            self.constant_operation(ty)
+        } else {
+            self.literal(ty)
+        }
+    }
+
+    /// An operation whose operands are all constant, which WGSL evaluates
+    /// when the shader is created (and the checker folds): builtins, `%`,
+    /// shifts, bitwise operators, comparisons, swizzles and indexing of
+    /// constants, `?:`, all with values inside the ranges and domains WGSL
+    /// allows.
+    fn constant_operation(&mut self, ty: Ty) -> E {
+        self.feat("constant operation");
+        let text = match ty {
+            FLOAT => self
+                .pick(&[
+                    "sin(0.5)",
+                    "cos(2.0)",
+                    "tan(0.25)",
+                    "exp(2.0)",
+                    "exp2(3.0)",
+                    "log(2.5)",
+                    "log2(8.0)",
+                    "sqrt(2.0)",
+                    "inversesqrt(4.0)",
+                    "pow(2.0, 3.0)",
+                    "atan2(1.0, 2.0)",
+                    "atan(3.0)",
+                    "tanh(0.5)",
+                    "cosh(2.0)",
+                    "sinh(1.0)",
+                    "asin(0.5)",
+                    "acos(0.25)",
+                    "degrees(1.0)",
+                    "radians(90.0)",
+                    "fract(2.75)",
+                    "round(2.5)",
+                    "floor(-1.5)",
+                    "ceil(1.25)",
+                    "trunc(-2.5)",
+                    "saturate(1.5)",
+                    "sign(-3.0)",
+                    "abs(-0.5)",
+                    "step(0.5, 0.25)",
+                    "min(1.0, 2.0)",
+                    "max(1.0, 2)",
+                    "clamp(0.5, 0.0, 1.0)",
+                    "length(float2(3.0, 4.0))",
+                    "distance(float3(1.0), float3(2.0))",
+                    "dot(float2(1.0, 2.0), float2(3.0, 4.0))",
+                    "(7.5 % 2.0)",
+                    "(1.5 / 4.0)",
+                    "float(7 % 3)",
+                    "float(1 << 4)",
+                    "float3(1.0, 2.0, 3.0).z",
+                    "float2(0.5, 1.5)[1]",
+                    "(true ? 1.0 : 2.0)",
+                    "float(0xF0u >> 4u)",
+                    "float(5 & 3)",
+                    "float2x2(1.0, 2.0, 3.0, 4.0)[1].x",
+                    "(float2x2(1.0, 2.0, 3.0, 4.0) * float2(1.0, 0.5)).y",
+                ])
+                .to_string(),
+            INT => self
+                .pick(&[
+                    "(7 % 3)",
+                    "(-7 % 3)",
+                    "(1 << 4)",
+                    "(-1 << 30)",
+                    "(256 >> 2)",
+                    "(2147483647 >> 30)",
+                    "(12 / 5)",
+                    "(5 & 3)",
+                    "(5 | 8)",
+                    "(5 ^ 1)",
+                    "~7",
+                    "abs(-3)",
+                    "min(2, 9)",
+                    "max(-2, 1)",
+                    "clamp(5, 0, 3)",
+                    "sign(-4)",
+                    "dot(int2(1, 2), int2(3, 4))",
+                    "int3(1, 2, 3).y",
+                    "int(2.5)",
+                    "int(true)",
+                    "(1 < 2 ? 3 : 4)",
+                    "(1i << 30u)",
+                ])
+                .to_string(),
+            UINT => self
+                .pick(&[
+                    "(7u % 3u)",
+                    "(1u << 31u)",
+                    "(0xFFu >> 4u)",
+                    "(12u / 5u)",
+                    "max(1u, 5u)",
+                    "min(3u, 2u)",
+                    "(0xF0u | 0x0Fu)",
+                    "~0u",
+                    "uint(2.5)",
+                    "uint3(1u, 2u, 3u).z",
+                    "(4294967295u / 2u)",
+                    "dot(uint2(1u, 2u), uint2(3u, 4u))",
+                ])
+                .to_string(),
+            BOOL => self
+                .pick(&[
+                    "(1 < 2)",
+                    "all(bool2(true, false))",
+                    "any(bool3(false))",
+                    "((7 % 2) == 1)",
+                    "!(2.5 > 1.0)",
+                    "(true && false)",
+                    "((5 & 1) != 0)",
+                ])
+                .to_string(),
+            V(S::F, n) => match self.below(5) {
+                0 => format!("normalize(float{n}(1.0))"),
+                1 => format!("float{n}(sin(1.0))"),
+                2 => format!("abs(float{n}(-1.5))"),
+                3 => format!("(float{n}(7.5) % float{n}(2.0))"),
+                _ if n == 3 => "cross(float3(1.0, 0.0, 0.0), float3(0.0, 1.0, 0.0))".into(),
+                _ => format!("(float{n}(1.5) * 2.0)"),
+            },
+            V(S::I, n) => match self.below(3) {
+                0 => format!("(int{n}(7) % int{n}(3))"),
+                1 => format!("(int{n}(1) << uint{n}(3u))"),
+                _ => format!("abs(int{n}(-2))"),
+            },
+            V(S::U, n) => match self.below(2) {
+                0 => format!("(uint{n}(7u) >> uint{n}(1u))"),
+                _ => format!("max(uint{n}(1u), uint{n}(2u))"),
+            },
+            V(S::B, n) => match self.below(2) {
+                0 => format!("(int{n}(1) < int{n}(2))"),
+                _ => format!("!bool{n}(true)"),
+            },
+            M(n) => {
+                let cols: Vec<String> = (0..n).map(|k| format!("float{n}({}.0)", k + 1)).collect();
+                format!("(float{n}x{n}({}) * 2.0)", cols.join(", "))
+            }
+            _ => unreachable!("no constant operation of {ty:?}"),
+        };
+        E { text, konst: true, dsafe: true, literal: false }
     }
 
     /// Arithmetic `a op b` of type `ty`; at least one side non-constant
@@ -1205,7 +1406,13 @@ impl<'c> Gen<'c> {
         if int && (op == "/" || op == "%") {
             // Never a constant divisor that could be zero.
             let a = self.expr(ctx, lt, depth + 1, false);
-            let b = if self.chance(1, 3) {
+            let divisor_local = if a.konst || self.chance(3, 4) { None } else { self.konst_local(ctx, &[rt]) };
+            let b = if let Some(local) = divisor_local {
+                // A local holding a constant, maybe zero: a run-time divisor
+                // (WGSL's integer division by zero gives the dividend).
+                self.feat("local holding a constant as divisor");
+                local
+            } else if self.chance(1, 3) {
                 E::lit(match rt {
                     Ty::S(S::U) => "3u".to_string(),
                     Ty::S(_) => "3".to_string(),
@@ -1233,6 +1440,23 @@ impl<'c> Gen<'c> {
             _ => unreachable!(),
         };
         E { text: format!("({} | {one})", x.text), ..x }
+    }
+
+    /// A local that holds a constant (WGSL reads it at run time), of one of
+    /// `types`, if one is visible.
+    fn konst_local(&mut self, ctx: &Ctx, types: &[Ty]) -> Option<E> {
+        let locals: Vec<Var> = self
+            .leaves(ctx)
+            .into_iter()
+            .filter(|v| matches!(v.kind, Kind::Local { konst: true, .. }) && types.contains(&v.ty))
+            .collect();
+        if locals.is_empty() {
+            return None;
+        }
+        let v = self.pick(&locals);
+        let e = self.var_expr(&v);
+        // Constant to the generator's bookkeeping: an operand beside it must not be.
+        Some(E { konst: true, ..e })
     }
 
     /// A builtin call whose first argument is non-constant.
@@ -1449,12 +1673,25 @@ impl<'c> Gen<'c> {
                 let op = self.pick(&["<<", ">>"]);
                 let a = self.expr(ctx, ty, depth + 1, true);
                 let at = Ty::with_width(if self.chance(1, 2) { S::U } else { S::I }, ty.width());
-                let b = if self.chance(1, 2) {
+                let local = if ctx.deriv || self.chance(3, 4) { None } else { self.konst_local(ctx, &[at]) };
+                let b = if let Some(local) = local {
+                    // Any value: a run-time amount, which WGSL takes modulo 32.
+                    self.feat("local holding a constant as shift amount");
+                    local
+                } else if self.chance(1, 2) {
                     let k = self.below(32);
+                    let u = if at.scalar() == Some(S::U) { "u" } else { "" };
+                    let k = if self.chance(1, 3) {
+                        self.feat("constant shift amount expression");
+                        format!("({}{u} & {}{u})", self.below(1000), 31)
+                    } else {
+                        format!("{k}{u}")
+                    };
                     match at {
-                        Ty::S(S::U) => E::lit(format!("{k}u")),
-                        Ty::S(_) => E::lit(format!("{k}")),
-                        V(s2, n) => E::lit(format!("{}({k}{})", V(s2, n).name(), if s2 == S::U { "u" } else { "" })),
+                        Ty::S(_) => E { text: k, konst: true, dsafe: true, literal: false },
+                        V(s2, n) => {
+                            E { text: format!("{}({k})", V(s2, n).name()), konst: true, dsafe: true, literal: false }
+                        }
                         _ => unreachable!(),
                     }
                 } else {
@@ -1609,9 +1846,11 @@ impl<'c> Gen<'c> {
                     E::new(format!("({} * {})", s.text, a.text), &[&s, &a])
                 }
             }
+            3 => {
+                self.feat("?: on matrices");
+                self.ternary(ctx, ty, depth)
+            }
             _ => {
-                // No `?:` on matrices: it passes the checks but WGSL's `select`
-                // takes no matrix (docs/fuzzing.md, finding F2).
                 let a = self.expr(ctx, ty, depth + 1, true);
                 self.call("transpose", vec![a])
             }
@@ -1637,6 +1876,12 @@ impl<'c> Gen<'c> {
         let name = self.functions[i].name.clone();
         let textures = self.texture_names(ctx);
         let samplers = self.sampler_names(ctx);
+        // Decide before writing any argument: an argument thrown away may
+        // have read an effect, which would then count as read (and stay
+        // unread, W0001).
+        if params.iter().any(|p| (*p == Ty::Tex && textures.is_empty()) || (*p == Ty::Smp && samplers.is_empty())) {
+            return None;
+        }
         let mut args = vec![];
         for p in params {
             args.push(match p {
@@ -1768,6 +2013,27 @@ fn to_float(e: &str, ty: Ty) -> String {
         M(_) => format!("{e}[1].x"),
         _ => unreachable!(),
     }
+}
+
+/// The names `text` reads: its identifiers, except the components after a
+/// `.` (`uv.b` does not read `b`).
+fn names_in(text: &str) -> BTreeSet<&str> {
+    let mut names = BTreeSet::new();
+    let mut start = None;
+    for (k, c) in text.char_indices().chain(std::iter::once((text.len(), ' '))) {
+        let word = c.is_alphanumeric() || c == '_';
+        match (start, word) {
+            (None, true) => start = Some(k),
+            (Some(from), false) => {
+                if !text[..from].ends_with('.') {
+                    names.insert(&text[from..k]);
+                }
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    names
 }
 
 fn paren(text: &str) -> String {
