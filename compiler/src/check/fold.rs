@@ -651,7 +651,13 @@ impl Checker<'_> {
                     if len == 0.0 {
                         return Err(domain_error(e.span, builtin, "a zero vector".into(), "vectors that are not zero"));
                     }
-                    d.iter().map(|v| in_kind2(kind, *v, len, |p, q| p / q, |p, q| p / q)).collect()
+                    if len.is_finite() {
+                        d.iter().map(|v| in_kind2(kind, *v, len, |p, q| p / q, |p, q| p / q)).collect()
+                    } else {
+                        // naga rejects a length that overflows before
+                        // dividing by it: reported below as not finite.
+                        vec![len]
+                    }
                 } else {
                     vec![len]
                 }
@@ -664,8 +670,12 @@ impl Checker<'_> {
                     if let Some((inside, domain)) = builtin.constant_domain()
                         && !inside(x, y)
                     {
-                        let shown = if args.len() == 2 { format!("x = {x}, y = {y}") } else { format!("x = {x}") };
-                        return Err(domain_error(e.span, builtin, shown, domain));
+                        let at = if args.len() == 2 {
+                            format!("x = {}, y = {}", shown(x), shown(y))
+                        } else {
+                            format!("x = {}", shown(x))
+                        };
+                        return Err(domain_error(e.span, builtin, at, domain));
                     }
                     out.push(match builtin {
                         Abs if kind.is_int() => x.abs(),
@@ -686,8 +696,8 @@ impl Checker<'_> {
                         }
                         Clamp => {
                             if y > z {
-                                let shown = format!("low = {y}, high = {z}");
-                                return Err(domain_error(e.span, builtin, shown, "low <= high"));
+                                let at = format!("low = {}, high = {}", shown(y), shown(z));
+                                return Err(domain_error(e.span, builtin, at, "low <= high"));
                             }
                             x.max(y).min(z)
                         }
@@ -771,7 +781,15 @@ fn builtin_arith(e: &Expr, builtin: Builtin, kind: Kind, op: BinaryOp, x: f64, y
 
 /// A number as messages show it: `1e20` rather than its twenty-one digits.
 fn shown(x: f64) -> String {
-    if x != 0.0 && !(1e-4..1e7).contains(&x.abs()) { format!("{x:e}") } else { x.to_string() }
+    // A `float` prints as the `f32` it is, without the digits of its `f64` widening.
+    let single = x as f32;
+    let exact = single as f64 == x;
+    match (x != 0.0 && !(1e-4..1e7).contains(&x.abs()), exact) {
+        (true, true) => format!("{single:e}"),
+        (true, false) => format!("{x:e}"),
+        (false, true) => single.to_string(),
+        (false, false) => x.to_string(),
+    }
 }
 
 fn domain_error(span: Span, builtin: Builtin, shown: String, domain: &str) -> Diagnostic {
