@@ -275,7 +275,7 @@ impl Checker<'_> {
                 Ok(Some(ConstValue { ty: t.clone(), values: picked.values.iter().map(|v| kind.round(*v)).collect() }))
             }
             ExprKind::Field { base, field } => {
-                let Some(v) = self.value(base) else { return Ok(None) };
+                let Some(v) = self.value(base).filter(|v| !v.values.is_empty()) else { return Ok(None) };
                 let values = field
                     .name
                     .chars()
