@@ -3,7 +3,9 @@
 //! all nine kernels of `Options::default()` on every execution made these
 //! targets nine times slower; each execution builds the kernels of one mode
 //! instead, chosen by the input, so that every kind is still covered across
-//! executions (and a finding replays with the same kernels).
+//! executions (and a finding replays with the same kernels). The proptest
+//! smoke of generated programs (compiler/tests/it/fuzz.rs) builds its
+//! programs the same way, with this file.
 
 use mrsl::Options;
 

@@ -115,6 +115,14 @@ impl Kind {
     }
 }
 
+/// The element type of `ty` that `values` do not fit, if any: for the
+/// values of uniform defaults, which the layout carries and the runtime
+/// writes into the uniform block as that type.
+pub(super) fn misfit(ty: &Type, values: &[f64]) -> Option<&'static str> {
+    let kind = Kind::of(ty)?;
+    if values.iter().all(|x| kind.fits(*x)) { None } else { Some(kind.name()) }
+}
+
 /// Why a constant operation fails.
 enum Fail {
     DivideByZero,

@@ -142,6 +142,8 @@ impl Checker<'_> {
                 }
                 match op {
                     AssignOp::Set => self.expect_type(&value_ty, &target_ty, value.span, "assignment"),
+                    // Either side already reported.
+                    _ if target_ty.is_error() || value_ty.is_error() => {}
                     _ => {
                         let bop = match op {
                             AssignOp::Add => BinaryOp::Add,
@@ -338,6 +340,8 @@ impl Checker<'_> {
             ExprKind::Index { base, index } => {
                 let base_ty = self.lvalue(base);
                 let t = self.index_type(&base_ty, index, target.span);
+                // A constant index must be in range here too (E0214, `fold.rs`).
+                let t = if t.is_error() { t } else { self.fold(target, t) };
                 self.out.types[target.id.0 as usize] = t.clone();
                 t
             }
