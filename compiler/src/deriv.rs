@@ -156,6 +156,12 @@ type Definition<'a> = (&'a Expr, Option<usize>);
 struct LocalFacts<'a> {
     invariant: HashMap<LocalId, bool>,
     definitions: HashMap<LocalId, Definition<'a>>,
+    /// The top-level statement holding each single definition, declarations
+    /// included: where an inlined definition reads the locals it names.
+    defined_in: HashMap<LocalId, usize>,
+    /// The top-level statements holding each local's assignments other than
+    /// its declaration's initialiser and a loop's counter updates.
+    assigned_in: HashMap<LocalId, Vec<usize>>,
     assignment_count: HashMap<LocalId, u32>,
     loop_counters: HashSet<LocalId>,
 }
@@ -165,6 +171,8 @@ impl<'a> LocalFacts<'a> {
         let mut facts = LocalFacts {
             invariant: HashMap::new(),
             definitions: HashMap::new(),
+            defined_in: HashMap::new(),
+            assigned_in: HashMap::new(),
             assignment_count: HashMap::new(),
             loop_counters: HashSet::new(),
         };
@@ -177,6 +185,9 @@ impl<'a> LocalFacts<'a> {
             if a.for_init {
                 facts.loop_counters.insert(a.local);
             }
+            if !a.declaration {
+                facts.assigned_in.entry(a.local).or_default().push(a.statement);
+            }
         }
         for a in &all {
             if facts.assignment_count[&a.local] != 1 {
@@ -185,9 +196,11 @@ impl<'a> LocalFacts<'a> {
             match (a.value, a.declaration, a.nested) {
                 (Some(v), true, _) => {
                     facts.definitions.insert(a.local, (v, None));
+                    facts.defined_in.insert(a.local, a.statement);
                 }
                 (Some(v), false, false) => {
                     facts.definitions.insert(a.local, (v, Some(a.statement)));
+                    facts.defined_in.insert(a.local, a.statement);
                 }
                 _ => {}
             }
@@ -215,6 +228,17 @@ impl<'a> LocalFacts<'a> {
     /// An invariant local keeps its value from its declaration on.
     fn is_stable(&self, local: LocalId) -> bool {
         self.loop_counters.contains(&local) || self.assignment_count.get(&local).copied().unwrap_or(0) <= 1
+    }
+
+    /// Whether `local` may be assigned at or after top-level statement
+    /// `at`, other than by its declaration or as a loop counter. A
+    /// definition read there may then see an earlier value than the one a
+    /// derivative later in the body sees (a local declared without an
+    /// initialiser holds zero until its assignment). Statements are compared
+    /// at the top level, so an assignment in the same top-level statement
+    /// counts as after: conservative.
+    fn assigned_from(&self, local: LocalId, at: usize) -> bool {
+        !self.loop_counters.contains(&local) && self.assigned_in.get(&local).is_some_and(|s| s.iter().any(|&q| q >= at))
     }
 
     fn expr_invariant(&self, e: &Expr, checked: &Checked) -> bool {
@@ -454,25 +478,39 @@ impl<'a> OperandWalk<'_, 'a> {
     /// must be walked next.
     fn local(&mut self, local: LocalId, span: Span, name: &str, through: Option<LocalId>) -> Option<&'a Expr> {
         let facts = self.facts;
+        // Where the read happens: at the derivative, or where the definition
+        // that reads the local stands (it is inlined, but reads the values
+        // of that point of the body).
+        let reading_at = match through {
+            Some(t) => facts.defined_in.get(&t).copied().unwrap_or(self.statement),
+            None => self.statement,
+        };
         if facts.is_invariant(local) {
             if through.is_some() && !facts.is_stable(local) {
                 self.error(local, span, name, Why::Stale);
+                return None;
+            }
+            // Passed as an argument, it has the value of the derivative's
+            // point; a definition that reads it earlier, before its
+            // assignment, saw another value.
+            if through.is_some() && facts.assigned_from(local, reading_at) {
+                self.error(local, span, name, Why::Before);
                 return None;
             }
             self.params.insert(local);
             return None;
         }
         match facts.definitions.get(&local) {
-            Some((_, Some(defined_at))) if *defined_at >= self.statement => {
-                self.error(local, span, name, Why::Before);
-                None
-            }
             // Read again through its own definition: a definition that reads
             // the local it assigns (`a = a + x;`), directly or through others,
             // reads the value from before the assignment, which inlining
             // cannot give (and would never finish).
             Some(_) if self.visiting.contains(&local) => {
                 self.error(local, span, name, Why::SelfRead);
+                None
+            }
+            Some((_, Some(defined_at))) if *defined_at >= reading_at => {
+                self.error(local, span, name, Why::Before);
                 None
             }
             Some(_) if self.walked.contains(&local) => None,
@@ -515,12 +553,15 @@ impl<'a> OperandWalk<'_, 'a> {
         let via = &self.checked.locals[through.index()].name;
         let callee = &self.callee.name;
         let site = match why {
-            Why::Before | Why::SelfRead => None,
+            Why::SelfRead => None,
+            // The assignment that comes too late: a local assigned after the
+            // definition that reads it is assigned once, so its first assignment.
+            Why::Before => assignments(self.body, self.checked, local).first().map(|(span, _)| (*span, Nesting::Later)),
             Why::Stale | Why::Unstable => assignment_site(self.body, self.checked, local),
         };
         let used = match (why, site) {
             (Why::Before, _) => {
-                format!("`{via}` is computed from `{name}`, which is assigned only after the derivative")
+                format!("`{via}` is computed from `{name}` before `{name}` is assigned")
             }
             (Why::SelfRead, _) if via == name => {
                 format!("`{name}` is read by its own definition, before it is assigned")
@@ -550,6 +591,7 @@ impl<'a> OperandWalk<'_, 'a> {
                     Nesting::Loop => format!("`{name}` is assigned inside a loop"),
                     Nesting::Branch => format!("`{name}` is assigned inside a branch"),
                     Nesting::Again => format!("`{name}` is assigned again here"),
+                    Nesting::Later => format!("`{name}` is assigned here"),
                 },
             )),
             None => d.with_label(Label::secondary(decl, "declared here")),
@@ -713,7 +755,9 @@ fn collect_skipped(s: &Stmt, checked: &Checked, needed: &HashSet<LocalId>, skipp
 enum Why {
     /// Invariant, but assigned again: an inlined definition may have read another value.
     Stale,
-    /// Its single assignment comes after the derivative.
+    /// Its single assignment comes after the derivative, or, read through an
+    /// inlined definition, at or after that definition (an invariant local
+    /// passed as an argument included).
     Before,
     /// Neither invariant nor single-definition.
     Unstable,
@@ -729,12 +773,24 @@ enum Nesting {
     Branch,
     /// A second assignment at the top level of the body.
     Again,
+    /// The assignment that comes after a read (for `Why::Before`).
+    Later,
 }
 
 /// For diagnostics: the assignment to `local` that stops it from being
 /// recomputed at a neighbour, the first one inside a loop, else inside a
 /// branch, else the second one.
 fn assignment_site(body: &[&Stmt], checked: &Checked, local: LocalId) -> Option<(Span, Nesting)> {
+    let sites = assignments(body, checked, local);
+    let find = |n: Nesting| sites.iter().find(|(_, k)| *k == Some(n)).map(|(span, _)| (*span, n));
+    find(Nesting::Loop)
+        .or_else(|| find(Nesting::Branch))
+        .or_else(|| sites.get(1).map(|(span, _)| (*span, Nesting::Again)))
+}
+
+/// The assignments to `local` in source order (declarations with an
+/// initialiser included), each with the loop or branch it is in, if any.
+fn assignments(body: &[&Stmt], checked: &Checked, local: LocalId) -> Vec<(Span, Option<Nesting>)> {
     fn walk(
         s: &Stmt,
         checked: &Checked,
@@ -772,8 +828,5 @@ fn assignment_site(body: &[&Stmt], checked: &Checked, local: LocalId) -> Option<
     for s in body {
         walk(s, checked, local, None, &mut sites);
     }
-    let find = |n: Nesting| sites.iter().find(|(_, k)| *k == Some(n)).map(|(span, _)| (*span, n));
-    find(Nesting::Loop)
-        .or_else(|| find(Nesting::Branch))
-        .or_else(|| sites.get(1).map(|(span, _)| (*span, Nesting::Again)))
+    sites
 }

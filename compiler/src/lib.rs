@@ -52,6 +52,7 @@ pub mod internals {
     pub use crate::check::{EffectId, check as check_ast};
     pub use crate::graph::build as build_graph;
     pub use crate::interface::{EXACT_LIMIT, allocate as allocate_interface, colour};
+    pub use crate::syntax::lexer::Lexer;
     pub use crate::syntax::parse;
 
     /// The operations of the program's fully inlined code, as the size

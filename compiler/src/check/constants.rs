@@ -1,9 +1,10 @@
 //! Constant evaluation: the values of `const`s, uniform defaults, array
-//! lengths and loop bounds, and the range checks WGSL would otherwise make
-//! when the shader is created (so that such programs fail here, not in naga).
+//! lengths and loop bounds, the constant expressions of the language
+//! (docs/language.md, section 3.3). WGSL's wider notion of a constant
+//! expression, and the checks it makes on them when the shader is created,
+//! are in `fold.rs`.
 
 use super::{Checker, ConstId, ConstValue, Ctx, Global, err};
-use crate::builtins::Builtin;
 use crate::syntax::ast::*;
 use crate::syntax::visit_expr;
 use crate::types::{self, Scalar, Type};
@@ -179,70 +180,5 @@ impl Checker<'_> {
             }
             _ => None,
         }
-    }
-
-    /// Whether an expression is made only of literals and constants (WGSL
-    /// evaluates such expressions when the shader is created).
-    pub(super) fn is_constant(&self, e: &Expr) -> bool {
-        let mut constant = true;
-        visit_expr(e, &mut |x| match &x.kind {
-            ExprKind::Name(n) => constant &= matches!(self.globals.get(n), Some((Global::Const(_), _))),
-            ExprKind::Call { callee, .. } => constant &= Type::from_name(&callee.name).is_some(),
-            ExprKind::Index { .. } | ExprKind::Field { .. } | ExprKind::Ternary(..) => constant = false,
-            _ => {}
-        });
-        constant
-    }
-
-    /// Reports a constant expression whose value does not fit its type (as
-    /// WGSL would at shader creation); returns whether it fits.
-    pub(super) fn constant_in_range(&mut self, e: &Expr, ty: &Type) -> bool {
-        let Some(value) = self.const_eval(e) else { return true };
-        let fits = |x: f64| match ty.scalar() {
-            _ if *ty == Type::AbstractInt => (i32::MIN as f64..=i32::MAX as f64).contains(&x),
-            Some(Scalar::Int) => (i32::MIN as f64..=i32::MAX as f64).contains(&x),
-            Some(Scalar::Uint) => (0.0..=u32::MAX as f64).contains(&x),
-            Some(Scalar::Float) => x.is_finite() && x.abs() <= f32::MAX as f64,
-            _ => true,
-        };
-        if value.values.iter().all(|x| fits(*x)) {
-            return true;
-        }
-        let what = if value.values.iter().any(|x| x.is_infinite() || x.is_nan()) {
-            "divides by zero or overflows"
-        } else {
-            "out of range"
-        };
-        self.error(err("E0205", format!("constant expression out of range for `{}`", ty.concretize()), e.span, what));
-        false
-    }
-
-    /// Reports a builtin call on constant arguments outside the builtin's
-    /// domain (`log(-1)`, `sqrt(-1)`, `pow(-1, 2)`): WGSL evaluates such a
-    /// call when the shader is created and rejects it there.
-    pub(super) fn constant_arguments_in_domain(&mut self, builtin: Builtin, call: &Expr, args: &[Expr]) {
-        let Some((inside, domain)) = builtin.constant_domain() else { return };
-        let Some(x) = args.first().and_then(|a| self.const_eval(a)) else { return };
-        let y = match args.get(1) {
-            Some(a) => match self.const_eval(a) {
-                Some(y) => y.values,
-                None => return,
-            },
-            None => vec![0.0],
-        };
-        let at = |values: &[f64], i: usize| values[if values.len() == 1 { 0 } else { i.min(values.len() - 1) }];
-        let n = x.values.len().max(y.len());
-        let Some(bad) = (0..n).find(|&i| !inside(at(&x.values, i), at(&y, i))) else { return };
-        let shown = if args.len() == 2 {
-            format!("x = {}, y = {}", at(&x.values, bad), at(&y, bad))
-        } else {
-            format!("x = {}", at(&x.values, bad))
-        };
-        let name = builtin.name();
-        self.error(
-            err("E0213", format!("`{name}` of constant arguments outside its domain"), call.span, shown)
-                .with_note(format!("`{name}` is defined for {domain}"))
-                .with_note("WGSL evaluates calls on constants when the shader is created, and rejects this one"),
-        );
     }
 }

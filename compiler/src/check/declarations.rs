@@ -240,6 +240,19 @@ impl Checker<'_> {
                 UniformKind::Value { .. } => {
                     let value = self.const_eval(default);
                     match value {
+                        // `uniform uint u = -1;`, `uniform int i = 2147483647 + 1;`.
+                        Some(v)
+                            if (v.ty.converts_to(&ty) || v.ty == ty)
+                                && super::fold::misfit(&ty, &v.values).is_some() =>
+                        {
+                            let name = super::fold::misfit(&ty, &v.values).unwrap_or("its type");
+                            self.error(err(
+                                "E0205",
+                                format!("uniform default out of range for `{name}`"),
+                                default.span,
+                                "out of range",
+                            ));
+                        }
                         Some(v) if v.ty.converts_to(&ty) || v.ty == ty => {
                             self.out.uniforms[id.index()].kind =
                                 UniformKind::Value { default: Some(ConstValue { ty: ty.clone(), values: v.values }) };

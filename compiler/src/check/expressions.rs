@@ -6,7 +6,7 @@ use super::builtins::{BuiltinError, builtin_type};
 use super::names::{TYPE_NAMES, suggest, well_known_uniform};
 use super::typing::{binary_type, construct_check, unify};
 use super::{Callee, Checker, Ctx, Global, LocalId, Symbol, err};
-use crate::builtins::{Builtin, Rule};
+use crate::builtins::Builtin;
 use crate::diagnostic::{Diagnostic, Label};
 use crate::syntax::ast::*;
 use crate::types::{self, Scalar, Type};
@@ -14,6 +14,8 @@ use crate::types::{self, Scalar, Type};
 impl Checker<'_> {
     pub(super) fn expr(&mut self, e: &Expr) -> Type {
         let t = self.expr_inner(e);
+        // What WGSL would reject about constant operands (`fold.rs`).
+        let t = if t.is_error() { t } else { self.fold(e, t) };
         self.out.types[e.id.0 as usize] = t.clone();
         t
     }
@@ -59,9 +61,7 @@ impl Checker<'_> {
                         matches!(t.scalar(), Some(Scalar::Int | Scalar::Uint)) && !matches!(t, Type::Matrix(_))
                     }
                 };
-                if ok && matches!(op, UnaryOp::Neg) && self.is_constant(inner) && !self.constant_in_range(e, &t) {
-                    Type::Error
-                } else if ok {
+                if ok {
                     t
                 } else {
                     let sym = match op {
@@ -81,30 +81,6 @@ impl Checker<'_> {
                     return Type::Error;
                 }
                 match binary_type(*op, &ta, &tb) {
-                    // WGSL folds literal-only arithmetic at shader creation;
-                    // what it would reject must be reported here.
-                    // WGSL folds constant arithmetic (literals, typed or not) at
-                    // shader creation; what it would reject is reported here.
-                    Ok(t) if self.is_constant(a) && self.is_constant(b) => {
-                        let integer = matches!(t.scalar(), Some(Scalar::Int | Scalar::Uint)) && !t.is_abstract()
-                            || t == Type::AbstractInt;
-                        if matches!(op, BinaryOp::Div | BinaryOp::Rem)
-                            && integer
-                            && self.const_eval(b).is_some_and(|v| v.values.contains(&0.0))
-                        {
-                            self.error(err(
-                                "E0205",
-                                "division by zero in a constant expression",
-                                e.span,
-                                "divides by zero",
-                            ));
-                            return Type::Error;
-                        }
-                        if !self.constant_in_range(e, &t) {
-                            return Type::Error;
-                        }
-                        t
-                    }
                     Ok(t) => t,
                     Err(message) => {
                         self.error(
@@ -348,16 +324,6 @@ impl Checker<'_> {
         if let Some(ty) = Type::from_name(name) {
             self.out.callees.insert(e.id, Callee::Construct(ty.clone()));
             return match construct_check(&ty, &arg_types) {
-                Ok(()) if args.iter().all(|a| self.is_constant(a)) => {
-                    // `uint(-1)` and friends: WGSL rejects them when creating the shader.
-                    let negative_to_uint = ty.scalar() == Some(Scalar::Uint)
-                        && args.iter().any(|a| self.const_eval(a).is_some_and(|v| v.values.iter().any(|x| *x < 0.0)));
-                    if negative_to_uint {
-                        self.error(err("E0205", format!("`{name}` of a negative constant"), e.span, "out of range"));
-                        return Type::Error;
-                    }
-                    if self.constant_in_range(e, &ty) { ty } else { Type::Error }
-                }
                 Ok(()) => ty,
                 Err(message) => {
                     self.error(err("E0210", message, e.span, format!("in this `{name}` constructor")));
@@ -403,6 +369,7 @@ impl Checker<'_> {
             }
             for ((arg, at), pt) in args.iter().zip(&arg_types).zip(&params) {
                 self.expect_type(at, pt, arg.span, &format!("argument to `{name}`"));
+                self.check_fits(arg, pt);
             }
             return ret;
         }
@@ -410,18 +377,6 @@ impl Checker<'_> {
             self.out.callees.insert(e.id, Callee::Builtin(builtin));
             return match builtin_type(builtin, &arg_types) {
                 Ok((ret, splat_to)) => {
-                    self.constant_arguments_in_domain(builtin, e, args);
-                    // Literal arguments take the type of the concrete ones (`min(2u, -1)`
-                    // makes `-1` a `uint`), so they must fit it, as WGSL checks.
-                    let concrete =
-                        arg_types.iter().find(|t| !t.is_abstract() && !t.is_error()).and_then(|t| t.scalar());
-                    if let (Some(scalar), Rule::Generic { .. }) = (concrete, builtin.signature().rule) {
-                        for (arg, at) in args.iter().zip(&arg_types) {
-                            if at.is_abstract() {
-                                self.constant_in_range(arg, &Type::Scalar(scalar));
-                            }
-                        }
-                    }
                     if let Some(target) = splat_to {
                         for (arg, at) in args.iter().zip(&arg_types) {
                             if at.components() == 1 && target.vector_len().is_some() {

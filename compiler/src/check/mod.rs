@@ -7,7 +7,8 @@
 //!
 //! [`check`] runs the passes of one [`Checker`] in order; each pass lives in
 //! its own module: `declarations` (globals), `constants`, `statements` and
-//! `loops` (bodies), `expressions`, then `program` (whole-program checks).
+//! `loops` (bodies), `expressions` (with `fold`, WGSL's constant
+//! expressions in them), then `program` (whole-program checks).
 //! `typing`, `builtins` and `formats` are the rules those passes apply, and
 //! `names` makes the "did you mean" suggestions.
 
@@ -22,6 +23,7 @@ mod builtins;
 mod constants;
 mod declarations;
 mod expressions;
+mod fold;
 mod formats;
 mod loops;
 mod names;
@@ -176,6 +178,10 @@ pub struct Checked<'a> {
     /// The static trip count of every `for` statement whose bounds the
     /// loop check evaluated (the cost model multiplies its body by it).
     pub loop_trips: HashMap<NodeId, u64>,
+    /// The value of every expression WGSL evaluates when the shader is
+    /// created (made of literals, constants and operations on them; see
+    /// `fold.rs`), in the type the checker gives the expression.
+    pub constants: HashMap<NodeId, ConstValue>,
 }
 
 impl Checked<'_> {
@@ -273,6 +279,7 @@ impl<'a> Checker<'a> {
                 splats: HashMap::new(),
                 derivative_calls: vec![],
                 loop_trips: HashMap::new(),
+                constants: HashMap::new(),
             },
             diagnostics: vec![],
             globals: HashMap::new(),

@@ -68,6 +68,7 @@ impl Checker<'_> {
                 let ty = self.expr(expr);
                 let want = self.out.effects[id.index()].ty.clone();
                 self.expect_type(&ty, &want, expr.span, "effect value");
+                self.check_fits(expr, &want);
             }
             EffectBody::Block(block) => {
                 let ty = self.out.effects[id.index()].ty.clone();
@@ -117,6 +118,7 @@ impl Checker<'_> {
                 if let Some(init) = init {
                     let t = self.expr(init);
                     self.expect_type(&t, &declared, init.span, "initialiser");
+                    self.check_fits(init, &declared);
                 }
                 let id = self.declare_local(name, declared);
                 self.out.local_decls.insert(s.id, id);
@@ -124,8 +126,24 @@ impl Checker<'_> {
             StmtKind::Assign { target, op, value } => {
                 let target_ty = self.lvalue(target);
                 let value_ty = self.expr(value);
+                // Whatever the operator, a literal value converts to the target's type.
+                self.check_fits(value, &target_ty);
+                // `x /= 0` is `x = x / 0`: an integer division by a constant zero.
+                if *op == AssignOp::Div
+                    && matches!(target_ty.scalar(), Some(Scalar::Int | Scalar::Uint))
+                    && self.out.constants.get(&value.id).is_some_and(|v| v.values.contains(&0.0))
+                {
+                    self.error(err(
+                        "E0205",
+                        "division by zero in a constant expression",
+                        value.span,
+                        "divides by zero",
+                    ));
+                }
                 match op {
                     AssignOp::Set => self.expect_type(&value_ty, &target_ty, value.span, "assignment"),
+                    // Either side already reported.
+                    _ if target_ty.is_error() || value_ty.is_error() => {}
                     _ => {
                         let bop = match op {
                             AssignOp::Add => BinaryOp::Add,
@@ -211,6 +229,7 @@ impl Checker<'_> {
                         Some(v) => {
                             let t = self.expr(v);
                             self.expect_type(&t, &ret, v.span, "return value");
+                            self.check_fits(v, &ret);
                         }
                         None => self.error(err(
                             "E0201",
@@ -321,6 +340,8 @@ impl Checker<'_> {
             ExprKind::Index { base, index } => {
                 let base_ty = self.lvalue(base);
                 let t = self.index_type(&base_ty, index, target.span);
+                // A constant index must be in range here too (E0214, `fold.rs`).
+                let t = if t.is_error() { t } else { self.fold(target, t) };
                 self.out.types[target.id.0 as usize] = t.clone();
                 t
             }

@@ -30,6 +30,22 @@ pub(super) fn binary_type(op: BinaryOp, a: &Type, b: &Type) -> Result<Type, Stri
     let mismatch = || format!("cannot apply `{}` to `{a}` and `{b}`", op.symbol());
     let (ea, sa) = parts(a).ok_or_else(mismatch)?;
     let (eb, sb) = parts(b).ok_or_else(mismatch)?;
+    let is_int = |e: Elem| matches!(e, Elem::Int | Elem::Uint | Elem::AbsInt);
+    if let Shl | Shr = op {
+        // The shift amount may be int or uint, whatever the left operand's
+        // element type: WGSL wants u32, codegen converts.
+        return if is_int(ea) && is_int(eb) && sa == sb && !matches!(sa, Shape::Mat(_)) {
+            // A literal shifted by a concrete amount concretizes to `int`, as in WGSL.
+            let elem = match (ea, eb) {
+                (Elem::AbsInt, Elem::AbsInt) => Elem::AbsInt,
+                (Elem::AbsInt, _) => Elem::Int,
+                _ => ea,
+            };
+            Ok(build(elem, sa))
+        } else {
+            Err(mismatch())
+        };
+    }
     let elem = unify_elem(ea, eb).ok_or_else(|| {
         format!(
             "cannot apply `{}` to `{a}` and `{b}`: the element types differ (convert one side explicitly)",
@@ -37,7 +53,6 @@ pub(super) fn binary_type(op: BinaryOp, a: &Type, b: &Type) -> Result<Type, Stri
         )
     })?;
     let is_num = |e: Elem| e != Elem::Bool;
-    let is_int = |e: Elem| matches!(e, Elem::Int | Elem::Uint | Elem::AbsInt);
     match op {
         Add | Sub | Mul | Div | Rem => {
             if !is_num(elem) {
@@ -84,20 +99,7 @@ pub(super) fn binary_type(op: BinaryOp, a: &Type, b: &Type) -> Result<Type, Stri
                 Err(mismatch())
             }
         }
-        Shl | Shr => {
-            // The shift amount may be int or uint; WGSL wants u32, codegen converts.
-            if is_int(ea) && is_int(eb) && sa == sb && !matches!(sa, Shape::Mat(_)) {
-                // A literal shifted by a concrete amount concretizes to `int`, as in WGSL.
-                let elem = match (ea, eb) {
-                    (Elem::AbsInt, Elem::AbsInt) => Elem::AbsInt,
-                    (Elem::AbsInt, _) => Elem::Int,
-                    _ => ea,
-                };
-                Ok(build(elem, sa))
-            } else {
-                Err(mismatch())
-            }
-        }
+        Shl | Shr => unreachable!("shifts are typed above"),
     }
 }
 

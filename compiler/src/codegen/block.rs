@@ -346,12 +346,19 @@ impl Writer<'_, '_, '_> {
             };
             let info = &c.effects[e.index()];
             let (filter, value) = if layout::uses_nearest(c, e) {
+                // `select` takes no matrix: a matrix goes through `mrsl_select_m<N>`.
+                let select = match info.ty {
+                    crate::types::Type::Matrix(n) => format!("mrsl_select_m{n}"),
+                    _ => "select".to_string(),
+                };
                 (
                     "nearest corner",
-                    "select(select(v0, v1, b.nearest == 1u), select(v2, v3, b.nearest == 3u), b.nearest >= 2u)",
+                    format!(
+                        "{select}({select}(v0, v1, b.nearest == 1u), {select}(v2, v3, b.nearest == 3u), b.nearest >= 2u)"
+                    ),
                 )
             } else {
-                ("bilinear", "v0 * b.weights.x + v1 * b.weights.y + v2 * b.weights.z + v3 * b.weights.w")
+                ("bilinear", "v0 * b.weights.x + v1 * b.weights.y + v2 * b.weights.z + v3 * b.weights.w".to_string())
             };
             self.template(
                 0,

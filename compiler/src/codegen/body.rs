@@ -13,28 +13,50 @@ use crate::syntax::ast::*;
 use crate::types::{Scalar, Type};
 use mrsl_abi::{KernelKind, entry};
 
-/// Renames user identifiers that collide with WGSL keywords, WGSL builtins or
-/// the generated `mrsl_` namespace, so source names survive everywhere else.
+/// The WGSL name of a user identifier: the name itself where WGSL takes it
+/// and nothing generated can be called so, else an escaped form. Distinct
+/// source names always get distinct WGSL names (the escapes are injective),
+/// and none is a name the generator writes:
+///
+/// - a name WGSL reserves for itself (starting with `__`, or `_` alone) or
+///   in the generated namespace (starting with `mrsl` in any case) is
+///   prefixed: `mrsl_user_<name>`. Generated names start with `mrsl`,
+///   `Mrsl` or `MRSL` but never with `mrsl_user_`;
+/// - a WGSL keyword, reserved word or builtin, a generated entry point or a
+///   name with an entry point's prefix (`hier_`, `cb_`), `u` and `pos`, and
+///   any name that ends in `_` or `_l`, gets a trailing `_`. Names ending in
+///   `_` are escaped too so that an escaped name cannot equal a source name
+///   (`var` becomes `var_`, and `var_` becomes `var__`); names ending in
+///   `_l` so that no name this function returns ends in `_l`, the suffix of
+///   [`local_name`].
 pub(super) fn wgsl_ident(name: &str) -> String {
     // WGSL's reserved words and builtin names, looked up in a set: the
     // generator asks for every name it writes.
     static WGSL_NAMES: std::sync::LazyLock<std::collections::HashSet<&'static str>> = std::sync::LazyLock::new(|| {
         naga::keywords::wgsl::RESERVED.iter().chain(naga::keywords::wgsl::BUILTIN_IDENTIFIERS).copied().collect()
     });
-    let reserved = WGSL_NAMES.contains(name)
-        || name.to_ascii_lowercase().starts_with("mrsl")
+    let prefixed =
+        name.starts_with("__") || name == "_" || name.get(..4).is_some_and(|p| p.eq_ignore_ascii_case("mrsl"));
+    let suffixed = WGSL_NAMES.contains(name)
         || KernelKind::ALL.iter().any(|k| k.entry_points().contains(&name))
         || entry::RESERVED_PREFIXES.iter().any(|p| name.starts_with(p))
-        || name.starts_with("__")
+        || name.ends_with('_')
+        || name.ends_with("_l")
         || matches!(name, "u" | "pos");
-    if reserved { format!("{name}_") } else { name.to_string() }
+    match (prefixed, suffixed) {
+        (true, true) => format!("mrsl_user_{name}_"),
+        (true, false) => format!("mrsl_user_{name}"),
+        (false, true) => format!("{name}_"),
+        (false, false) => name.to_string(),
+    }
 }
 
 /// The WGSL name of a local variable or parameter.
 pub(super) fn local_name(checked: &Checked, id: LocalId) -> String {
     let info = &checked.locals[id.index()];
     // Locals may shadow module-scope user names (C allows it, WGSL would then
-    // hide the function or texture), so they are suffixed when they would.
+    // hide the function or texture), so they are suffixed when they would:
+    // `_l` after the escaped name, which no name `wgsl_ident` returns ends in.
     let base = wgsl_ident(&info.name);
     let clashes = checked.functions.iter().any(|f| f.name == info.name)
         || checked.consts.iter().any(|c| c.name == info.name)
@@ -79,6 +101,50 @@ impl Writer<'_, '_, '_> {
         self.line(0, "");
     }
 
+    /// The sizes of the matrices the program selects between: with `?:`
+    /// anywhere, or by resampling a `@nearest` coarse effect.
+    fn matrix_select_sizes(&self) -> std::collections::BTreeSet<u8> {
+        let c = self.checked();
+        let mut sizes = std::collections::BTreeSet::new();
+        let mut visit = |e: &Expr| {
+            crate::syntax::visit_expr(e, &mut |x| {
+                if let (ExprKind::Ternary(..), Type::Matrix(n)) = (&x.kind, c.ty(x)) {
+                    sizes.insert(*n);
+                }
+            })
+        };
+        for item in &c.program.items {
+            match item {
+                Item::Function(f) => f.body.stmts.iter().for_each(|s| crate::syntax::visit_stmt_exprs(s, &mut visit)),
+                Item::Effect(d) => match &d.body {
+                    EffectBody::Expr(e) => visit(e),
+                    EffectBody::Block(b) => b.stmts.iter().for_each(|s| crate::syntax::visit_stmt_exprs(s, &mut visit)),
+                },
+                _ => {}
+            }
+        }
+        for e in &c.effects {
+            if let (true, Type::Matrix(n)) = (e.nearest, &e.ty) {
+                sizes.insert(*n);
+            }
+        }
+        sizes
+    }
+
+    /// `mrsl_select_m<N>(f, t, c)`: WGSL's `select(f, t, c)` for the
+    /// `matN x N` matrices the program selects between, which `select` does
+    /// not take: column by column.
+    pub(super) fn matrix_selects(&mut self) {
+        for n in self.matrix_select_sizes() {
+            let ty = crate::types::Type::Matrix(n).wgsl();
+            let columns: Vec<String> = (0..n).map(|k| format!("select(f[{k}], t[{k}], c)")).collect();
+            self.line(0, format!("fn mrsl_select_m{n}(f: {ty}, t: {ty}, c: bool) -> {ty} {{"));
+            self.line(1, format!("return {ty}({});", columns.join(", ")));
+            self.line(0, "}");
+            self.line(0, "");
+        }
+    }
+
     pub(super) fn stmt(&mut self, s: &Stmt, indent: usize) {
         if self.skipped.is_some_and(|skipped| skipped.contains(&s.id)) {
             return;
@@ -91,7 +157,14 @@ impl Writer<'_, '_, '_> {
                 let name = local_name(c, id);
                 match init {
                     Some(v) => {
-                        let keyword = if info.reassigned { "var" } else { "let" };
+                        // naga folds what a `let` names when it is constant and
+                        // then treats every use as that constant (`x / zero`
+                        // with `let zero = 0;` would be a division by a
+                        // constant zero, which WGSL rejects); WGSL does not,
+                        // nor does mrsl: such a local is a `var`, whose value
+                        // naga reads at run time.
+                        let constant = c.constants.contains_key(&v.id);
+                        let keyword = if info.reassigned || constant { "var" } else { "let" };
                         let value = self.expr(v, Mode::Body);
                         self.line(indent, format!("{keyword} {name}: {} = {value};", info.ty.wgsl()));
                     }
@@ -139,6 +212,11 @@ impl Writer<'_, '_, '_> {
     }
 
     fn body(&mut self, s: &Stmt, indent: usize) {
+        // A branch or loop body left out of a value-only function as a
+        // whole: its statements are not in the skipped set themselves.
+        if self.skipped.is_some_and(|skipped| skipped.contains(&s.id)) {
+            return;
+        }
         match &s.kind {
             StmtKind::Block(b) => b.stmts.iter().for_each(|s| self.stmt(s, indent)),
             _ => self.stmt(s, indent),
@@ -226,7 +304,13 @@ impl Writer<'_, '_, '_> {
                 let cond = self.expr(cond, mode);
                 let x = self.expr(a, mode);
                 let y = self.expr(b, mode);
-                format!("select({y}, {x}, {cond})")
+                // WGSL's `select` takes scalars and vectors only; a matrix is
+                // selected column by column in a helper (`matrix_selects`),
+                // which, like `select`, evaluates both branches once.
+                match c.ty(e) {
+                    Type::Matrix(n) => format!("mrsl_select_m{n}({y}, {x}, {cond})"),
+                    _ => format!("select({y}, {x}, {cond})"),
+                }
             }
             ExprKind::Field { base, field } => format!("{}.{}", self.expr(base, mode), field.name),
             ExprKind::Index { base, index } => {

@@ -291,7 +291,12 @@ impl<'b> Writer<'_, '_, 'b> {
         let c = self.checked();
         {
             let site = &self.i.deriv.sites[k];
-            let ty = c.ty(site.operand).concretize();
+            // A derivative is a float (of the operand's shape): a literal
+            // operand (`ddx(1)`) is a float, not the `int` it would concretize to.
+            let ty = match c.ty(site.operand) {
+                t if t.is_abstract() => crate::types::FLOAT,
+                t => t.clone(),
+            };
             let mut params = vec!["mrsl_pos: vec2<i32>".to_string()];
             params.extend(
                 site.params.iter().map(|p| format!("{}: {}", local_name(c, *p), c.locals[p.index()].ty.wgsl())),

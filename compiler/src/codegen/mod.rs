@@ -233,6 +233,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         if !c.consts.is_empty() {
             self.line(0, "");
         }
+        self.matrix_selects();
         self.position_helpers();
         self.input_loaders();
         for k in 0..c.functions.len() {

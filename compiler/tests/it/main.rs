@@ -5,7 +5,12 @@ mod corpus;
 mod examples;
 mod fuzz;
 mod interface;
+// The modes the `compile` and `wellformed` fuzz targets build, one per
+// execution; the proptest smoke of generated programs builds them the same way.
+#[path = "../../fuzz/fuzz_targets/kernels.rs"]
+mod kernels;
 mod limits;
+mod wellformed;
 
 use mrsl::KernelKind;
 

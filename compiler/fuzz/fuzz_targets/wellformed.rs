@@ -1,0 +1,46 @@
+//! Well-typed programs from the grammar-aware generator
+//! (compiler/tests/it/wellformed.rs), driven by the fuzzer's bytes: each must
+//! pass every check with no diagnostic at all and compile to kernels naga
+//! accepts, with no warning. The first input byte picks the kernels of one
+//! mode to build (see `kernels.rs`); the rest drive the generator.
+#![no_main]
+
+mod kernels;
+#[path = "../../tests/it/wellformed.rs"]
+mod wellformed;
+
+use arbitrary::Unstructured;
+use libfuzzer_sys::fuzz_target;
+
+struct Bytes<'a, 'b>(&'b mut Unstructured<'a>);
+
+impl wellformed::Choices for Bytes<'_, '_> {
+    fn below(&mut self, n: usize) -> usize {
+        if n <= 1 { 0 } else { self.0.choose_index(n).unwrap_or(0) }
+    }
+}
+
+fuzz_target!(|data: &[u8]| {
+    let (choice, rest) = data.split_first().map_or((0, data), |(&b, rest)| (b as usize, rest));
+    let options = kernels::options(choice);
+    let mut u = Unstructured::new(rest);
+    let source = wellformed::program(&mut Bytes(&mut u)).source;
+    // W0002 (a key no coarse effect reads) is the one diagnostic allowed:
+    // the generator draws `@key` attributes independently of what its
+    // effects read.
+    let idle_key = |d: &mrsl::Diagnostic| d.code == "W0002";
+    let mut diagnostics = mrsl::check(&source);
+    diagnostics.retain(|d| !idle_key(d));
+    assert!(
+        diagnostics.is_empty(),
+        "a generated program has diagnostics:\n{source}\n{}",
+        mrsl::render_all(&diagnostics, "generated.mrsl", &source)
+    );
+    match mrsl::compile(&source, &options) {
+        Ok(program) => assert!(program.warnings.iter().all(idle_key), "a generated program warns:\n{source}"),
+        Err(diagnostics) => panic!(
+            "a generated program does not compile:\n{source}\n{}",
+            mrsl::render_all(&diagnostics, "generated.mrsl", &source)
+        ),
+    }
+});
