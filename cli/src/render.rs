@@ -44,6 +44,33 @@ struct Run {
     stats: Stats,
     /// Against the reference image (with `--compare`).
     metrics: Option<mrsl_lab::metrics::Metrics>,
+    /// Warm wall time from submission to idle, in ms (the median of the
+    /// paired runs with `--compare`).
+    wall_ms: f64,
+    /// With `--compare`: the median over [`PAIRS`] runs of this mode's wall
+    /// time divided by that of a reference run next to it.
+    relative_to_reference: Option<f64>,
+}
+
+/// Runs of each mode paired with reference runs for the timing of
+/// `--compare` (alternately before and after), so that the ratio is taken
+/// between runs at the same moment of a shared machine.
+const PAIRS: usize = 3;
+
+/// One warm run of `options`, from encoding to idle: its wall time in ms.
+fn time_run(gpu: &Gpu, shader: &mut Shader, bindings: &Bindings, options: DispatchOptions) -> Result<f64, String> {
+    let start = Instant::now();
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    shader.encode(&gpu.device, &gpu.queue, &mut encoder, bindings, options).map_err(|e| e.to_string())?;
+    gpu.queue.submit([encoder.finish()]);
+    gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| e.to_string())?;
+    Ok(start.elapsed().as_secs_f64() * 1e3)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) }
 }
 
 fn progress(what: &str, start: Instant) {
@@ -131,13 +158,53 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
         gpu.queue.submit([encoder.finish()]);
         reference = Some(gpu.read_rgba32f(first_output).map_err(|e| e.to_string())?);
     }
+    // Per-pass timestamps mean nothing on a CPU device: lavapipe writes a
+    // timestamp when its queue thread reaches it, so a pass reads as a few
+    // microseconds. Wall times are shown instead.
+    let cpu_device = gpu.adapter_info.device_type == wgpu::DeviceType::Cpu;
+    if cpu_device && (args.stats || args.output.is_none()) {
+        eprintln!(
+            "note: {} is a CPU device, whose per-pass timestamps are not meaningful; times shown are warm wall times",
+            gpu.adapter_info.name
+        );
+    }
     for &mode in &args.modes {
         let start = Instant::now();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options(mode)).map_err(|e| e.to_string())?;
         gpu.queue.submit([encoder.finish()]);
-        let stats = shader.read_stats(&gpu.device).map_err(|e| e.to_string())?;
-        progress(&format!("rendered {mode}"), start);
+        let mut stats = shader.read_stats(&gpu.device).map_err(|e| e.to_string())?;
+        if cpu_device {
+            stats.timings = None;
+        }
+        progress(&format!("rendered {mode} (first run, pipelines warming up)"), start);
+        // Warm wall time; with --compare, paired with reference runs.
+        let (wall_ms, relative_to_reference) = if args.compare && mode != Mode::Reference {
+            let (mut walls, mut ratios) = (vec![], vec![]);
+            for pair in 0..PAIRS {
+                let (wall, reference) = if pair % 2 == 0 {
+                    let r = time_run(&gpu, &mut shader, &bindings, options(Mode::Reference))?;
+                    (time_run(&gpu, &mut shader, &bindings, options(mode))?, r)
+                } else {
+                    let t = time_run(&gpu, &mut shader, &bindings, options(mode))?;
+                    (t, time_run(&gpu, &mut shader, &bindings, options(Mode::Reference))?)
+                };
+                walls.push(wall);
+                ratios.push(wall / reference);
+            }
+            // The images and statistics below are this mode's again.
+            time_run(&gpu, &mut shader, &bindings, options(mode))?;
+            (median(walls), Some(median(ratios)))
+        } else {
+            (time_run(&gpu, &mut shader, &bindings, options(mode))?, None)
+        };
+        match relative_to_reference {
+            Some(r) => eprintln!(
+                "{mode}: {wall_ms:.1} ms warm wall time, {:.2}x the reference's speed (median of {PAIRS} runs paired with the reference)",
+                1.0 / r
+            ),
+            None => eprintln!("{mode}: {wall_ms:.1} ms warm wall time"),
+        }
         let mut metrics = None;
         if args.compare {
             let pixels = gpu.read_rgba32f(first_output).map_err(|e| e.to_string())?;
@@ -204,7 +271,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
         if args.stats || args.output.is_none() {
             println!("{}", stats.table());
         }
-        all_stats.push(Run { stats, metrics });
+        all_stats.push(Run { stats, metrics, wall_ms, relative_to_reference });
     }
     let stats_path = match &args.output {
         Some(p) => p.with_extension("stats.json"),
