@@ -25,6 +25,7 @@ pub mod geometry;
 mod kernel;
 mod layout;
 mod program;
+pub mod shading_rate;
 mod types;
 
 pub use control::{CONTROL_FIELDS, Control, ControlField};
@@ -35,6 +36,7 @@ pub use layout::{
     StatsLayout, UniformBlock,
 };
 pub use program::{CompiledProgram, Kernel, ReadError};
+pub use shading_rate::ShadingRate;
 pub use types::{SampleType, Scalar, TextureFormat, ValueType};
 
 /// Bind group of the control block, user uniforms, textures and samplers.
