@@ -18,8 +18,10 @@ pub struct Control {
     pub frame: u32,
     /// Hierarchical mode: largest neighbour variance that is still interpolated.
     pub similarity: f32,
+    /// Rate-image mode: pixels per side of one shading-rate tile (8 or 16).
+    pub rate_tile: u32,
     /// Padding to a multiple of 16 bytes.
-    pub reserved: [u32; 3],
+    pub reserved: [u32; 2],
 }
 
 /// One field of the control block as the layout and the generated WGSL describe it.
@@ -41,7 +43,7 @@ const UINT: ValueType = ValueType::Scalar(Scalar::Uint);
 const FLOAT: ValueType = ValueType::Scalar(Scalar::Float);
 
 /// The fields of [`Control`], in order, with their offsets.
-pub static CONTROL_FIELDS: [ControlField; 4] = [
+pub static CONTROL_FIELDS: [ControlField; 5] = [
     ControlField { name: "size", ty: UINT2, wgsl_type: "vec2<u32>", offset: 0, size: 8, default: None, comment: None },
     ControlField {
         name: "force_refine",
@@ -62,6 +64,15 @@ pub static CONTROL_FIELDS: [ControlField; 4] = [
         default: Some(0.0),
         comment: Some("hierarchical mode: largest neighbour variance still interpolated"),
     },
+    ControlField {
+        name: "rate_tile",
+        ty: UINT,
+        wgsl_type: "u32",
+        offset: 20,
+        size: 4,
+        default: Some(8.0),
+        comment: Some("rate-image mode: pixels per side of a shading-rate tile"),
+    },
 ];
 
 impl Control {
@@ -80,6 +91,7 @@ mod tests {
         assert_eq!(std::mem::offset_of!(Control, force_refine) as u32, CONTROL_FIELDS[1].offset);
         assert_eq!(std::mem::offset_of!(Control, frame) as u32, CONTROL_FIELDS[2].offset);
         assert_eq!(std::mem::offset_of!(Control, similarity) as u32, CONTROL_FIELDS[3].offset);
+        assert_eq!(std::mem::offset_of!(Control, rate_tile) as u32, CONTROL_FIELDS[4].offset);
         for f in &CONTROL_FIELDS {
             assert_eq!(f.ty.components() * 4, f.size, "{}", f.name);
         }

@@ -117,6 +117,32 @@ pub fn indirect_args_offset(level: u32) -> u64 {
     u64::from(level * QUEUE_WORDS_PER_LEVEL * 4)
 }
 
+/// Rate-image mode: shading-rate tiles per side of one `rate_list` workgroup
+/// (one invocation per tile).
+pub const RATE_LIST_TILES: u32 = 8;
+
+/// Rate-image mode: `rate_list` workgroups for a `size` image and `tile`-pixel tiles.
+pub fn rate_list_workgroups(size: (u32, u32), tile: u32) -> (u32, u32) {
+    let (tx, ty) = crate::shading_rate::rate_image_size(size, tile);
+    (tx.div_ceil(RATE_LIST_TILES), ty.div_ceil(RATE_LIST_TILES))
+}
+
+/// Rate-image mode: words of the sample list. Every listed sample is a
+/// distinct pixel (each is listed by the one tile that owns it), so the
+/// list never holds more than one word per pixel.
+pub fn rate_work_words(size: (u32, u32)) -> u64 {
+    u64::from(size.0) * u64::from(size.1)
+}
+
+/// Rate-image mode: bytes of the counter buffer (word 0 counts listed
+/// samples) and of the indirect arguments of `rate_coarse` (x, y, z, unused):
+/// the workgroups are laid out `RATE_ARGS_MAX_X` wide and as many rows as needed.
+pub const RATE_QUEUE_BYTES: u64 = (QUEUE_WORDS_PER_LEVEL * 4) as u64;
+
+/// Rate-image mode: the widest indirect dispatch row (WebGPU's default
+/// `max_compute_workgroups_per_dimension`).
+pub const RATE_ARGS_MAX_X: u32 = 65535;
+
 /// Checkerboard `cb_shade` workgroups: rows of quads, [`CHECKERBOARD_QUADS_PER_WORKGROUP`]
 /// shaded quads per workgroup (half the quads of a row; all when `forced`).
 pub fn checkerboard_workgroups(size: (u32, u32), forced: bool) -> (u32, u32) {

@@ -1,7 +1,7 @@
 //! The kernels a program compiles to: their names, entry points in dispatch
 //! order and workgroup sizes, stated once in [`KernelKind`] and [`entry`].
 
-use crate::geometry::{COARSE_WORKGROUP, PIXEL_WORKGROUP};
+use crate::geometry::{COARSE_WORKGROUP, PIXEL_WORKGROUP, WORK_LIST_WORKGROUP};
 use serde::{Deserialize, Serialize};
 
 /// Entry-point names of the generated kernels. The runtime looks pipelines
@@ -27,13 +27,22 @@ pub mod entry {
     pub const CB_SHADE: &str = "cb_shade";
     /// Checkerboard final pass: reconstruct, then fine effects and outputs per pixel.
     pub const CB_FINAL: &str = "cb_final";
+    /// Rate-image mode: per shading-rate tile, append the coarse samples its rate needs to the work list.
+    pub const RATE_LIST: &str = "rate_list";
+    /// Rate-image mode: turn the work-list count into indirect dispatch arguments
+    /// (binds [`crate::GROUP_ARGS`]).
+    pub const RATE_ARGS: &str = "rate_args";
+    /// Rate-image mode: shade the coarse samples of the work list (indirect dispatch).
+    pub const RATE_COARSE: &str = "rate_coarse";
+    /// Rate-image mode, per pixel: resample at the tile's rate or evaluate, then fine effects and outputs.
+    pub const RATE_FINE: &str = "rate_fine";
 
     /// Prefixes of generated entry points; user identifiers with them are renamed.
-    pub const RESERVED_PREFIXES: [&str; 2] = ["hier_", "cb_"];
+    pub const RESERVED_PREFIXES: [&str; 3] = ["hier_", "cb_", "rate_"];
 
     /// Whether `name` is an entry point that binds the indirect-argument group.
     pub fn binds_args_group(name: &str) -> bool {
-        HIER_ARGS.contains(&name)
+        HIER_ARGS.contains(&name) || name == RATE_ARGS
     }
 }
 
@@ -77,11 +86,17 @@ pub enum KernelKind {
     /// Checkerboard baseline: coarse effects shaded in half the 2x2 quads,
     /// reconstructed in the others.
     Checkerboard,
+    /// Rate-image mode, coarse part: the samples each shading-rate tile needs
+    /// at its rate, listed, then shaded from the compacted list.
+    RateCoarse,
+    /// Rate-image mode, per pixel: coarse values resampled at the tile's rate
+    /// (or evaluated), then fine effects and outputs.
+    RateFine,
 }
 
 impl KernelKind {
     /// Every kind, in the order the compiler writes them.
-    pub const ALL: [KernelKind; 7] = [
+    pub const ALL: [KernelKind; 9] = [
         KernelKind::Coarse,
         KernelKind::Fine,
         KernelKind::Reference,
@@ -89,6 +104,8 @@ impl KernelKind {
         KernelKind::DynamicFine,
         KernelKind::Hierarchical,
         KernelKind::Checkerboard,
+        KernelKind::RateCoarse,
+        KernelKind::RateFine,
     ];
 
     /// The name used in file names and messages (`dynamic_coarse`).
@@ -101,6 +118,8 @@ impl KernelKind {
             KernelKind::DynamicFine => "dynamic_fine",
             KernelKind::Hierarchical => "hierarchical",
             KernelKind::Checkerboard => "checkerboard",
+            KernelKind::RateCoarse => "rate_coarse",
+            KernelKind::RateFine => "rate_fine",
         }
     }
 
@@ -119,6 +138,8 @@ impl KernelKind {
             KernelKind::DynamicFine => &[entry::DYNAMIC_FINE],
             KernelKind::Hierarchical => &HIERARCHICAL_ENTRY_POINTS,
             KernelKind::Checkerboard => &[entry::CB_SHADE, entry::CB_FINAL],
+            KernelKind::RateCoarse => &[entry::RATE_LIST, entry::RATE_ARGS, entry::RATE_COARSE],
+            KernelKind::RateFine => &[entry::RATE_FINE],
         }
     }
 
@@ -130,12 +151,12 @@ impl KernelKind {
 
     /// Whether the kernel runs per coarse sample (else per pixel).
     pub fn is_coarse(self) -> bool {
-        matches!(self, KernelKind::Coarse | KernelKind::DynamicCoarse)
+        matches!(self, KernelKind::Coarse | KernelKind::DynamicCoarse | KernelKind::RateCoarse)
     }
 
     /// Whether the kernel resolves coarse values per pixel from an interface buffer.
     pub fn is_fine(self) -> bool {
-        matches!(self, KernelKind::Fine | KernelKind::DynamicFine)
+        matches!(self, KernelKind::Fine | KernelKind::DynamicFine | KernelKind::RateFine)
     }
 
     /// Whether the kernel exists once per block size (coarse and fine); the
@@ -146,7 +167,13 @@ impl KernelKind {
 
     /// Workgroup size of the main entry point.
     pub fn workgroup_size(self) -> [u32; 3] {
-        if self.is_coarse() { [COARSE_WORKGROUP, COARSE_WORKGROUP, 1] } else { [PIXEL_WORKGROUP, 1, 1] }
+        if self == KernelKind::RateCoarse {
+            [WORK_LIST_WORKGROUP, 1, 1]
+        } else if self.is_coarse() {
+            [COARSE_WORKGROUP, COARSE_WORKGROUP, 1]
+        } else {
+            [PIXEL_WORKGROUP, 1, 1]
+        }
     }
 }
 

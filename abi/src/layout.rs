@@ -10,7 +10,7 @@ use crate::types::{SampleType, TextureFormat, ValueType};
 use serde::{Deserialize, Serialize};
 
 /// The layout format this crate reads and writes (the `format` field).
-pub const LAYOUT_FORMAT: &str = "mrsl-layout/2";
+pub const LAYOUT_FORMAT: &str = "mrsl-layout/3";
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Layout {
@@ -32,6 +32,11 @@ pub struct Layout {
     pub interface2: ResourceBinding,
     /// The hierarchical (DACS) and checkerboard modes' buffers.
     pub hierarchical: HierarchicalLayout,
+    /// The rate-image mode's shading-rate image (`texture_2d<u32>`, one texel
+    /// per tile, codes of [`crate::ShadingRate`]), read by both its kernels.
+    /// Its coarse kernel's work list and counter are bound at the hierarchical
+    /// mode's `work_binding` and `queue_binding`, and its arguments like theirs.
+    pub shading_rate: ResourceBinding,
     pub effects: Vec<EffectLayout>,
 }
 
@@ -70,6 +75,11 @@ impl Layout {
         let h = &self.hierarchical;
         let buffer =
             |slot, binding, read_only| StageBinding { binding, slot, resource: StageResource::Buffer { read_only } };
+        let shading_rate = StageBinding {
+            binding: self.shading_rate.binding,
+            slot: S::ShadingRate,
+            resource: StageResource::UintTexture,
+        };
         let mut bindings = match kind {
             KernelKind::Coarse => vec![buffer(S::Interface, self.interface.binding, false)],
             KernelKind::Fine => vec![buffer(S::Interface, self.interface.binding, true)],
@@ -90,6 +100,13 @@ impl Layout {
                 buffer(S::Queues, h.queue_binding, false),
             ],
             KernelKind::Checkerboard => vec![buffer(S::Records, h.values_binding, false)],
+            KernelKind::RateCoarse => vec![
+                buffer(S::Interface, self.interface.binding, false),
+                buffer(S::WorkLists, h.work_binding, false),
+                buffer(S::Queues, h.queue_binding, false),
+                shading_rate,
+            ],
+            KernelKind::RateFine => vec![buffer(S::Interface, self.interface.binding, true), shading_rate],
         };
         if !kind.is_coarse() {
             bindings.extend(self.outputs.iter().enumerate().map(|(index, o)| StageBinding {
@@ -136,10 +153,12 @@ pub enum StageSlot {
     Output(usize),
     /// The hierarchical and checkerboard modes' per-pixel records.
     Records,
-    /// The hierarchical work lists.
+    /// The hierarchical work lists (the rate-image mode's sample list).
     WorkLists,
-    /// The hierarchical queue counters.
+    /// The hierarchical queue counters (the rate-image mode's sample count).
     Queues,
+    /// The rate-image mode's shading-rate image.
+    ShadingRate,
 }
 
 /// What a stage-group binding holds.
@@ -149,6 +168,8 @@ pub enum StageResource {
     Buffer { read_only: bool },
     /// A write-only storage texture (an output, or the rate image).
     StorageTexture(TextureFormat),
+    /// A sampled `texture_2d<u32>` read with `textureLoad` (the shading-rate image).
+    UintTexture,
 }
 
 /// Buffers of the hierarchical and checkerboard modes (group 2): a record per
@@ -233,6 +254,9 @@ pub enum ResourceKind {
     /// A read-write storage buffer.
     #[serde(rename = "storage")]
     Storage,
+    /// A `texture_2d<u32>` of shading-rate codes.
+    #[serde(rename = "shading_rate")]
+    ShadingRate,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -213,6 +213,12 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface, cost
             binding: 3 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
             kind: ResourceKind::Storage,
         },
+        shading_rate: ResourceBinding {
+            name: "mrsl_shading_rate".into(),
+            group: GROUP_STAGE,
+            binding: 6 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
+            kind: ResourceKind::ShadingRate,
+        },
         hierarchical: {
             let outputs = checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32;
             let coarse: Vec<&crate::check::EffectInfo> =

@@ -113,6 +113,8 @@ pub struct Options {
     pub hierarchical: bool,
     /// The checkerboard baseline's kernel.
     pub checkerboard: bool,
+    /// The rate-image mode's two kernels (coarse samples at each tile's rate, then per pixel).
+    pub rate_image: bool,
     /// Name written in the header comment of every generated kernel.
     pub file_name: String,
     /// Compact the block modes' fine pass: the pixels of a workgroup that
@@ -136,6 +138,7 @@ impl Default for Options {
             dynamic: true,
             hierarchical: true,
             checkerboard: true,
+            rate_image: true,
             file_name: "program.mrsl".into(),
             compact: false,
         }
@@ -176,6 +179,10 @@ impl Options {
         if self.checkerboard {
             wanted.push((KernelKind::Checkerboard, None));
         }
+        if self.rate_image {
+            wanted.push((KernelKind::RateCoarse, None));
+            wanted.push((KernelKind::RateFine, None));
+        }
         wanted
     }
 
@@ -189,6 +196,7 @@ impl Options {
             dynamic: false,
             hierarchical: false,
             checkerboard: false,
+            rate_image: false,
             ..Options::default()
         }
     }

@@ -36,4 +36,5 @@ pub mod rig;
 pub mod runtime_dir;
 pub mod scene;
 pub mod scene_file;
+pub mod shading_rate;
 pub mod uniforms;

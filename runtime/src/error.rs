@@ -32,8 +32,20 @@ pub enum Error {
     BadSize { width: u32, height: u32, reason: String },
     #[error("mode `{0}` is not supported by this program: {1}")]
     UnsupportedMode(String, String),
-    #[error("unknown mode `{0}` (expected reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard)")]
+    #[error(
+        "unknown mode `{0}` (expected reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard, rate-image)"
+    )]
     UnknownMode(String),
+    #[error("the rate-image mode needs a shading-rate image (`Bindings::shading_rate`), and none is bound")]
+    MissingShadingRate,
+    #[error(
+        "the shading-rate image has format {0:?}; it must be an unsigned-integer texture (R8Uint as in D3D12 and Vulkan, R16Uint or R32Uint)"
+    )]
+    ShadingRateFormat(wgpu::TextureFormat),
+    #[error("the shading-rate image was not created with TextureUsages::TEXTURE_BINDING")]
+    ShadingRateUsage,
+    #[error("shading-rate tiles of {0} pixels are not supported (expected 8 or 16)")]
+    RateTile(u32),
     #[error("the device rejected a pipeline: {0}")]
     Pipeline(String),
     #[error("reading results back failed: {0}")]

@@ -78,6 +78,7 @@ pub fn compile_options(modes: &[Mode]) -> mrsl::Options {
             Mode::Dynamic => options.dynamic = true,
             Mode::Hierarchical => options.hierarchical = true,
             Mode::Checkerboard => options.checkerboard = true,
+            Mode::RateImage => options.rate_image = true,
         }
     }
     options.block_sizes.sort();
@@ -102,11 +103,23 @@ pub enum Mode {
     /// The baseline DACS compares with: coarse effects shaded in half the 2x2
     /// quads (a checkerboard), reconstructed in the others; not adaptive.
     Checkerboard,
+    /// Software variable-rate shading: coarse effects shaded at a per-tile
+    /// rate (1x1 to 4x4, anisotropic ones included) read from a shading-rate
+    /// image ([`Bindings::shading_rate`]), refined inside a tile as in the
+    /// block modes.
+    RateImage,
 }
 
 impl Mode {
-    pub const ALL: [Mode; 6] =
-        [Mode::Reference, Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic, Mode::Hierarchical, Mode::Checkerboard];
+    pub const ALL: [Mode; 7] = [
+        Mode::Reference,
+        Mode::Coarse2x2,
+        Mode::Coarse4x4,
+        Mode::Dynamic,
+        Mode::Hierarchical,
+        Mode::Checkerboard,
+        Mode::RateImage,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -116,6 +129,7 @@ impl Mode {
             Mode::Dynamic => "dynamic",
             Mode::Hierarchical => "hierarchical",
             Mode::Checkerboard => "checkerboard",
+            Mode::RateImage => "rate-image",
         }
     }
 
@@ -133,13 +147,14 @@ impl Mode {
             ],
             Mode::Hierarchical => &[(KernelKind::Hierarchical, None)],
             Mode::Checkerboard => &[(KernelKind::Checkerboard, None)],
+            Mode::RateImage => &[(KernelKind::RateCoarse, None), (KernelKind::RateFine, None)],
         }
     }
 
     /// The (first) coarse block size, or `None` for per-pixel shading.
     pub fn block_size(self) -> Option<u32> {
         match self {
-            Mode::Reference | Mode::Hierarchical | Mode::Checkerboard => None,
+            Mode::Reference | Mode::Hierarchical | Mode::Checkerboard | Mode::RateImage => None,
             Mode::Coarse2x2 => Some(2),
             Mode::Coarse4x4 => Some(4),
             Mode::Dynamic => Some(DYNAMIC_OUTER_BLOCK),

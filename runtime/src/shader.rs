@@ -24,6 +24,12 @@ pub struct Bindings<'a> {
     pub samplers: HashMap<String, &'a wgpu::Sampler>,
     /// Output storage textures, by `fine out` name.
     pub outputs: HashMap<String, &'a wgpu::Texture>,
+    /// The rate-image mode's shading-rate image: one texel per
+    /// [`DispatchOptions::rate_tile`]-pixel tile
+    /// ([`mrsl_abi::shading_rate::rate_image_size`]), an unsigned-integer
+    /// texture (R8Uint, R16Uint or R32Uint) holding the codes of
+    /// [`mrsl_abi::ShadingRate`]. Other modes ignore it.
+    pub shading_rate: Option<&'a wgpu::Texture>,
 }
 
 /// Per-dispatch settings.
@@ -36,6 +42,8 @@ pub struct DispatchOptions {
     /// Hierarchical mode: a pixel is interpolated only while the variance of
     /// its four neighbours' values (each component, linear) is at most this.
     pub similarity: f32,
+    /// Rate-image mode: pixels per side of a shading-rate tile (8 or 16).
+    pub rate_tile: u32,
 }
 
 impl DispatchOptions {
@@ -43,13 +51,26 @@ impl DispatchOptions {
     pub const DEFAULT_SIMILARITY: f32 = 1e-3;
 
     pub fn new(mode: Mode) -> DispatchOptions {
-        DispatchOptions { mode, force_refine: false, similarity: Self::DEFAULT_SIMILARITY }
+        DispatchOptions {
+            mode,
+            force_refine: false,
+            similarity: Self::DEFAULT_SIMILARITY,
+            rate_tile: mrsl_abi::shading_rate::DEFAULT_RATE_TILE,
+        }
     }
 }
 
 /// Buffers of the hierarchical mode.
 struct HierBuffers {
     values: wgpu::Buffer,
+    work: wgpu::Buffer,
+    queue: wgpu::Buffer,
+    args: wgpu::Buffer,
+}
+
+/// Buffers of the rate-image mode: the sample list, its counter and the
+/// indirect arguments of `rate_coarse`.
+struct RateBuffers {
     work: wgpu::Buffer,
     queue: wgpu::Buffer,
     args: wgpu::Buffer,
@@ -78,6 +99,8 @@ pub struct Shader {
     pipelines: HashMap<PipelineKey, wgpu::ComputePipeline>,
     /// Hierarchical mode buffers (values, work lists, queues) and the size they were made for.
     hier_buffers: Option<(HierBuffers, (u32, u32))>,
+    /// Rate-image mode buffers and the size they were made for.
+    rate_buffers: Option<(RateBuffers, (u32, u32))>,
     /// Whether the dispatch being encoded forces refinement.
     forced: bool,
     args_group_layout: wgpu::BindGroupLayout,
@@ -217,6 +240,7 @@ impl Shader {
             stage_layouts,
             pipelines,
             hier_buffers: None,
+            rate_buffers: None,
             forced: false,
             args_group_layout,
             queue_readback: device.create_buffer(&wgpu::BufferDescriptor {
@@ -287,7 +311,8 @@ impl Shader {
     }
 
     /// Checks `bindings` against the layout.
-    fn validate(&self, bindings: &Bindings, mode: Mode) -> Result<(), Error> {
+    fn validate(&self, bindings: &Bindings, options: DispatchOptions) -> Result<(), Error> {
+        let mode = options.mode;
         let (width, height) = bindings.size;
         let missing = |what: &str| {
             Err(Error::UnsupportedMode(mode.name().into(), format!("the program was compiled without {what}")))
@@ -328,6 +353,11 @@ impl Shader {
         }
         if matches!(mode, Mode::Hierarchical | Mode::Checkerboard) {
             fits("the hierarchical records", pixels * u64::from(self.layout.hierarchical.record_words))?;
+        }
+        if mode == Mode::RateImage {
+            fits("the rate-image interface", pixels * u64::from(self.layout.interface.stride_words))?;
+            fits("the rate-image sample list", geometry::rate_work_words(bindings.size))?;
+            self.validate_shading_rate(bindings, options.rate_tile)?;
         }
         if mode == Mode::Hierarchical {
             fits("the hierarchical work lists", geometry::work_list_words(bindings.size))?;
@@ -408,7 +438,7 @@ impl Shader {
         options: DispatchOptions,
     ) -> Result<(), Error> {
         let mode = options.mode;
-        self.validate(bindings, mode)?;
+        self.validate(bindings, options)?;
         let (width, height) = bindings.size;
         self.frame = self.frame.wrapping_add(1).max(1);
         self.forced = options.force_refine;
@@ -417,7 +447,8 @@ impl Shader {
             force_refine: u32::from(options.force_refine),
             frame: self.frame,
             similarity: options.similarity,
-            reserved: [0; 3],
+            rate_tile: options.rate_tile,
+            reserved: [0; 2],
         };
         queue.write_buffer(&self.control, 0, bytemuck::bytes_of(&control));
         if let Some(buffer) = &self.uniforms {
@@ -430,7 +461,9 @@ impl Shader {
             bindings.outputs.iter().map(|(k, t)| (k.as_str(), t.create_view(&Default::default()))).collect();
         encoder.clear_buffer(&self.stats, 0, None);
         let tiles = geometry::pixel_workgroups(bindings.size);
-        if matches!(mode, Mode::Hierarchical | Mode::Checkerboard) {
+        if mode == Mode::RateImage {
+            self.rate_image_passes(device, encoder, bindings, &views, [&resources, &gbuffer], options.rate_tile);
+        } else if matches!(mode, Mode::Hierarchical | Mode::Checkerboard) {
             let kind = mode.kernels()[0].0;
             let stage = self.record_stage(device, kind, bindings.size, &views);
             let groups = [&resources, &gbuffer, &stage];
@@ -442,7 +475,7 @@ impl Shader {
         } else {
             match mode.block_size() {
                 None => {
-                    let stage = self.stage_group(device, KernelKind::Reference, None, None, &views);
+                    let stage = self.stage_group(device, KernelKind::Reference, None, None, &views, None);
                     self.pass(
                         encoder,
                         "mrsl reference",
@@ -461,9 +494,11 @@ impl Shader {
                     } else {
                         None
                     };
-                    let coarse_stage = self.stage_group(device, KernelKind::Coarse, Some(&interface), None, &views);
+                    let coarse_stage =
+                        self.stage_group(device, KernelKind::Coarse, Some(&interface), None, &views, None);
                     let fine_kind = if dynamic { KernelKind::DynamicFine } else { KernelKind::Fine };
-                    let fine_stage = self.stage_group(device, fine_kind, Some(&interface), inner.as_ref(), &views);
+                    let fine_stage =
+                        self.stage_group(device, fine_kind, Some(&interface), inner.as_ref(), &views, None);
                     self.pass(
                         encoder,
                         "mrsl coarse",
@@ -479,6 +514,7 @@ impl Shader {
                             Some(&interface),
                             inner.as_ref(),
                             &views,
+                            None,
                         );
                         self.pass(
                             encoder,
@@ -555,6 +591,115 @@ impl Shader {
         encoder.copy_buffer_to_buffer(&buffers.queue, 0, &self.queue_readback, 0, None);
     }
 
+    /// The rate-image mode: list the samples each tile's rate needs, shade
+    /// them from the list (indirect), then resolve every pixel.
+    fn rate_image_passes(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        bindings: &Bindings,
+        views: &HashMap<&str, wgpu::TextureView>,
+        groups: [&wgpu::BindGroup; 2],
+        tile: u32,
+    ) {
+        let size = bindings.size;
+        let interface = self.interface(device, 1, false, size).clone();
+        self.ensure_rate_image(device, size);
+        self.ensure_rate_buffers(device, size);
+        let shading_rate = bindings.shading_rate.expect("validated").create_view(&Default::default());
+        let coarse =
+            self.stage_group(device, KernelKind::RateCoarse, Some(&interface), None, views, Some(&shading_rate));
+        let fine = self.stage_group(device, KernelKind::RateFine, Some(&interface), None, views, Some(&shading_rate));
+        let (buffers, _) = self.rate_buffers.as_ref().expect("created above");
+        encoder.clear_buffer(&buffers.queue, 0, None);
+        let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("mrsl rate-image args"),
+            layout: &self.args_group_layout,
+            entries: &[wgpu::BindGroupEntry { binding: BINDING_ARGS, resource: buffers.args.as_entire_binding() }],
+        });
+        let pipeline = |kind, name: &'static str| &self.pipelines[&(kind, None, name)];
+        {
+            let mut pass = self.begin_pass(encoder, "mrsl rate-image coarse", 1, &[groups[0], groups[1], &coarse]);
+            let (gx, gy) = geometry::rate_list_workgroups(size, tile);
+            pass.set_pipeline(pipeline(KernelKind::RateCoarse, entry::RATE_LIST));
+            pass.dispatch_workgroups(gx, gy, 1);
+            pass.set_pipeline(pipeline(KernelKind::RateCoarse, entry::RATE_ARGS));
+            pass.set_bind_group(GROUP_ARGS, Some(&args), &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(pipeline(KernelKind::RateCoarse, entry::RATE_COARSE));
+            pass.dispatch_workgroups_indirect(&buffers.args, 0);
+        }
+        {
+            let mut pass = self.begin_pass(encoder, "mrsl rate-image fine", 2, &[groups[0], groups[1], &fine]);
+            pass.set_pipeline(pipeline(KernelKind::RateFine, entry::RATE_FINE));
+            let (gx, gy) = geometry::pixel_workgroups(size);
+            pass.dispatch_workgroups(gx, gy, 1);
+        }
+        encoder.copy_buffer_to_buffer(&buffers.queue, 0, &self.queue_readback, 0, Some(4));
+    }
+
+    fn ensure_rate_buffers(&mut self, device: &wgpu::Device, size: (u32, u32)) {
+        if self.rate_buffers.as_ref().is_some_and(|(_, s)| *s == size) {
+            return;
+        }
+        let storage = |label, bytes: u64, extra| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(4),
+                usage: wgpu::BufferUsages::STORAGE | extra,
+                mapped_at_creation: false,
+            })
+        };
+        let buffers = RateBuffers {
+            work: storage(
+                "mrsl rate-image sample list",
+                geometry::rate_work_words(size) * 4,
+                wgpu::BufferUsages::empty(),
+            ),
+            queue: storage(
+                "mrsl rate-image sample count",
+                geometry::RATE_QUEUE_BYTES,
+                wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            ),
+            args: storage(
+                "mrsl rate-image dispatch arguments",
+                geometry::RATE_QUEUE_BYTES,
+                wgpu::BufferUsages::INDIRECT,
+            ),
+        };
+        self.rate_buffers = Some((buffers, size));
+    }
+
+    /// The shading-rate image of the rate-image mode: bound, an unsigned-integer
+    /// texture, one texel per tile.
+    fn validate_shading_rate(&self, bindings: &Bindings, tile: u32) -> Result<(), Error> {
+        if !mrsl_abi::shading_rate::RATE_TILE_SIZES.contains(&tile) {
+            return Err(Error::RateTile(tile));
+        }
+        let t = bindings.shading_rate.ok_or(Error::MissingShadingRate)?;
+        if !matches!(
+            t.format(),
+            wgpu::TextureFormat::R8Uint | wgpu::TextureFormat::R16Uint | wgpu::TextureFormat::R32Uint
+        ) {
+            return Err(Error::ShadingRateFormat(t.format()));
+        }
+        if !t.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING) {
+            return Err(Error::ShadingRateUsage);
+        }
+        let (width, height) = mrsl_abi::shading_rate::rate_image_size(bindings.size, tile);
+        if (t.width(), t.height()) != (width, height) {
+            return Err(Error::SizeMismatch {
+                what: "shading-rate image",
+                name: format!("{tile}x{tile} tiles"),
+                width,
+                height,
+                found_width: t.width(),
+                found_height: t.height(),
+            });
+        }
+        Ok(())
+    }
+
     /// The checkerboard baseline: shade the coarse effects in half the quads,
     /// then reconstruct and finish every pixel.
     fn checkerboard_passes(
@@ -585,7 +730,7 @@ impl Shader {
     ) -> wgpu::BindGroup {
         self.ensure_rate_image(device, size);
         self.ensure_hier_buffers(device, size);
-        self.stage_group(device, kind, None, None, views)
+        self.stage_group(device, kind, None, None, views, None)
     }
 
     fn ensure_hier_buffers(&mut self, device: &wgpu::Device, size: (u32, u32)) {
@@ -730,8 +875,12 @@ impl Shader {
         interface: Option<&wgpu::Buffer>,
         inner: Option<&wgpu::Buffer>,
         outputs: &HashMap<&str, wgpu::TextureView>,
+        shading_rate: Option<&wgpu::TextureView>,
     ) -> wgpu::BindGroup {
         let l = &self.layout;
+        // The rate-image mode binds its own list and counter where the hierarchical mode binds its.
+        let rate_buffers = self.rate_buffers.as_ref().map(|(b, _)| b);
+        let rate_kind = matches!(kind, KernelKind::RateCoarse | KernelKind::RateFine);
         let rate_view = self.rate.as_ref().map(|(t, _)| t.create_view(&Default::default()));
         let records = self.hier_buffers.as_ref().map(|(b, _)| b);
         let needed = "created by encode before the stage group";
@@ -749,8 +898,11 @@ impl Shader {
                         wgpu::BindingResource::TextureView(&outputs[l.outputs[index].name.as_str()])
                     }
                     StageSlot::Records => records.expect(needed).values.as_entire_binding(),
+                    StageSlot::WorkLists if rate_kind => rate_buffers.expect(needed).work.as_entire_binding(),
+                    StageSlot::Queues if rate_kind => rate_buffers.expect(needed).queue.as_entire_binding(),
                     StageSlot::WorkLists => records.expect(needed).work.as_entire_binding(),
                     StageSlot::Queues => records.expect(needed).queue.as_entire_binding(),
+                    StageSlot::ShadingRate => wgpu::BindingResource::TextureView(shading_rate.expect(needed)),
                 },
             })
             .collect();
@@ -812,7 +964,12 @@ impl Shader {
             }
             None => None,
         };
-        let mut stats = Stats::new(&self.layout, options, size, &counters, timings);
+        let listed = if options.mode == Mode::RateImage {
+            read_buffer::<u32>(device, &self.queue_readback)?[0] as u64
+        } else {
+            0
+        };
+        let mut stats = Stats::new(&self.layout, options, size, &counters, timings, listed);
         if options.mode == Mode::Hierarchical {
             let queue: Vec<u32> = read_buffer(device, &self.queue_readback)?;
             let words = geometry::QUEUE_WORDS_PER_LEVEL as usize;
@@ -981,6 +1138,11 @@ fn stage_layout(device: &wgpu::Device, l: &Layout, kind: KernelKind) -> wgpu::Bi
                     access: wgpu::StorageTextureAccess::WriteOnly,
                     format: wgpu_format(format),
                     view_dimension: wgpu::TextureViewDimension::D2,
+                },
+                StageResource::UintTexture => wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Uint,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
                 },
             },
             count: None,

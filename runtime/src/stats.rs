@@ -64,13 +64,17 @@ impl Stats {
         size: (u32, u32),
         counters: &[u32],
         timings: Option<Timings>,
+        listed_samples: u64,
     ) -> Stats {
         let pixels = size.0 as u64 * size.1 as u64;
         let samples_of = |block| {
             let (nx, ny) = sample_grid(size, block);
             nx as u64 * ny as u64
         };
-        let mut samples = options.mode.block_size().map(samples_of).unwrap_or(0);
+        let rate_image = options.mode == crate::Mode::RateImage;
+        // The rate-image mode shades the samples its tiles listed (read back from its counter).
+        let mut samples =
+            if rate_image { listed_samples } else { options.mode.block_size().map(samples_of).unwrap_or(0) };
         if options.mode == crate::Mode::Dynamic {
             // The 2x2 samples the second level shaded, counted by its kernel.
             samples += counters.get(layout.stats.counters.len()).copied().unwrap_or(0) as u64;
@@ -83,7 +87,7 @@ impl Stats {
                     let k = layout.stats.counters.iter().position(|c| *c == e.name);
                     (0, k.map(|k| counters.get(k).copied().unwrap_or(0) as u64).unwrap_or(0))
                 }
-                (Some(_), Rate::Coarse) => {
+                (_, Rate::Coarse) if rate_image || options.mode.block_size().is_some() => {
                     let k = layout.stats.counters.iter().position(|c| *c == e.name);
                     (samples, k.map(|k| counters.get(k).copied().unwrap_or(0) as u64).unwrap_or(0))
                 }

@@ -54,13 +54,31 @@ pub fn compile(source: &str) -> mrsl::Program {
 }
 
 /// Runs `program` over `gbuffer`; uniforms without defaults get `fill`
-/// values (a deterministic ramp) so that every example can run.
+/// values (a deterministic ramp) so that every example can run. The
+/// rate-image mode gets 8x8 tiles with every rate beside every other
+/// ([`mrsl_lab::shading_rate::pattern`]).
 pub fn run(
     gpu: &Gpu,
     program: &CompiledProgram,
     gbuffer: &GBuffer,
     mode: Mode,
     force_refine: bool,
+) -> Result<Output, Error> {
+    let size = (gbuffer.width, gbuffer.height);
+    let tile = mrsl_abi::shading_rate::DEFAULT_RATE_TILE;
+    let rates = mrsl_lab::shading_rate::pattern(mrsl_abi::shading_rate::rate_image_size(size, tile));
+    run_at_rates(gpu, program, gbuffer, mode, force_refine, tile, &rates)
+}
+
+/// [`run`] with the rate-image mode's tile size and rates (one per tile, row-major) given.
+pub fn run_at_rates(
+    gpu: &Gpu,
+    program: &CompiledProgram,
+    gbuffer: &GBuffer,
+    mode: Mode,
+    force_refine: bool,
+    tile: u32,
+    rates: &[mrsl_abi::ShadingRate],
 ) -> Result<Output, Error> {
     let size = (gbuffer.width, gbuffer.height);
     let channels = gbuffer.upload(gpu);
@@ -108,13 +126,16 @@ pub fn run(
     for (name, t) in &outputs {
         bindings.outputs.insert(name.clone(), t);
     }
+    // Only the rate-image mode reads it.
+    let shading_rate = mrsl_lab::shading_rate::upload(gpu, size, tile, rates);
+    bindings.shading_rate = Some(&shading_rate);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     shader.encode(
         &gpu.device,
         &gpu.queue,
         &mut encoder,
         &bindings,
-        DispatchOptions { force_refine, ..DispatchOptions::new(mode) },
+        DispatchOptions { force_refine, rate_tile: tile, ..DispatchOptions::new(mode) },
     )?;
     gpu.queue.submit([encoder.finish()]);
     let stats = shader.read_stats(&gpu.device)?;

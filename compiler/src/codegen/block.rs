@@ -47,7 +47,8 @@ impl Writer<'_, '_, '_> {
     /// The interface buffer of the coarse (written) and fine (read) kernels.
     pub(super) fn interface_bindings(&mut self) {
         let l = self.i.layout;
-        let access = if self.kind == KernelKind::Coarse { "read_write" } else { "read" };
+        let access =
+            if matches!(self.kind, KernelKind::Coarse | KernelKind::RateCoarse) { "read_write" } else { "read" };
         self.template(
             0,
             include_str!("templates/interface.wgsl"),
@@ -67,8 +68,22 @@ impl Writer<'_, '_, '_> {
         let c = self.checked();
         let iface = self.i.interface;
         let [x, y, z] = self.kind.workgroup_size();
-        let [head, tail] = cut(include_str!("templates/coarse_main.wgsl"), &["BODY"]);
-        self.template(0, head, &[("WORKGROUP", &format!("{x}, {y}, {z}")), ("ENTRY", &self.kind.main_entry_point())]);
+        let main = if self.kind == KernelKind::RateCoarse {
+            include_str!("templates/rate_coarse_main.wgsl")
+        } else {
+            include_str!("templates/coarse_main.wgsl")
+        };
+        let [head, tail] = cut(main, &["BODY"]);
+        self.template(
+            0,
+            head,
+            &[
+                ("WORKGROUP", &format!("{x}, {y}, {z}")),
+                ("ENTRY", &self.kind.main_entry_point()),
+                ("WORK_GROUP", &x),
+                ("MAX_X", &mrsl_abi::geometry::RATE_ARGS_MAX_X),
+            ],
+        );
         if self.kind == KernelKind::DynamicCoarse {
             self.dynamic_coarse_gate();
         }
@@ -143,7 +158,13 @@ impl Writer<'_, '_, '_> {
             return;
         }
         let mask_words = (coarse.len() as u32).div_ceil(32);
-        let [head, tail] = cut(include_str!("templates/block_struct.wgsl"), &["REFINED_WORDS"]);
+        let rate = self.kind == KernelKind::RateFine;
+        let block_struct = if rate {
+            include_str!("templates/rate_block_struct.wgsl")
+        } else {
+            include_str!("templates/block_struct.wgsl")
+        };
+        let [head, tail] = cut(block_struct, &["REFINED_WORDS"]);
         self.template(0, head, &[]);
         // Separate words, not an array: llvmpipe spills dynamically indexed
         // arrays in structs to memory, which made every lookup a memory access.
@@ -179,7 +200,26 @@ impl Writer<'_, '_, '_> {
         let iface = self.i.interface;
         let (sfx, bk, buf) = (level.suffix, level.block, level.buffer);
         let stride = if level.parent { iface.stride + DYNAMIC_TAG_WORDS } else { iface.stride };
-        let [head, corners, refined] = cut(include_str!("templates/resolve.wgsl"), &["CORNERS", "REFINED"]);
+        // The samples a pixel resamples from: a block's four corners, or in the
+        // rate-image mode each corner's two border samples.
+        let rate = self.kind == KernelKind::RateFine;
+        let samples: &[&str] = if rate {
+            &[
+                "b.corners.x",
+                "b.corners.y",
+                "b.corners.z",
+                "b.corners.w",
+                "b.others.x",
+                "b.others.y",
+                "b.others.z",
+                "b.others.w",
+            ]
+        } else {
+            &["b.corners.x", "b.corners.y", "b.corners.z", "b.corners.w"]
+        };
+        let resolve =
+            if rate { include_str!("templates/rate_resolve.wgsl") } else { include_str!("templates/resolve.wgsl") };
+        let [head, corners, refined] = cut(resolve, &["CORNERS", "REFINED"]);
         let params = if level.parent {
             self.inner_level_note(bk);
             "pos: vec2<i32>, parent: MrslBlock"
@@ -196,6 +236,17 @@ impl Writer<'_, '_, '_> {
         }
         for key in self.keys_of(&coarse) {
             let name = key.name;
+            if rate {
+                let mut tests: Vec<String> =
+                    (0..8).map(|s| key.differs(&format!("k_{name}"), &format!("k{s}_{name}"))).collect();
+                tests.extend((1..4).map(|s| key.differs(&format!("k0_{name}"), &format!("k{s}_{name}"))));
+                self.template(
+                    0,
+                    include_str!("templates/rate_resolve_key.wgsl"),
+                    &[("NAME", &name), ("TESTS", &tests.join(" || "))],
+                );
+                continue;
+            }
             let mut tests: Vec<String> = ["k00", "k10", "k01", "k11"]
                 .iter()
                 .map(|corner| key.differs(&format!("k_{name}"), &format!("{corner}_{name}")))
@@ -211,9 +262,9 @@ impl Writer<'_, '_, '_> {
             None => (0..iface.flag_words).collect(),
             Some(_) => self.flag_words_read(&coarse).into_iter().collect(),
         };
-        for (ci, corner) in ["x", "y", "z", "w"].iter().enumerate() {
+        for (ci, sample) in samples.iter().enumerate() {
             for &w in &words {
-                self.line(1, format!("let f{ci}_{w} = {buf}[b.corners.{corner} * {stride}u + {w}u];"));
+                self.line(1, format!("let f{ci}_{w} = {buf}[{sample} * {stride}u + {w}u];"));
             }
         }
         self.template(0, corners, &[]);
@@ -223,7 +274,7 @@ impl Writer<'_, '_, '_> {
             let mut terms = vec![self.discontinuity(e)];
             if let Some(b) = iface.refine_bit[e.index()] {
                 let (word, mask) = bit(b);
-                let words: Vec<String> = (0..4).map(|ci| format!("f{ci}_{word}")).collect();
+                let words: Vec<String> = (0..samples.len()).map(|ci| format!("f{ci}_{word}")).collect();
                 terms.push(format!("((({}) & {mask}u) != 0u)", words.join(" | ")));
             }
             // Needed coarsely: some live user runs per pixel here.
@@ -243,7 +294,7 @@ impl Writer<'_, '_, '_> {
             if !iface.is_passed(e) {
                 terms.push(format!("({needed})"));
             } else if iface.is_shared(e) {
-                let misses: Vec<String> = (0..4)
+                let misses: Vec<String> = (0..samples.len())
                     .map(|ci| format!("!({})", self.store_condition(e, &|b| test_bit(&format!("f{ci}_"), b))))
                     .collect();
                 terms.push(format!("(({needed}) && ({}))", misses.join(" || ")));
@@ -360,20 +411,38 @@ impl Writer<'_, '_, '_> {
             } else {
                 ("bilinear", "v0 * b.weights.x + v1 * b.weights.y + v2 * b.weights.z + v3 * b.weights.w".to_string())
             };
-            self.template(
-                0,
-                include_str!("templates/resample.wgsl"),
-                &[
-                    ("SUFFIX", &sfx),
-                    ("NAME", &info.name),
-                    ("TYPE", &info.ty.wgsl()),
-                    ("STRIDE", &stride),
-                    ("OFFSET", &slot.offset),
-                    ("UNPACK", &unpack_words(&info.ty, buf)),
-                    ("FILTER", &filter),
-                    ("VALUE", &value),
-                ],
-            );
+            let values: &super::writer::Values = &[
+                ("SUFFIX", &sfx),
+                ("NAME", &info.name),
+                ("TYPE", &info.ty.wgsl()),
+                ("STRIDE", &stride),
+                ("OFFSET", &slot.offset),
+                ("UNPACK", &unpack_words(&info.ty, buf)),
+                ("FILTER", &filter),
+                ("VALUE", &value),
+            ];
+            if self.kind != KernelKind::RateFine {
+                self.template(0, include_str!("templates/resample.wgsl"), values);
+                continue;
+            }
+            // The rate-image mode: a corner on a border may blend two border samples.
+            let [head, tail] = cut(include_str!("templates/rate_resample.wgsl"), &["CORNERS"]);
+            self.template(0, head, values);
+            let get = format!("mrsl_get{sfx}_{}", info.name);
+            for (k, lane) in ["x", "y", "z", "w"].iter().enumerate() {
+                self.line(1, format!("var v{k} = {get}(b.corners.{lane});"));
+                if layout::uses_nearest(c, e) {
+                    self.line(1, format!("if (b.lerps.{lane} >= 0.5) {{ v{k} = {get}(b.others.{lane}); }}"));
+                } else {
+                    self.line(
+                        1,
+                        format!(
+                            "if (b.lerps.{lane} != 0.0) {{ v{k} = v{k} * (1.0 - b.lerps.{lane}) + {get}(b.others.{lane}) * b.lerps.{lane}; }}"
+                        ),
+                    );
+                }
+            }
+            self.template(0, tail, values);
         }
     }
 
@@ -410,7 +479,12 @@ impl Writer<'_, '_, '_> {
     /// Entry point of the fine and reference kernels.
     pub(super) fn pixel_entry(&mut self) {
         // The reference kernel has no blocks; it lays its tiles out in 2x2 ones.
-        self.tile_pixel_blocks(if self.kind.is_fine() { self.block } else { 2 });
+        // The rate-image mode's cells are at most 4x4: 4x4 blocks keep a cell's pixels on neighbouring lanes.
+        self.tile_pixel_blocks(match self.kind {
+            KernelKind::RateFine => 4,
+            kind if kind.is_fine() => self.block,
+            _ => 2,
+        });
         if self.compacts() {
             return self.compacted_fine_entry();
         }

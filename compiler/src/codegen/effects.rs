@@ -125,6 +125,7 @@ impl<'b> Writer<'_, '_, 'b> {
             KernelKind::DynamicCoarse => self.dynamic_coarse_bindings(),
             KernelKind::Hierarchical => self.hierarchical_bindings(),
             KernelKind::Checkerboard => self.checkerboard_bindings(),
+            KernelKind::RateCoarse | KernelKind::RateFine => self.rate_bindings(),
             KernelKind::Reference => {}
         }
         if self.counts_stats() {
@@ -148,7 +149,8 @@ impl<'b> Writer<'_, '_, 'b> {
     /// position loads its inputs) and `mrsl_pair_x` / `mrsl_pair_y` (a
     /// position's quad, which derivatives difference across).
     pub(super) fn position_helpers(&mut self) {
-        let (grid, pixel) = if self.kind.is_coarse() {
+        // The rate-image mode's coarse samples are pixels, listed by its tiles.
+        let (grid, pixel) = if self.kind.is_coarse() && self.kind != KernelKind::RateCoarse {
             (
                 "(size + vec2<i32>(MRSL_BLOCK - 2)) / MRSL_BLOCK + vec2<i32>(1)",
                 "min(pos * MRSL_BLOCK, vec2<i32>(mrsl_ctl.size) - vec2<i32>(1))",

@@ -53,6 +53,7 @@ mod dynamic;
 mod effects;
 mod hierarchical;
 mod pixel;
+mod rate;
 mod records;
 mod words;
 mod writer;
@@ -258,6 +259,12 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             KernelKind::Reference => self.pixel_entry(),
             KernelKind::Hierarchical => self.hierarchical_entries(),
             KernelKind::Checkerboard => self.checkerboard_entries(),
+            KernelKind::RateCoarse => self.rate_coarse_entries(),
+            KernelKind::RateFine => {
+                self.rate_tiles();
+                self.fine_support();
+                self.pixel_entry();
+            }
         }
     }
 }
@@ -281,6 +288,12 @@ fn describe(kind: KernelKind, block: u32) -> String {
         ),
         KernelKind::Checkerboard => {
             "checkerboard baseline: half the 2x2 quads shaded, the rest reconstructed".to_string()
+        }
+        KernelKind::RateCoarse => {
+            "rate-image mode, coarse part: the samples each tile's rate needs, listed, then shaded".to_string()
+        }
+        KernelKind::RateFine => {
+            "rate-image mode, per pixel: resampled at the tile's rate, refined, then fine effects".to_string()
         }
     }
 }

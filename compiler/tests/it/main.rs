@@ -25,7 +25,7 @@ pub fn compile_ok(source: &str) -> mrsl::Program {
 
 /// The kernels `Options::default()` asks for, as (kind, block size), in the
 /// canonical order of `CompiledProgram::kernels` (by kind, then block size).
-pub const DEFAULT_KERNELS: [(KernelKind, Option<u32>); 9] = [
+pub const DEFAULT_KERNELS: [(KernelKind, Option<u32>); 11] = [
     (KernelKind::Coarse, Some(2)),
     (KernelKind::Coarse, Some(4)),
     (KernelKind::Fine, Some(2)),
@@ -35,6 +35,8 @@ pub const DEFAULT_KERNELS: [(KernelKind, Option<u32>); 9] = [
     (KernelKind::DynamicFine, Some(4)),
     (KernelKind::Hierarchical, None),
     (KernelKind::Checkerboard, None),
+    (KernelKind::RateCoarse, None),
+    (KernelKind::RateFine, None),
 ];
 
 /// Asserts that `program` (compiled with default options) has exactly the
