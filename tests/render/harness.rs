@@ -159,3 +159,13 @@ pub fn ulps(a: f32, b: f32) -> u32 {
 pub fn max_abs_diff(a: &[[f32; 4]], b: &[[f32; 4]]) -> f32 {
     a.iter().zip(b).flat_map(|(p, q)| (0..4).map(move |c| (p[c] - q[c]).abs())).fold(0.0, f32::max)
 }
+
+/// Peak signal-to-noise ratio of `a` against `b` over RGB, each channel
+/// clamped to [0, 1] (peak 1); infinite for identical images.
+pub fn psnr_of(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let clamp = |v: f32| v.clamp(0.0, 1.0) as f64;
+    let sum: f64 = a.iter().zip(b).flat_map(|(p, q)| (0..3).map(move |c| (clamp(p[c]) - clamp(q[c])).powi(2))).sum();
+    let mse = sum / (3 * a.len()) as f64;
+    if mse == 0.0 { f64::INFINITY } else { 10.0 * (1.0 / mse).log10() }
+}

@@ -12,6 +12,7 @@ mod harness;
 mod binding;
 mod errors;
 mod modes;
+mod rate_image;
 mod sponza;
 mod textures;
 
@@ -73,6 +74,17 @@ const GPU_TESTS: &[GpuTest] = &[
         "textures::pbr_example_renders_textured_content_in_every_mode",
         textures::pbr_example_renders_textured_content_in_every_mode,
     ),
+    (
+        "rate_image::pixels_blend_the_samples_of_their_tiles_rate",
+        rate_image::pixels_blend_the_samples_of_their_tiles_rate,
+    ),
+    ("rate_image::tile_borders_have_no_seams", rate_image::tile_borders_have_no_seams),
+    (
+        "rate_image::forced_refinement_equals_reference_at_every_rate",
+        rate_image::forced_refinement_equals_reference_at_every_rate,
+    ),
+    ("rate_image::coarser_rates_shade_less", rate_image::coarser_rates_shade_less),
+    ("rate_image::bad_shading_rate_images_are_typed_errors", rate_image::bad_shading_rate_images_are_typed_errors),
 ];
 
 /// Tests that run on the CPU only.

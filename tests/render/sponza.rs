@@ -2,7 +2,7 @@
 //! every mode, and the pieces that make it (mesh loaders, the rasteriser,
 //! scene files) checked on small inputs with known answers.
 
-use crate::{Output, compile};
+use crate::{Output, compile, psnr_of as psnr};
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::mesh::{Mesh, MeshError};
 use mrsl_lab::raster::{self, Camera, RasterError};
@@ -13,16 +13,6 @@ use std::path::PathBuf;
 
 const DEMO: &str = include_str!("../../examples/demo.mrsl");
 const SIZE: (u32, u32) = (192, 108);
-
-/// Peak signal-to-noise ratio of `a` against `b` over RGB, each channel
-/// clamped to [0, 1] (peak 1); infinite for identical images.
-fn psnr(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let clamp = |v: f32| v.clamp(0.0, 1.0) as f64;
-    let sum: f64 = a.iter().zip(b).flat_map(|(p, q)| (0..3).map(move |c| (clamp(p[c]) - clamp(q[c])).powi(2))).sum();
-    let mse = sum / (3 * a.len()) as f64;
-    if mse == 0.0 { f64::INFINITY } else { 10.0 * (1.0 / mse).log10() }
-}
 
 /// Runs `program` over G-buffer textures already on the device (what the
 /// rasteriser returns), setting `camera_pos` where given.
@@ -622,6 +612,9 @@ pub fn sponza_lights_workload_matches_its_reference(gpu: &Gpu) {
         }
         bindings.samplers.insert("linear".into(), &sampler);
         bindings.outputs.insert("color".into(), &color);
+        // The rate-image mode gets every rate beside every other.
+        let shading_rate = mrsl_lab::shading_rate::upload_pattern(gpu, SIZE, 8);
+        bindings.shading_rate = Some(&shading_rate);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let options = DispatchOptions { force_refine, ..DispatchOptions::new(mode) };
         shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options).unwrap();

@@ -541,6 +541,9 @@ pub fn pbr_example_renders_textured_content_in_every_mode(gpu: &Gpu) {
         }
         bindings.textures.insert("shadow_map".into(), &shadow_view);
         bindings.outputs.insert("color".into(), &color);
+        // The rate-image mode gets every rate beside every other.
+        let shading_rate = mrsl_lab::shading_rate::upload_pattern(gpu, size, 8);
+        bindings.shading_rate = Some(&shading_rate);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let options = DispatchOptions { force_refine, ..DispatchOptions::new(mode) };
         shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options).unwrap();
@@ -611,6 +614,9 @@ pub fn pbr_example_over_the_dungeon(gpu: &Gpu) {
         }
         bindings.textures.insert("shadow_map".into(), &shadow_view);
         bindings.outputs.insert("color".into(), &color);
+        // The rate-image mode gets every rate beside every other.
+        let shading_rate = mrsl_lab::shading_rate::upload_pattern(gpu, size, 8);
+        bindings.shading_rate = Some(&shading_rate);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let options = DispatchOptions { force_refine, ..DispatchOptions::new(mode) };
         shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options).unwrap();

@@ -149,8 +149,11 @@ impl<'b> Writer<'_, '_, 'b> {
     /// position loads its inputs) and `mrsl_pair_x` / `mrsl_pair_y` (a
     /// position's quad, which derivatives difference across).
     pub(super) fn position_helpers(&mut self) {
-        // The rate-image mode's coarse samples are pixels, listed by its tiles.
-        let (grid, pixel) = if self.kind.is_coarse() && self.kind != KernelKind::RateCoarse {
+        if self.kind == KernelKind::RateCoarse {
+            // Its samples are pixels, listed by its tiles; derivatives pair cells of the tile's rate.
+            return self.template(0, include_str!("templates/rate_positions.wgsl"), &[]);
+        }
+        let (grid, pixel) = if self.kind.is_coarse() {
             (
                 "(size + vec2<i32>(MRSL_BLOCK - 2)) / MRSL_BLOCK + vec2<i32>(1)",
                 "min(pos * MRSL_BLOCK, vec2<i32>(mrsl_ctl.size) - vec2<i32>(1))",

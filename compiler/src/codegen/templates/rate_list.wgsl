@@ -19,8 +19,8 @@ fn mrsl_list(at: u32, p: vec2<i32>) {
 // last column and row at the edge); the samples on its far borders belong to the tiles
 // there. A full-rate (1x1) tile shades everything per pixel and owns only what its
 // coarser neighbours' cells need: its first column at its left neighbour's height,
-// its first row at its upper neighbour's width, and its origin. So every listed sample
-// is a distinct pixel, and the cells of every tile find all their corners listed.
+// its first row at its upper neighbour's width, and its origin when one of those or the
+// tile diagonally above-left is coarser. So every listed sample is a distinct pixel, and the cells of every tile find all their corners listed.
 @compute @workgroup_size({{TILES}}, {{TILES}}, 1)
 fn {{LIST}}(@builtin(global_invocation_id) gid: vec3<u32>) {
     let size = vec2<i32>(mrsl_ctl.size);
@@ -43,13 +43,16 @@ fn {{LIST}}(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         let column = select(0, mrsl_axis_count(origin.y, end.y, left, size.y), left > 0);
         let row = select(0, mrsl_axis_count(origin.x, end.x, up, size.x), up > 0);
-        // The origin is the first sample of the column and of the row; listed once.
-        let total = max(column + row - select(0, 1, column > 0 && row > 0), 1);
-        var at = atomicAdd(&mrsl_queue[0], u32(total));
         if (column == 0 && row == 0) {
-            mrsl_list(at, origin);
+            // Only a coarser tile diagonally above-left can need the origin (its last cell's corner).
+            if (all(t > vec2<i32>(0)) && any(mrsl_tile_rate(t - vec2<i32>(1)) != vec2<i32>(1))) {
+                mrsl_list(atomicAdd(&mrsl_queue[0], 1u), origin);
+            }
             return;
         }
+        // The origin is the first sample of the column and of the row; listed once.
+        let total = column + row - select(0, 1, column > 0 && row > 0);
+        var at = atomicAdd(&mrsl_queue[0], u32(total));
         for (var i = 0; i < column; i += 1) {
             mrsl_list(at, vec2<i32>(origin.x, mrsl_axis_at(origin.y, left, size.y, i)));
             at += 1u;
