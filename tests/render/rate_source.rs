@@ -212,7 +212,6 @@ pub fn first_frame_and_resizes_are_full_rate(gpu: &Gpu) {
     let sixteen = RateOptions { tile: 16, ..options };
     assert_all(&run(&larger, &sixteen), ShadingRate::R1x1, "first frame with 16x16 tiles");
     assert_all(&run(&larger, &sixteen), ShadingRate::R4x4, "second frame with 16x16 tiles");
-    drop(run);
     // And a reset (a camera cut).
     source.reset();
     let color = larger.upload(gpu);
@@ -434,7 +433,6 @@ pub fn bad_inputs_are_typed_errors(gpu: &Gpu) {
     ));
     // None of that advanced the history: the next good frame is the first.
     let flat = Frame::grey(size, |_, _| 0.5).upload(gpu);
-    drop(encode);
     assert_all(&frame(gpu, &mut source, &RateInputs::new(&flat), &options).unwrap(), ShadingRate::R1x1, "first");
 }
 
@@ -548,7 +546,7 @@ fn random_velocity(rng: &mut Lcg, size: (u32, u32), tile: u32) -> Vec<[f32; 2]> 
         .map(|i| {
             let (x, y) = (i % size.0, i / size.0);
             let s = per_tile[((y / tile) * tiles.0 + x / tile) as usize] * (1.0 + rng.next());
-            let a = 6.283 * rng.next();
+            let a = std::f32::consts::TAU * rng.next();
             [s * a.cos(), s * a.sin()]
         })
         .collect()
