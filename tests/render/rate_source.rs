@@ -25,6 +25,7 @@ pub const GPU_TESTS: &[crate::GpuTest] = &[
     ("rate_source::high_contrast_checker_is_1x1", high_contrast_checker_is_1x1),
     ("rate_source::motion_lowers_the_rate_by_the_velocity_terms", motion_lowers_the_rate_by_the_velocity_terms),
     ("rate_source::weber_fechner_is_more_conservative_in_the_dark", weber_fechner_is_more_conservative_in_the_dark),
+    ("rate_source::half_float_inputs_are_read_alike", half_float_inputs_are_read_alike),
     ("rate_source::first_frame_and_resizes_are_full_rate", first_frame_and_resizes_are_full_rate),
     (
         "rate_source::hysteresis_stops_an_alternating_input_from_flickering",
@@ -192,6 +193,36 @@ pub fn weber_fechner_is_more_conservative_in_the_dark(gpu: &Gpu) {
     let strict = RateOptions { weber_fechner_constant: 0.2, ..weber };
     assert_all(&settled(gpu, &faint, None, &weber), ShadingRate::R2x4, "faint dark stripes, constant 1");
     assert_all(&settled(gpu, &faint, None, &strict), ShadingRate::R1x2, "faint dark stripes, constant 0.2");
+}
+
+pub fn half_float_inputs_are_read_alike(gpu: &Gpu) {
+    // Values exact in f16, so that both precisions hold the same frame.
+    let size = (48, 40);
+    let stripes = Frame::grey(size, |x, y| [0.375, 0.625][(x % 2) as usize] + 0.125 * (y / 8 % 2) as f32);
+    let speeds: Vec<[f32; 2]> = (0..size.0 * size.1).map(|i| [(i % size.0 / 8) as f32, 0.5]).collect();
+    let options = RateOptions { motion: true, ..undamped(Preset::Balanced) };
+    let full = settled(gpu, &stripes, Some(&speeds), &options);
+    let halves = |values: Vec<f32>| -> Vec<u8> {
+        values.into_iter().flat_map(|v| half::f16::from_f32(v).to_le_bytes()).collect()
+    };
+    let color = gpu.texture_with_data(
+        "f16 frame",
+        size,
+        wgpu::TextureFormat::Rgba16Float,
+        &halves(stripes.rgb.iter().flat_map(|c| [c[0], c[1], c[2], 1.0]).collect()),
+    );
+    let velocity = gpu.texture_with_data(
+        "f16 velocity",
+        size,
+        wgpu::TextureFormat::Rg16Float,
+        &halves(speeds.iter().flat_map(|v| *v).collect()),
+    );
+    let mut source = RateSource::new(&gpu.device).unwrap();
+    let inputs = RateInputs { velocity: Some(&velocity), ..RateInputs::new(&color) };
+    frame(gpu, &mut source, &inputs, &options).unwrap();
+    let half_rates = frame(gpu, &mut source, &inputs, &options).unwrap();
+    assert_eq!(half_rates, full);
+    assert!(full.iter().collect::<std::collections::BTreeSet<_>>().len() >= 3, "varied rates: {full:?}");
 }
 
 pub fn first_frame_and_resizes_are_full_rate(gpu: &Gpu) {
