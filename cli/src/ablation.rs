@@ -226,7 +226,7 @@ pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>, String> {
         textures = if k == 0 { prepared.warn() } else { prepared.textures };
         shaders.push(shader);
     }
-    let resources = Resources::new(&gpu, &program, scene.size, textures);
+    let resources = Resources::new(&gpu, &program, scene.size, textures, mrsl_abi::shading_rate::DEFAULT_RATE_TILE)?;
     let bindings: Bindings = resources.bindings(&program, &scene.channels);
     // Entry 0 is the reference (run with the full program's shader), then
     // the full kernel, then the variants.

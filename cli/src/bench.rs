@@ -6,9 +6,11 @@
 use crate::render::{BoundScene, Resources, bind_scene, compile_program};
 use crate::report::{self, ControllerFrame, Point};
 use indicatif::{ProgressBar, ProgressStyle};
+use mrsl_abi::shading_rate::DEFAULT_RATE_TILE;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::raster::Camera;
 use mrsl_runtime::controller::{Target, ThresholdController};
+use mrsl_runtime::rate_source::{Preset, RateOptions};
 use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader, Stats};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -170,6 +172,10 @@ fn uniform<'p>(program: &'p mrsl::Program, name: &str) -> Option<&'p mrsl_abi::F
     program.layout.uniforms.as_ref()?.fields.iter().find(|f| f.name == name)
 }
 
+/// The rate-image mode's points: the rate source's sensitivity t of VALAR's presets
+/// (Quality, Balanced, Performance).
+const RATE_SENSITIVITIES: [f64; 3] = [0.25, 0.5, 0.75];
+
 /// The configurations of one scene, in order.
 fn plan(args: &BenchArgs, has_knob: bool) -> Vec<(Mode, Option<f64>, bool)> {
     let mut plan = vec![(Mode::Reference, None, false)];
@@ -178,6 +184,8 @@ fn plan(args: &BenchArgs, has_knob: bool) -> Vec<(Mode, Option<f64>, bool)> {
             Mode::Reference => {}
             Mode::Checkerboard => plan.push((mode, None, false)),
             Mode::Hierarchical => plan.extend(args.similarities.iter().map(|&s| (mode, Some(s), false))),
+            // The rate source's presets (its sensitivity t), with the program's own knob at its default.
+            Mode::RateImage => plan.extend(RATE_SENSITIVITIES.iter().map(|&t| (mode, Some(t), false))),
             _ if has_knob => plan.extend(args.values.iter().map(|&v| (mode, Some(v), false))),
             _ => plan.push((mode, None, false)),
         }
@@ -211,7 +219,7 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
         let mut shader = Shader::new(&gpu.device, &program).map_err(|e| e.to_string())?;
         shader.set_timestamp_period(&gpu.queue);
         let textures = scene.prepare(&gpu, &mut shader).map_err(|e| format!("{scene_name}: {e}"))?.warn();
-        let resources = Resources::new(&gpu, &program, scene.size, textures);
+        let resources = Resources::new(&gpu, &program, scene.size, textures, DEFAULT_RATE_TILE)?;
         resources.note_fallbacks();
         let mut bench = Bench { gpu: &gpu, shader, runs: args.runs.max(1) };
         let plan = plan(args, has_knob);
@@ -230,6 +238,7 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
         for (mode, value, forced) in plan {
             let knob = match (mode, value) {
                 (Mode::Hierarchical, Some(_)) => "similarity".to_string(),
+                (Mode::RateImage, Some(_)) => "rate_sensitivity".to_string(),
                 (_, Some(_)) => args.knob.clone(),
                 _ => "-".to_string(),
             };
@@ -247,6 +256,7 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
             if has_knob {
                 let v = match (mode, value) {
                     (Mode::Hierarchical, _) => KNOB_OFF,
+                    (Mode::RateImage, _) => knob_default.unwrap_or(KNOB_OFF),
                     (_, Some(v)) => v,
                     _ => knob_default.unwrap_or(KNOB_OFF),
                 };
@@ -254,6 +264,17 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
             }
             if let (Mode::Hierarchical, Some(s)) = (mode, value) {
                 options.similarity = s as f32;
+            }
+            if mode == Mode::RateImage {
+                // The rate image of this view and sensitivity, settled over frames of a still camera.
+                let rates = RateOptions {
+                    sensitivity: value.unwrap_or(Preset::Balanced.sensitivity() as f64) as f32,
+                    ..RateOptions::preset(Preset::Balanced)
+                };
+                let settled = crate::rates::settle(&gpu, &mut bench.shader, &bindings, first_output, &rates, options)?;
+                if bar.is_hidden() {
+                    eprintln!("  {}", settled.describe());
+                }
             }
             let paired = (mode != Mode::Reference || forced).then(|| DispatchOptions::new(Mode::Reference));
             let m = bench.measure(&bindings, options, paired)?;
@@ -389,7 +410,7 @@ fn controller_run(
     // The same bindings as the sweep's, whose warnings were printed there.
     let textures = scene.prepare(gpu, &mut shader)?.textures;
     let mesh = scene.mesh.as_ref().ok_or("the controller needs a mesh scene")?;
-    let resources = Resources::new(gpu, program, args.size, textures);
+    let resources = Resources::new(gpu, program, args.size, textures, DEFAULT_RATE_TILE)?;
     if uniform(program, &args.knob).is_some() {
         shader.set_uniform(&args.knob, &[KNOB_OFF]).map_err(|e| e.to_string())?;
     }

@@ -10,6 +10,7 @@ use std::process::ExitCode;
 mod ablation;
 mod bench;
 mod legend;
+mod rates;
 mod render;
 mod report;
 
@@ -153,6 +154,40 @@ struct Render {
     /// Hierarchical mode: largest variance of four neighbours that is still interpolated.
     #[arg(long, default_value_t = mrsl_runtime::DispatchOptions::DEFAULT_SIMILARITY)]
     similarity: f32,
+    /// Rate-image mode: the rate source's sensitivity preset (VALAR's t: 0.25, 0.5, 0.75).
+    #[arg(long, value_enum, default_value_t = RatePreset::Balanced)]
+    rate_preset: RatePreset,
+    /// Rate-image mode: pixels per side of a shading-rate tile.
+    #[arg(long, default_value_t = mrsl_abi::shading_rate::DEFAULT_RATE_TILE, value_parser = parse_rate_tile)]
+    rate_tile: u32,
+}
+
+/// `--rate-tile`: one of the tile sizes the rate-image mode supports.
+fn parse_rate_tile(text: &str) -> Result<u32, String> {
+    let sizes = mrsl_abi::shading_rate::RATE_TILE_SIZES;
+    text.parse::<u32>()
+        .ok()
+        .filter(|t| sizes.contains(t))
+        .ok_or_else(|| format!("`{text}` is not a supported tile size (expected {sizes:?})"))
+}
+
+/// The rate source's presets (`mrsl_runtime::rate_source::Preset`).
+#[derive(Clone, Copy, ValueEnum, PartialEq, Debug)]
+enum RatePreset {
+    Quality,
+    Balanced,
+    Performance,
+}
+
+impl RatePreset {
+    fn runtime(self) -> mrsl_runtime::rate_source::Preset {
+        use mrsl_runtime::rate_source::Preset;
+        match self {
+            RatePreset::Quality => Preset::Quality,
+            RatePreset::Balanced => Preset::Balanced,
+            RatePreset::Performance => Preset::Performance,
+        }
+    }
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq)]
@@ -223,6 +258,10 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
                 force_refine: r.force_refine,
                 compare: r.compare,
                 similarity: r.similarity,
+                rates: mrsl_runtime::rate_source::RateOptions {
+                    tile: r.rate_tile,
+                    ..mrsl_runtime::rate_source::RateOptions::preset(r.rate_preset.runtime())
+                },
             };
             Ok(written(render::render(&args)))
         }

@@ -35,6 +35,8 @@ pub struct RenderArgs {
     pub compare: bool,
     /// The hierarchical mode's similarity threshold.
     pub similarity: f32,
+    /// The rate-image mode's rate source.
+    pub rates: mrsl_runtime::rate_source::RateOptions,
 }
 
 /// One mode's run, as written to the stats JSON.
@@ -67,7 +69,7 @@ fn time_run(gpu: &Gpu, shader: &mut Shader, bindings: &Bindings, options: Dispat
     Ok(start.elapsed().as_secs_f64() * 1e3)
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
+pub fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     let n = v.len();
     if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) }
@@ -127,7 +129,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
     for (name, values) in &args.sets {
         shader.set_uniform(name, values).map_err(|e| e.to_string())?;
     }
-    let resources = Resources::new(&gpu, &program, size, textures);
+    let resources = Resources::new(&gpu, &program, size, textures, args.rates.tile)?;
     resources.note_fallbacks();
     // Created only now, so that a run that fails before rendering leaves nothing behind.
     std::fs::create_dir_all(&args.out_dir).map_err(|e| format!("cannot create {}: {e}", args.out_dir.display()))?;
@@ -140,6 +142,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
     let options = |mode| DispatchOptions {
         force_refine: args.force_refine,
         similarity: args.similarity,
+        rate_tile: args.rates.tile,
         ..DispatchOptions::new(mode)
     };
     let first_output = &outputs.first().ok_or("the program has no output")?.1;
@@ -169,6 +172,11 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
         );
     }
     for &mode in &args.modes {
+        if mode == Mode::RateImage {
+            let start = Instant::now();
+            let settled = crate::rates::settle(&gpu, &mut shader, &bindings, first_output, &args.rates, options(mode))?;
+            progress(&settled.describe(), start);
+        }
         let start = Instant::now();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options(mode)).map_err(|e| e.to_string())?;
@@ -379,6 +387,8 @@ pub struct Resources {
     /// The program's textures that get the checker.
     checkered: Vec<String>,
     sampler: wgpu::Sampler,
+    /// The rate-image mode's shading-rate image (full rate until a rate source writes it).
+    pub shading_rate: wgpu::Texture,
 }
 
 impl Resources {
@@ -387,7 +397,10 @@ impl Resources {
         program: &mrsl::Program,
         size: (u32, u32),
         textures: Vec<(String, wgpu::Texture)>,
-    ) -> Resources {
+        rate_tile: u32,
+    ) -> Result<Resources, String> {
+        let shading_rate =
+            mrsl_runtime::rate_source::create_rate_image(&gpu.device, size, rate_tile).map_err(|e| e.to_string())?;
         let outputs = program
             .layout
             .outputs
@@ -403,14 +416,15 @@ impl Resources {
             .filter(|t| !views.iter().any(|(name, _)| *name == t.name))
             .map(|t| t.name.clone())
             .collect();
-        Resources {
+        Ok(Resources {
             size,
             outputs,
             checker_view: checker_texture(gpu).create_view(&Default::default()),
             views,
             checkered,
             sampler: linear_sampler(gpu),
-        }
+            shading_rate,
+        })
     }
 
     /// Says which textures get the procedural checker, and how to give them an image.
@@ -439,6 +453,7 @@ impl Resources {
         for (name, texture) in &self.outputs {
             bindings.outputs.insert(name.clone(), texture);
         }
+        bindings.shading_rate = Some(&self.shading_rate);
         bindings
     }
 }

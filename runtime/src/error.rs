@@ -38,14 +38,6 @@ pub enum Error {
     UnknownMode(String),
     #[error("the rate-image mode needs a shading-rate image (`Bindings::shading_rate`), and none is bound")]
     MissingShadingRate,
-    #[error(
-        "the shading-rate image has format {0:?}; it must be an unsigned-integer texture (R8Uint as in D3D12 and Vulkan, R16Uint or R32Uint)"
-    )]
-    ShadingRateFormat(wgpu::TextureFormat),
-    #[error("the shading-rate image was not created with TextureUsages::TEXTURE_BINDING")]
-    ShadingRateUsage,
-    #[error("shading-rate tiles of {0} pixels are not supported (expected 8 or 16)")]
-    RateTile(u32),
     #[error("the device rejected a pipeline: {0}")]
     Pipeline(String),
     #[error("reading results back failed: {0}")]
@@ -54,4 +46,17 @@ pub enum Error {
     #[cfg(feature = "compile")]
     #[error("the program does not compile:\n{0}")]
     Compile(String),
+    // Shading-rate images (the rate-image mode's and the rate source's): inputs, outputs, options.
+    #[error("{what} is {}x{}, but a {}x{} image with {tile}x{tile} tiles needs {}x{} texels", found.0, found.1, image.0, image.1, expected.0, expected.1)]
+    RateImageSize { what: &'static str, image: (u32, u32), tile: u32, expected: (u32, u32), found: (u32, u32) },
+    #[error("{what} has format {found:?}, expected {expected}")]
+    RateFormat { what: &'static str, expected: &'static str, found: wgpu::TextureFormat },
+    #[error("{what} was not created with TextureUsages::{missing}")]
+    RateUsage { what: &'static str, missing: &'static str },
+    #[error("motion is on (RateOptions::motion) but no velocity texture was given")]
+    MissingVelocity,
+    #[error("rate tile size {0} is not supported (expected 8 or 16)")]
+    BadTileSize(u32),
+    #[error("rate option `{name}` is {value}, but it must be a finite number >= 0")]
+    BadRateOption { name: &'static str, value: f32 },
 }

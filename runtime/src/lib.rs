@@ -30,12 +30,14 @@
 
 pub mod controller;
 mod error;
+pub mod rate_source;
 mod shader;
 mod stats;
 
 pub use error::Error;
 use mrsl_abi::geometry::{DYNAMIC_INNER_BLOCK, DYNAMIC_OUTER_BLOCK};
 pub use mrsl_abi::{CompiledProgram, KernelKind, Layout, ReadError};
+pub use rate_source::{Combiner, ExternalRates, Foveation, Preset, RateInputs, RateOptions, RateSource};
 pub use shader::{Bindings, DispatchOptions, Shader, wgpu_format};
 pub use stats::{EffectStats, Stats, Timings};
 

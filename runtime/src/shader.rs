@@ -673,29 +673,25 @@ impl Shader {
     /// The shading-rate image of the rate-image mode: bound, an unsigned-integer
     /// texture, one texel per tile.
     fn validate_shading_rate(&self, bindings: &Bindings, tile: u32) -> Result<(), Error> {
+        const WHAT: &str = "the shading-rate image";
         if !mrsl_abi::shading_rate::RATE_TILE_SIZES.contains(&tile) {
-            return Err(Error::RateTile(tile));
+            return Err(Error::BadTileSize(tile));
         }
         let t = bindings.shading_rate.ok_or(Error::MissingShadingRate)?;
         if !matches!(
             t.format(),
             wgpu::TextureFormat::R8Uint | wgpu::TextureFormat::R16Uint | wgpu::TextureFormat::R32Uint
         ) {
-            return Err(Error::ShadingRateFormat(t.format()));
+            let expected = "R8Uint (as in D3D12 and Vulkan), R16Uint or R32Uint";
+            return Err(Error::RateFormat { what: WHAT, expected, found: t.format() });
         }
         if !t.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING) {
-            return Err(Error::ShadingRateUsage);
+            return Err(Error::RateUsage { what: WHAT, missing: "TEXTURE_BINDING" });
         }
-        let (width, height) = mrsl_abi::shading_rate::rate_image_size(bindings.size, tile);
-        if (t.width(), t.height()) != (width, height) {
-            return Err(Error::SizeMismatch {
-                what: "shading-rate image",
-                name: format!("{tile}x{tile} tiles"),
-                width,
-                height,
-                found_width: t.width(),
-                found_height: t.height(),
-            });
+        let expected = mrsl_abi::shading_rate::rate_image_size(bindings.size, tile);
+        if (t.width(), t.height()) != expected {
+            let (image, found) = (bindings.size, (t.width(), t.height()));
+            return Err(Error::RateImageSize { what: WHAT, image, tile, expected, found });
         }
         Ok(())
     }

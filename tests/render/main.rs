@@ -13,6 +13,7 @@ mod binding;
 mod errors;
 mod modes;
 mod rate_image;
+mod rate_source;
 mod sponza;
 mod textures;
 
@@ -114,13 +115,14 @@ fn main() {
     // SAFETY: no other thread exists yet.
     unsafe { mrsl_lab::runtime_dir::ensure_xdg_runtime_dir() };
     let args = Arguments::from_args();
-    let gpu = harness::gpu(GPU_TESTS.len() + DUNGEON_TESTS.len());
+    let gpu = harness::gpu(GPU_TESTS.len() + rate_source::GPU_TESTS.len() + DUNGEON_TESTS.len());
     let dungeon = mrsl_lab::mesh::dungeon_path();
     if let (Some(_), Err(e)) = (gpu, &dungeon) {
         println!("SKIPPING {} render test(s) over the dungeon (reported as ignored below): {e}", DUNGEON_TESTS.len());
     }
     let mut trials: Vec<Trial> = GPU_TESTS
         .iter()
+        .chain(rate_source::GPU_TESTS)
         .map(|&(name, test)| match gpu {
             Some(gpu) => Trial::test(name, move || {
                 test(gpu);

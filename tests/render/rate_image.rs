@@ -340,15 +340,20 @@ pub fn bad_shading_rate_images_are_typed_errors(gpu: &Gpu) {
         shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options)
     };
     assert_eq!(encode(None, 8), Err(Error::MissingShadingRate));
-    assert_eq!(encode(Some(&float), 8), Err(Error::ShadingRateFormat(wgpu::TextureFormat::R32Float)));
-    assert_eq!(encode(Some(&good), 12), Err(Error::RateTile(12)));
+    match encode(Some(&float), 8) {
+        Err(e @ Error::RateFormat { found: wgpu::TextureFormat::R32Float, .. }) => {
+            assert!(e.to_string().contains("R8Uint"), "{e}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(encode(Some(&good), 12), Err(Error::BadTileSize(12)));
     match encode(Some(&wrong_size), 8) {
-        Err(Error::SizeMismatch { what, width: 5, height: 3, found_width: 6, found_height: 3, .. }) => {
-            assert_eq!(what, "shading-rate image");
+        Err(e @ Error::RateImageSize { expected: (5, 3), found: (6, 3), tile: 8, .. }) => {
+            assert!(e.to_string().contains("shading-rate image is 6x3"), "{e}");
         }
         other => panic!("{other:?}"),
     }
     // The same image is the wrong size for 16-pixel tiles.
-    assert!(matches!(encode(Some(&good), 16), Err(Error::SizeMismatch { .. })));
+    assert!(matches!(encode(Some(&good), 16), Err(Error::RateImageSize { expected: (3, 2), .. })));
     assert_eq!(encode(Some(&good), 8), Ok(()));
 }

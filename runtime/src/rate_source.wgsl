@@ -1,0 +1,294 @@
+// The content-adaptive rate source of the `rate-image` mode (see
+// runtime/src/rate_source.rs and docs/rate-image.md): VALAR's per-tile
+// decision from the previous frame's luminance and motion (`decide`), then
+// temporal damping, reprojection and the combiners (`resolve`).
+//
+// Codes are those of D3D12/Vulkan: (log2(width) << 2) | log2(height), width
+// along x. Per-axis rates are carried as log2 values 0 (1x), 1 (2x), 2 (4x).
+
+struct Params {
+    size: vec2<u32>,
+    rate_size: vec2<u32>,
+    tile: u32,
+    flags: u32,
+    sensitivity: f32,
+    env_luma: f32,
+    k: f32,
+    weber_fechner: f32,
+    fovea_inner: f32,
+    fovea_outer: f32,
+    gaze: vec2<f32>,
+    // External combiner in bits 0..3, foveation combiner in bits 4..7.
+    combiners: u32,
+    pad: u32,
+}
+
+// Keep in step with `flags` in rate_source.rs.
+const FLAG_WEBER_FECHNER: u32 = 1u;
+const FLAG_MOTION: u32 = 2u;
+const FLAG_FIRST_FRAME: u32 = 4u;
+const FLAG_REPROJECT: u32 = 8u;
+const FLAG_EXTERNAL: u32 = 16u;
+const FLAG_FOVEATION: u32 = 32u;
+const FLAG_HYSTERESIS: u32 = 64u;
+
+const COMBINE_MIN: u32 = 0u;
+const COMBINE_MAX: u32 = 1u;
+const COMBINE_OVERRIDE: u32 = 2u;
+
+// A history slot that holds no decision (before the first frame, or where the
+// reprojected source left the screen): it takes no part in the damping.
+const NONE: u32 = 0xffu;
+
+// Rec.709 / sRGB primaries' luminance weights, as VALAR's RGBToLuminance.
+const REC709 = vec3<f32>(0.212671, 0.715160, 0.072169);
+
+// The smallest Weber–Fechner divisor (keep in step with rate_source.rs).
+const WEBER_FLOOR: f32 = 1.0e-4;
+
+// Larger than any velocity in pixels: the neutral element of the tile minimum.
+const FAR: f32 = 3.0e38;
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var color: texture_2d<f32>;
+@group(0) @binding(2) var velocity: texture_2d<f32>;
+@group(0) @binding(3) var raw_out: texture_storage_2d<r32uint, write>;
+@group(0) @binding(4) var raw_in: texture_2d<u32>;
+@group(0) @binding(5) var history_in: texture_2d<u32>;
+@group(0) @binding(6) var external_rates: texture_2d<u32>;
+@group(0) @binding(7) var target_out: texture_storage_2d<r32uint, write>;
+@group(0) @binding(8) var history_out: texture_storage_2d<r32uint, write>;
+
+// Pixels per tile side: 8 or 16, set per pipeline. One workgroup per tile,
+// one invocation per pixel, as VALAR dispatches it.
+override TILE: u32 = 8u;
+
+// Per-invocation partial results (sum of L, sum of x differences, sum of y
+// differences, minimum speed), reduced as a tree in shared memory. Sized for
+// the largest tile (16x16): WGSL workgroup arrays need a fixed size.
+var<workgroup> partial: array<vec4<f32>, 256>;
+
+fn has(flag: u32) -> bool {
+    return (params.flags & flag) != 0u;
+}
+
+fn luma(p: vec2<i32>) -> f32 {
+    return dot(textureLoad(color, p, 0).rgb, REC709);
+}
+
+// The minimum luminance of the 3x3 neighbourhood, clamped to the image
+// (the Weber–Fechner brightness sensitivity's input).
+fn min_luma_3x3(p: vec2<i32>) -> f32 {
+    let last = vec2<i32>(params.size) - 1;
+    var m = FAR;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            m = min(m, luma(clamp(p + vec2<i32>(dx, dy), vec2<i32>(0), last)));
+        }
+    }
+    return m;
+}
+
+// One neighbour difference: Eq. 2's |L - L'| / 2, or Weber's contrast with
+// the brightness sensitivity `bs` added to the darker of the two.
+fn difference(a: f32, b: f32, bs: f32) -> f32 {
+    if has(FLAG_WEBER_FECHNER) {
+        // The floor keeps a zero constant over black pixels finite.
+        return abs(a - b) / max(min(a, b) + bs, WEBER_FLOOR);
+    }
+    return abs(a - b) / 2.0;
+}
+
+// x^y for x >= 0, with 0^y = 0 (WGSL leaves pow(0, y) to log2(0)).
+fn pow0(x: f32, y: f32) -> f32 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    return pow(x, y);
+}
+
+// Eq. 16 / Eq. 14: full rate when the half-rate error reaches the JND
+// threshold, quarter rate when even the quarter-rate error stays below it.
+fn axis_rate(error: f32, tau: f32, half_rate: f32, quarter: f32) -> u32 {
+    if half_rate * error >= tau {
+        return 0u;
+    }
+    if quarter * error < tau {
+        return 2u;
+    }
+    return 1u;
+}
+
+// The code of per-axis log2 rates, 4x1 and 1x4 made 2x1 and 1x2 (as
+// `ShadingRate::clamp_size`: never coarser than asked on either axis).
+fn encode(rate: vec2<u32>) -> u32 {
+    var r = min(rate, vec2<u32>(2u));
+    if r.x == 2u && r.y == 0u {
+        r.x = 1u;
+    }
+    if r.x == 0u && r.y == 2u {
+        r.y = 1u;
+    }
+    return (r.x << 2u) | r.y;
+}
+
+fn decode(code: u32) -> vec2<u32> {
+    return min(vec2<u32>((code >> 2u) & 3u, code & 3u), vec2<u32>(2u));
+}
+
+@compute @workgroup_size(TILE, TILE)
+fn decide(
+    @builtin(workgroup_id) tile: vec3<u32>,
+    @builtin(local_invocation_id) local: vec3<u32>,
+    @builtin(local_invocation_index) index: u32,
+) {
+    let size = vec2<i32>(params.size);
+    let origin = vec2<i32>(tile.xy * TILE);
+    let p = origin + vec2<i32>(local.xy);
+    var acc = vec4<f32>(0.0, 0.0, 0.0, FAR);
+    if all(p < size) {
+        let l = luma(p);
+        var bs = 0.0;
+        if has(FLAG_WEBER_FECHNER) {
+            bs = params.weber_fechner * (1.0 - saturate(min_luma_3x3(p) * 50.0 - 2.5));
+        }
+        acc.x = l;
+        // The left and upper neighbours, across tile borders as in VALAR;
+        // the image's first column and row have none.
+        if p.x > 0 {
+            acc.y = difference(l, luma(p - vec2<i32>(1, 0)), bs);
+        }
+        if p.y > 0 {
+            acc.z = difference(l, luma(p - vec2<i32>(0, 1)), bs);
+        }
+        if has(FLAG_MOTION) {
+            acc.w = length(textureLoad(velocity, p, 0).xy);
+        }
+    }
+    partial[index] = acc;
+    workgroupBarrier();
+    // A shared-memory tree reduction: portable where subgroup operations
+    // (optional in WebGPU) are missing, and a deterministic order.
+    for (var stride = TILE * TILE / 2u; stride > 0u; stride >>= 1u) {
+        if index < stride {
+            let other = partial[index + stride];
+            let mine = partial[index];
+            partial[index] = vec4<f32>(mine.xyz + other.xyz, min(mine.w, other.w));
+        }
+        workgroupBarrier();
+    }
+    if index != 0u {
+        return;
+    }
+    let total = partial[0];
+    // Pixels of this tile inside the image, and how many of them have a left
+    // (upper) neighbour: the means' denominators.
+    let extent = min(vec2<i32>(i32(TILE)), size - origin);
+    let pixels = f32(extent.x * extent.y);
+    let with_left = f32(extent.y * (extent.x - select(0, 1, origin.x == 0)));
+    let with_up = f32(extent.x * (extent.y - select(0, 1, origin.y == 0)));
+    let mean_luma = total.x / pixels;
+    let mean_x = select(0.0, total.y / with_left, with_left > 0.0);
+    let mean_y = select(0.0, total.z / with_up, with_up > 0.0);
+    // Eq. 15: the just-noticeable-difference threshold.
+    let tau = params.sensitivity * (mean_luma + params.env_luma);
+    let error = sqrt(vec2<f32>(mean_x, mean_y));
+    var half_rate = 1.0;
+    var quarter = params.k;
+    if has(FLAG_MOTION) {
+        let speed = total.w;
+        // Eq. 20 and Eq. 21: motion hides the error of the coarser rates.
+        half_rate = pow(1.0 / (1.0 + pow0(1.05 * speed, 3.10)), 0.35);
+        quarter = params.k * pow(1.0 / (1.0 + pow0(0.55 * speed, 2.41)), 0.49);
+    }
+    let rate = vec2<u32>(axis_rate(error.x, tau, half_rate, quarter), axis_rate(error.y, tau, half_rate, quarter));
+    textureStore(raw_out, tile.xy, vec4<u32>(encode(rate), 0u, 0u, 0u));
+}
+
+fn combine(a: vec2<u32>, b: vec2<u32>, combiner: u32) -> vec2<u32> {
+    switch combiner {
+        case COMBINE_MIN: {
+            return min(a, b);
+        }
+        case COMBINE_MAX: {
+            return max(a, b);
+        }
+        default: {
+            return b;
+        }
+    }
+}
+
+// The foveation rate of the tile whose pixels are [lo, hi): from the point of
+// the tile nearest to the gaze, 1x1 within the inner radius, 2x2 within the
+// outer one, 4x4 beyond.
+fn foveation(lo: vec2<f32>, hi: vec2<f32>) -> vec2<u32> {
+    let nearest = clamp(params.gaze, lo, hi);
+    let d = distance(nearest, params.gaze);
+    if d <= params.fovea_inner {
+        return vec2<u32>(0u);
+    }
+    if d <= params.fovea_outer {
+        return vec2<u32>(1u);
+    }
+    return vec2<u32>(2u);
+}
+
+@compute @workgroup_size(8, 8)
+fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= params.rate_size) {
+        return;
+    }
+    let tile = vec2<i32>(id.xy);
+    let size = vec2<i32>(params.size);
+    // Reprojection: the rates are for the next frame, so each tile takes the
+    // decision (and its history) from where its content is now, one frame of
+    // motion back (constant velocity over one frame). Content from outside
+    // the screen has no decision.
+    var source = tile;
+    var inside = true;
+    if has(FLAG_REPROJECT) {
+        let centre = min(tile * i32(params.tile) + i32(params.tile / 2u), size - 1);
+        let back = vec2<f32>(centre) + 0.5 - textureLoad(velocity, centre, 0).xy;
+        inside = all(back >= vec2<f32>(0.0)) && all(back < vec2<f32>(size));
+        if inside {
+            source = vec2<i32>(floor(back)) / i32(params.tile);
+        }
+    }
+    var decision = NONE;
+    var history = (NONE << 8u) | NONE;
+    if inside {
+        decision = textureLoad(raw_in, source, 0).r;
+        if !has(FLAG_FIRST_FRAME) {
+            history = textureLoad(history_in, source, 0).r;
+        }
+    }
+    let previous = history & 0xffu;
+    let before = (history >> 8u) & 0xffu;
+    textureStore(history_out, tile, vec4<u32>(decision | (previous << 8u), 0u, 0u, 0u));
+    // First frame, or content new on screen: full rate.
+    var rate = vec2<u32>(0u);
+    if decision != NONE && !has(FLAG_FIRST_FRAME) {
+        rate = decode(decision);
+        // Hysteresis: a tile is no coarser on an axis than any of the last
+        // three decisions for its content; it refines at once and coarsens
+        // only when three frames agree.
+        if has(FLAG_HYSTERESIS) {
+            if previous != NONE {
+                rate = min(rate, decode(previous));
+            }
+            if before != NONE {
+                rate = min(rate, decode(before));
+            }
+        }
+    }
+    if has(FLAG_FOVEATION) {
+        let lo = vec2<f32>(tile * i32(params.tile));
+        let hi = vec2<f32>(min((tile + 1) * i32(params.tile), size));
+        rate = combine(rate, foveation(lo, hi), (params.combiners >> 4u) & 15u);
+    }
+    if has(FLAG_EXTERNAL) {
+        rate = combine(rate, decode(textureLoad(external_rates, tile, 0).r), params.combiners & 15u);
+    }
+    textureStore(target_out, tile, vec4<u32>(encode(rate), 0u, 0u, 0u));
+}
