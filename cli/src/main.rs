@@ -157,6 +157,10 @@ struct Render {
     /// Rate-image mode: the rate source's sensitivity preset (VALAR's t: 0.25, 0.5, 0.75).
     #[arg(long, value_enum, default_value_t = RatePreset::Balanced)]
     rate_preset: RatePreset,
+    /// Rate-image mode: one rate for every tile (1x1, 1x2, 2x1, 2x2, 2x4, 4x2, 4x4) instead of
+    /// the content-adaptive rate source.
+    #[arg(long, value_parser = parse_rate)]
+    uniform_rate: Option<mrsl_abi::ShadingRate>,
     /// Rate-image mode: pixels per side of a shading-rate tile.
     #[arg(long, default_value_t = mrsl_abi::shading_rate::DEFAULT_RATE_TILE, value_parser = parse_rate_tile)]
     rate_tile: u32,
@@ -169,6 +173,14 @@ fn parse_rate_tile(text: &str) -> Result<u32, String> {
         .ok()
         .filter(|t| sizes.contains(t))
         .ok_or_else(|| format!("`{text}` is not a supported tile size (expected {sizes:?})"))
+}
+
+/// `--uniform-rate`: one of the seven rates by name.
+fn parse_rate(text: &str) -> Result<mrsl_abi::ShadingRate, String> {
+    mrsl_abi::ShadingRate::ALL.into_iter().find(|r| r.name() == text).ok_or_else(|| {
+        let names: Vec<&str> = mrsl_abi::ShadingRate::ALL.iter().map(|r| r.name()).collect();
+        format!("`{text}` is not a shading rate (expected one of {})", names.join(", "))
+    })
 }
 
 /// The rate source's presets (`mrsl_runtime::rate_source::Preset`).
@@ -258,6 +270,7 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
                 force_refine: r.force_refine,
                 compare: r.compare,
                 similarity: r.similarity,
+                uniform_rate: r.uniform_rate,
                 rates: mrsl_runtime::rate_source::RateOptions {
                     tile: r.rate_tile,
                     ..mrsl_runtime::rate_source::RateOptions::preset(r.rate_preset.runtime())

@@ -3,8 +3,11 @@
 //! frame; a still frame has none, so the tools render the frames a still
 //! camera would show: the reference image of the view as frame 0, then
 //! rate-image frames, each deciding its rates from the one before, until the
-//! rate image stops changing (the source's damping coarsens a tile only
-//! after three frames agree, so this takes a few frames).
+//! rate image settles: at most [`SETTLED_FRACTION`] of the tiles change
+//! from one frame to the next (the source's damping coarsens a tile only
+//! after three frames agree, so this takes a few frames; a few tiles on the
+//! threshold may keep alternating between two rates when each frame's small
+//! resampling error tips them).
 
 use mrsl_abi::ShadingRate;
 use mrsl_lab::gpu::Gpu;
@@ -15,12 +18,17 @@ use std::time::Instant;
 /// Frames after which the tools stop waiting for the rate image to settle.
 pub const MAX_FRAMES: usize = 8;
 
+/// The fraction of tiles that may still change when the rate image counts as settled.
+pub const SETTLED_FRACTION: f64 = 0.005;
+
 /// The settled rate image and what it took.
 pub struct Settled {
     /// Rate-image frames rendered before the rate image stopped changing.
     pub frames: usize,
-    /// Whether it stopped changing within [`MAX_FRAMES`].
+    /// Whether it settled within [`MAX_FRAMES`].
     pub stable: bool,
+    /// Tiles that changed between the last two decisions.
+    pub changed: usize,
     /// Tiles at each rate, finest first.
     pub histogram: Vec<(ShadingRate, usize)>,
     /// Warm wall time of one rate-source pass, in ms (median of 3).
@@ -39,8 +47,9 @@ impl Settled {
             .collect();
         let settled = if self.stable { "settled after" } else { "still changing after" };
         format!(
-            "shading rates {settled} {} frames of a still camera: {} (rate source {:.1} ms warm wall time)",
+            "shading rates {settled} {} frames of a still camera ({} of {tiles} tiles changed in the last): {} (rate source {:.1} ms warm wall time)",
             self.frames,
+            self.changed,
             parts.join(", "),
             self.source_ms
         )
@@ -69,6 +78,8 @@ pub fn settle(
     };
     let mut source = RateSource::new(&gpu.device).map_err(|e| e.to_string())?;
     let decide = |source: &mut RateSource| -> Result<f64, String> {
+        // The frame before must be done, or its time would count as the source's.
+        gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| e.to_string())?;
         let start = Instant::now();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         source
@@ -80,14 +91,17 @@ pub fn settle(
     };
     submit(shader, Mode::Reference)?;
     let mut previous: Option<Vec<ShadingRate>> = None;
-    let (mut frames, mut stable) = (0, false);
+    let (mut frames, mut stable, mut changed) = (0, false, 0);
     let mut times = vec![];
     while frames < MAX_FRAMES {
         times.push(decide(&mut source)?);
         let rates = read_rate_image(&gpu.device, &gpu.queue, target).map_err(|e| e.to_string())?;
-        if previous.as_ref() == Some(&rates) {
-            stable = true;
-            break;
+        if let Some(previous) = &previous {
+            changed = previous.iter().zip(&rates).filter(|(a, b)| a != b).count();
+            if changed as f64 <= SETTLED_FRACTION * rates.len() as f64 {
+                stable = true;
+                break;
+            }
         }
         previous = Some(rates);
         submit(shader, Mode::RateImage)?;
@@ -97,5 +111,17 @@ pub fn settle(
     let histogram = ShadingRate::ALL.iter().map(|&r| (r, rates.iter().filter(|x| **x == r).count())).collect();
     // The first decisions build pipelines and history; time the last ones.
     let warm: Vec<f64> = times.iter().rev().take(3).copied().collect();
-    Ok(Settled { frames, stable, histogram, source_ms: crate::render::median(warm) })
+    Ok(Settled { frames, stable, changed, histogram, source_ms: crate::render::median(warm) })
+}
+
+/// Sets every tile of `target` (an `R32Uint` rate image) to `rate`.
+pub fn fill(gpu: &Gpu, target: &wgpu::Texture, rate: ShadingRate) {
+    let (w, h) = (target.width(), target.height());
+    let codes = vec![u32::from(rate.code()); (w * h) as usize];
+    gpu.queue.write_texture(
+        target.as_image_copy(),
+        &codes.iter().flat_map(|c| c.to_le_bytes()).collect::<Vec<u8>>(),
+        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(w * 4), rows_per_image: Some(h) },
+        target.size(),
+    );
 }

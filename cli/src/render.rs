@@ -37,6 +37,8 @@ pub struct RenderArgs {
     pub similarity: f32,
     /// The rate-image mode's rate source.
     pub rates: mrsl_runtime::rate_source::RateOptions,
+    /// The rate-image mode at one rate everywhere instead of the rate source's.
+    pub uniform_rate: Option<mrsl_abi::ShadingRate>,
 }
 
 /// One mode's run, as written to the stats JSON.
@@ -172,10 +174,18 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
         );
     }
     for &mode in &args.modes {
-        if mode == Mode::RateImage {
-            let start = Instant::now();
-            let settled = crate::rates::settle(&gpu, &mut shader, &bindings, first_output, &args.rates, options(mode))?;
-            progress(&settled.describe(), start);
+        match (mode, args.uniform_rate) {
+            (Mode::RateImage, Some(rate)) => {
+                crate::rates::fill(&gpu, &resources.shading_rate, rate);
+                eprintln!("shading rate {rate} everywhere (--uniform-rate)");
+            }
+            (Mode::RateImage, None) => {
+                let start = Instant::now();
+                let settled =
+                    crate::rates::settle(&gpu, &mut shader, &bindings, first_output, &args.rates, options(mode))?;
+                progress(&settled.describe(), start);
+            }
+            _ => {}
         }
         let start = Instant::now();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());

@@ -309,7 +309,7 @@ struct History {
 pub struct RateSource {
     decide_layout: wgpu::BindGroupLayout,
     resolve_layout: wgpu::BindGroupLayout,
-    /// `decide` for 8x8 and 16x16 tiles (the workgroup is one tile).
+    /// `decide` for 8x8 and 16x16 tiles (one invocation per tile).
     decide: Vec<(u32, wgpu::ComputePipeline)>,
     resolve: wgpu::ComputePipeline,
     /// Bound where no velocity or external image is given.
@@ -548,7 +548,8 @@ impl RateSource {
             });
             pass.set_pipeline(decide);
             pass.set_bind_group(0, &decide_group, &[]);
-            pass.dispatch_workgroups(rate_size.0, rate_size.1, 1);
+            // One invocation per tile, 8x8 tiles per workgroup.
+            pass.dispatch_workgroups(rate_size.0.div_ceil(8), rate_size.1.div_ceil(8), 1);
         }
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {

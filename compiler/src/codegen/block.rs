@@ -262,10 +262,25 @@ impl Writer<'_, '_, '_> {
             None => (0..iface.flag_words).collect(),
             Some(_) => self.flag_words_read(&coarse).into_iter().collect(),
         };
-        for (ci, sample) in samples.iter().enumerate() {
+        for (ci, sample) in samples.iter().enumerate().take(4) {
             for &w in &words {
                 self.line(1, format!("let f{ci}_{w} = {buf}[{sample} * {stride}u + {w}u];"));
             }
+        }
+        if rate && !words.is_empty() {
+            // The second border samples' flags, read only where a corner blends two.
+            for ci in 4..8 {
+                for &w in &words {
+                    self.line(1, format!("var f{ci}_{w} = f{}_{w};", ci - 4));
+                }
+            }
+            self.line(1, "if (blended) {");
+            for (ci, sample) in samples.iter().enumerate().skip(4) {
+                for &w in &words {
+                    self.line(2, format!("f{ci}_{w} = {buf}[{sample} * {stride}u + {w}u];"));
+                }
+            }
+            self.line(1, "}");
         }
         self.template(0, corners, &[]);
         for &e in coarse.iter().rev() {

@@ -15,6 +15,9 @@ fn mrsl_resolve{{SUFFIX}}(pos: vec2<i32>) -> MrslBlock {
     b.corners = vec4<u32>(c00.x, c10.x, c01.x, c11.x);
     b.others = vec4<u32>(c00.y, c10.y, c01.y, c11.y);
     b.lerps = bitcast<vec4<f32>>(vec4<u32>(c00.z, c10.z, c01.z, c11.z));
+    // Whether a corner blends two border samples (else `others` repeats `corners`, and
+    // their keys and flags are not read again).
+    let blended = any(b.lerps != vec4<f32>(0.0));
     b.weights = vec4<f32>((1.0 - t01.x) * (1.0 - t01.y), t01.x * (1.0 - t01.y), (1.0 - t01.x) * t01.y, t01.x * t01.y);
     b.nearest = select(0u, 1u, t01.x > 0.5) + select(0u, 2u, t01.y > 0.5);
     // A full-rate tile evaluates every coarse effect per pixel.

@@ -5,8 +5,14 @@
     let k1_{{NAME}} = mrsl_load_{{NAME}}(mrsl_sample_pixel(b.corners.y));
     let k2_{{NAME}} = mrsl_load_{{NAME}}(mrsl_sample_pixel(b.corners.z));
     let k3_{{NAME}} = mrsl_load_{{NAME}}(mrsl_sample_pixel(b.corners.w));
-    let k4_{{NAME}} = mrsl_load_{{NAME}}(mrsl_sample_pixel(b.others.x));
-    let k5_{{NAME}} = mrsl_load_{{NAME}}(mrsl_sample_pixel(b.others.y));
-    let k6_{{NAME}} = mrsl_load_{{NAME}}(mrsl_sample_pixel(b.others.z));
-    let k7_{{NAME}} = mrsl_load_{{NAME}}(mrsl_sample_pixel(b.others.w));
+    var k4_{{NAME}} = k0_{{NAME}};
+    var k5_{{NAME}} = k1_{{NAME}};
+    var k6_{{NAME}} = k2_{{NAME}};
+    var k7_{{NAME}} = k3_{{NAME}};
+    if (blended) {
+        k4_{{NAME}} = mrsl_load_{{NAME}}(mrsl_sample_pixel(b.others.x));
+        k5_{{NAME}} = mrsl_load_{{NAME}}(mrsl_sample_pixel(b.others.y));
+        k6_{{NAME}} = mrsl_load_{{NAME}}(mrsl_sample_pixel(b.others.z));
+        k7_{{NAME}} = mrsl_load_{{NAME}}(mrsl_sample_pixel(b.others.w));
+    }
     let disc_{{NAME}} = {{TESTS}};
