@@ -445,4 +445,18 @@ mod tests {
         assert_eq!(read_source(&bom).unwrap(), "\u{FEFF}in float3 n;\n");
         std::fs::remove_dir_all(&dir).unwrap();
     }
+    #[test]
+    fn rate_options_parse_or_say_what_is_expected() {
+        assert_eq!(parse_rate("2x4"), Ok(mrsl_abi::ShadingRate::R2x4));
+        let message = parse_rate("4x1").unwrap_err();
+        assert!(message.contains("1x1, 1x2, 2x1, 2x2, 2x4, 4x2, 4x4"), "{message}");
+        assert_eq!(parse_rate_tile("16"), Ok(16));
+        assert!(parse_rate_tile("12").unwrap_err().contains("[8, 16]"));
+        let cli = Cli::try_parse_from(["mrslc", "render", "--mode", "rate-image", "--uniform-rate", "4x2"]).unwrap();
+        let Command::Render(r) = cli.command else { panic!("render") };
+        assert_eq!(
+            (r.uniform_rate, r.rate_tile, r.rate_preset),
+            (Some(mrsl_abi::ShadingRate::R4x2), 8, RatePreset::Balanced)
+        );
+    }
 }

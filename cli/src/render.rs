@@ -576,7 +576,7 @@ fn save_heatmap(
 pub struct ModeList(pub Vec<Mode>);
 
 /// Parses `--mode`: a comma-separated list of mode names, where `all`
-/// stands for the six modes in their usual order; every unknown name is
+/// stands for the seven modes in their usual order; every unknown name is
 /// reported at once.
 pub fn parse_modes(text: &str) -> Result<ModeList, String> {
     let mut modes = vec![];
