@@ -57,9 +57,17 @@ impl<'a> Model<'a> {
                 let origin = (tx * self.tile, ty * self.tile);
                 let rate = self.rate((tx, ty));
                 if rate != (1, 1) {
+                    // Its lattice, but along its first row (column) only the coarser side's steps.
+                    let row_step = if ty > 0 { rate.0.max(self.rate((tx, ty - 1)).0) } else { rate.0 };
+                    let column_step = if tx > 0 { rate.1.max(self.rate((tx - 1, ty)).1) } else { rate.1 };
                     for &y in &self.axis(origin.1, rate.1, self.size.1) {
                         for &x in &self.axis(origin.0, rate.0, self.size.0) {
-                            out.push((x, y));
+                            let on_row = y == origin.1 && (x - origin.0) % row_step == 0 || x == self.size.0 - 1;
+                            let on_column = x == origin.0 && (y - origin.1) % column_step == 0 || y == self.size.1 - 1;
+                            let inside = x != origin.0 && y != origin.1;
+                            if inside || (y == origin.1 && on_row) || (x == origin.0 && on_column) {
+                                out.push((x, y));
+                            }
                         }
                     }
                     continue;

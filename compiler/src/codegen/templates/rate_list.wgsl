@@ -16,8 +16,10 @@ fn mrsl_list(at: u32, p: vec2<i32>) {
 
 // One invocation per tile: lists the coarse samples the tile owns. A tile at rate w x h
 // owns its lattice (every w-th column and h-th row from its origin, plus the image's
-// last column and row at the edge); the samples on its far borders belong to the tiles
-// there. A full-rate (1x1) tile shades everything per pixel and owns only what its
+// last column and row at the edge), except that along its first row it lists only every
+// max(w, w above)-th column and along its first column every max(h, h left)-th row: both
+// sides resample a shared border from those alone. The samples on its far borders belong
+// to the tiles there. A full-rate (1x1) tile shades everything per pixel and owns only what its
 // coarser neighbours' cells need: its first column at its left neighbour's height,
 // its first row at its upper neighbour's width, and its origin when one of those or the
 // tile diagonally above-left is coarser. So every listed sample is a distinct pixel, and the cells of every tile find all their corners listed.
@@ -63,11 +65,30 @@ fn {{LIST}}(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         return;
     }
+    // The steps along the first row and the first column: the coarser side's.
+    var row_step = rate.x;
+    var column_step = rate.y;
+    if (t.y > 0) {
+        row_step = max(row_step, mrsl_tile_rate(t - vec2<i32>(0, 1)).x);
+    }
+    if (t.x > 0) {
+        column_step = max(column_step, mrsl_tile_rate(t - vec2<i32>(1, 0)).y);
+    }
     let nx = mrsl_axis_count(origin.x, end.x, rate.x, size.x);
     let ny = mrsl_axis_count(origin.y, end.y, rate.y, size.y);
-    var at = atomicAdd(&mrsl_queue[0], u32(nx * ny));
-    for (var j = 0; j < ny; j += 1) {
-        for (var i = 0; i < nx; i += 1) {
+    let row = mrsl_axis_count(origin.x, end.x, row_step, size.x);
+    let column = mrsl_axis_count(origin.y, end.y, column_step, size.y);
+    var at = atomicAdd(&mrsl_queue[0], u32(row + column - 1 + (nx - 1) * (ny - 1)));
+    for (var i = 0; i < row; i += 1) {
+        mrsl_list(at, vec2<i32>(mrsl_axis_at(origin.x, row_step, size.x, i), origin.y));
+        at += 1u;
+    }
+    for (var j = 1; j < column; j += 1) {
+        mrsl_list(at, vec2<i32>(origin.x, mrsl_axis_at(origin.y, column_step, size.y, j)));
+        at += 1u;
+    }
+    for (var j = 1; j < ny; j += 1) {
+        for (var i = 1; i < nx; i += 1) {
             mrsl_list(at, vec2<i32>(mrsl_axis_at(origin.x, rate.x, size.x, i), mrsl_axis_at(origin.y, rate.y, size.y, j)));
             at += 1u;
         }
