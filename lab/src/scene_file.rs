@@ -11,6 +11,12 @@
 //! up = [0, 1, 0]               # optional
 //! fov = 60                     # optional: vertical field of view in degrees (default 50)
 //!
+//! camera_path = "walk"         # optional: the path of `mrslc render --frames` (Sponza's default)
+//! # or keyframes, passed through in order by a Catmull-Rom spline:
+//! # [[camera_path]]
+//! # eye = [-11.5, 2.2, -0.3]
+//! # target = [10.0, 4.5, 0.4]
+//!
 //! [uniforms]                   # optional: applied before any `mrslc render --set`
 //! light_dir = [0.3, 0.9, 0.3]
 //! shininess = 20
@@ -26,6 +32,7 @@
 //! a warning ([`SceneBinding::applied`]), or is an error when the program
 //! has no default for it; a name the program does not declare is an error.
 
+use crate::camera_path::{CameraPath, Keyframe};
 use crate::gbuffer::GBuffer;
 use crate::gpu::Gpu;
 use crate::image_texture::{ColorSpace, ImageError, ImageTexture};
@@ -134,6 +141,8 @@ pub struct SceneFile {
     pub camera: Option<Camera>,
     pub size: Option<(u32, u32)>,
     pub crease_angle: Option<f32>,
+    /// `camera_path`, if the file has one (see [`SceneFile::path`]).
+    pub camera_path: Option<CameraPath>,
     /// Uniform values and images, in the order of the file.
     pub uniforms: Vec<(String, UniformValue)>,
 }
@@ -155,10 +164,10 @@ impl SceneFile {
         let key_error =
             |key: &str, message: String| SceneFileError::Key { path: path.to_path_buf(), key: key.into(), message };
         for key in table.keys() {
-            if !["mesh", "size", "crease_angle", "camera", "uniforms"].contains(&key.as_str()) {
+            if !["mesh", "size", "crease_angle", "camera", "camera_path", "uniforms"].contains(&key.as_str()) {
                 return Err(key_error(
                     key,
-                    "unknown key (expected mesh, size, crease_angle, camera or uniforms)".into(),
+                    "unknown key (expected mesh, size, crease_angle, camera, camera_path or uniforms)".into(),
                 ));
             }
         }
@@ -240,6 +249,10 @@ impl SceneFile {
             }
             Some(other) => return Err(key_error("camera", format!("expected a table, found {}", other.type_str()))),
         };
+        let camera_path = match table.get("camera_path") {
+            None => None,
+            Some(v) => Some(camera_path(v).map_err(|(key, message)| key_error(&key, message))?),
+        };
         let base = path.parent().unwrap_or(Path::new(""));
         let mut uniforms = vec![];
         match table.get("uniforms") {
@@ -267,7 +280,7 @@ impl SceneFile {
             }
             Some(other) => return Err(key_error("uniforms", format!("expected a table, found {}", other.type_str()))),
         }
-        Ok(SceneFile { path: path.to_path_buf(), mesh, camera, size, crease_angle, uniforms })
+        Ok(SceneFile { path: path.to_path_buf(), mesh, camera, size, crease_angle, camera_path, uniforms })
     }
 
     /// Sets the file's `[uniforms]` on `shader` and uploads its images, by
@@ -345,6 +358,17 @@ impl SceneFile {
         }
     }
 
+    /// The camera path of `mrslc render --frames`: the file's
+    /// `camera_path`, else Sponza's default walk for `mesh = "sponza"`;
+    /// other meshes have none.
+    pub fn path(&self) -> Option<CameraPath> {
+        match (&self.camera_path, &self.mesh) {
+            (Some(path), _) => Some(path.clone()),
+            (None, MeshSource::Sponza) => Some(CameraPath::Walk),
+            (None, MeshSource::File(_)) => None,
+        }
+    }
+
     /// Rasterises the scene: G-buffer textures (see [`crate::raster`]) and the camera used.
     pub fn textures_on(
         &self,
@@ -370,6 +394,48 @@ impl SceneFile {
         let (textures, _) = self.textures_on(gpu, size)?;
         crate::raster::read_gbuffer(gpu, &textures)
             .map_err(|source| SceneFileError::Raster { path: self.path.clone(), source })
+    }
+}
+
+/// `camera_path`: `"walk"`, or an array of at least two `{ eye, target }`
+/// tables. Errors name the key at fault.
+fn camera_path(v: &toml::Value) -> Result<CameraPath, (String, String)> {
+    let expected = "expected \"walk\" or [[camera_path]] tables with eye and target";
+    match v {
+        toml::Value::String(s) if s == "walk" => Ok(CameraPath::Walk),
+        toml::Value::Array(items) => {
+            if items.len() < 2 {
+                return Err((
+                    "camera_path".into(),
+                    format!("a path needs at least 2 keyframes, found {}", items.len()),
+                ));
+            }
+            let mut keys = vec![];
+            for (i, item) in items.iter().enumerate() {
+                let here = format!("camera_path[{i}]");
+                let toml::Value::Table(t) = item else {
+                    return Err((here, format!("{expected}, found {}", describe_value(item))));
+                };
+                if let Some(key) = t.keys().find(|k| !["eye", "target"].contains(&k.as_str())) {
+                    return Err((format!("{here}.{key}"), "unknown key (expected eye or target)".into()));
+                }
+                let vec3 = |key: &str| -> Result<[f32; 3], (String, String)> {
+                    let at = format!("{here}.{key}");
+                    let v = t.get(key).ok_or_else(|| (at.clone(), "missing: expected [x, y, z]".to_string()))?;
+                    numbers(v)
+                        .filter(|n| n.len() == 3 && n.iter().all(|x| x.is_finite()))
+                        .map(|n| [n[0] as f32, n[1] as f32, n[2] as f32])
+                        .ok_or_else(|| (at, format!("expected [x, y, z], found {}", describe_value(v))))
+                };
+                let (eye, target) = (vec3("eye")?, vec3("target")?);
+                if eye == target {
+                    return Err((here, "the eye and the target are the same point".into()));
+                }
+                keys.push(Keyframe { eye, target });
+            }
+            Ok(CameraPath::Keyframes(keys))
+        }
+        other => Err(("camera_path".into(), format!("{expected}, found {}", describe_value(other)))),
     }
 }
 
