@@ -9,6 +9,7 @@ use std::process::ExitCode;
 
 mod ablation;
 mod bench;
+mod frames;
 mod legend;
 mod rates;
 mod render;
@@ -160,6 +161,12 @@ struct Render {
     /// Rate-image mode: pixels per side of a shading-rate tile.
     #[arg(long, default_value_t = mrsl_abi::shading_rate::DEFAULT_RATE_TILE, value_parser = parse_rate_tile)]
     rate_tile: u32,
+    /// Render N frames along the scene's camera path (Sponza's walk, or a scene file's
+    /// camera_path), writing PROGRAM.MODE.fNNN.png, the rate-image mode's rates per
+    /// frame and PROGRAM.frames.json; the rate-image mode takes its rates from the
+    /// previous frame and its motion vectors.
+    #[arg(long, value_parser = frames::parse_frames)]
+    frames: Option<usize>,
 }
 
 /// `--rate-tile`: one of the tile sizes the rate-image mode supports.
@@ -262,6 +269,7 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
                     tile: r.rate_tile,
                     ..mrsl_runtime::rate_source::RateOptions::preset(r.rate_preset.runtime())
                 },
+                frames: r.frames,
             };
             Ok(written(render::render(&args)))
         }
