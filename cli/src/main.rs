@@ -428,6 +428,25 @@ mod tests {
     }
 
     #[test]
+    fn render_takes_frames_as_a_count_and_defaults_to_a_still_frame() {
+        let frames = |args: &[&str]| -> Result<Option<usize>, String> {
+            let argv = ["mrslc", "render", "examples/sponza_lights.mrsl", "--scene", "sponza"];
+            let cli = Cli::try_parse_from(argv.iter().chain(args)).map_err(|e| e.to_string())?;
+            match cli.command {
+                Command::Render(r) => Ok(r.frames),
+                _ => Err("not render".into()),
+            }
+        };
+        assert_eq!(frames(&[]), Ok(None), "without --frames: a still frame");
+        assert_eq!(frames(&["--frames", "8"]), Ok(Some(8)));
+        assert_eq!(frames(&["--frames=1", "--mode", "rate-image", "--compare"]), Ok(Some(1)));
+        for bad in ["0", "-1", "two", "1.5"] {
+            let e = frames(&[&format!("--frames={bad}")]).unwrap_err();
+            assert!(e.contains("--frames") && e.contains("from 1 to 1000"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
     fn read_source_reports_invalid_utf8_and_keeps_a_byte_order_mark() {
         let dir = std::env::temp_dir().join(format!("mrslc-read-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();

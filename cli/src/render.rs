@@ -594,7 +594,7 @@ fn save_heatmap(
 pub struct ModeList(pub Vec<Mode>);
 
 /// Parses `--mode`: a comma-separated list of mode names, where `all`
-/// stands for the six modes in their usual order; every unknown name is
+/// stands for every mode in its usual order; every unknown name is
 /// reported at once.
 pub fn parse_modes(text: &str) -> Result<ModeList, String> {
     let mut modes = vec![];
@@ -671,7 +671,8 @@ mod tests {
                 Mode::Coarse2x2,
                 Mode::Coarse4x4,
                 Mode::Hierarchical,
-                Mode::Checkerboard
+                Mode::Checkerboard,
+                Mode::RateImage
             ]))
         );
     }
@@ -681,7 +682,7 @@ mod tests {
         assert_eq!(
             parse_modes("reference,coarse8x8"),
             Err("unknown mode `coarse8x8` (expected a comma-separated list of reference, coarse2x2, coarse4x4, \
-                 dynamic, hierarchical, checkerboard, or all)"
+                 dynamic, hierarchical, checkerboard, rate-image, or all)"
                 .into())
         );
         let e = parse_modes("fast,reference,,slow").unwrap_err();
