@@ -11,11 +11,9 @@
 //! up = [0, 1, 0]               # optional
 //! fov = 60                     # optional: vertical field of view in degrees (default 50)
 //!
-//! camera_path = "walk"         # optional: the path of `mrslc render --frames` (Sponza's default)
-//! # or keyframes, passed through in order by a Catmull-Rom spline:
-//! # [[camera_path]]
-//! # eye = [-11.5, 2.2, -0.3]
-//! # target = [10.0, 4.5, 0.4]
+//! # [[camera_path]]            # optional: keyframes of `mrslc render --frames`, at least two,
+//! # eye = [-11.5, 2.2, -0.3]    # passed through in order by a Catmull-Rom spline (or
+//! # target = [10.0, 4.5, 0.4]   # `camera_path = "walk"` before any table; Sponza's default)
 //!
 //! [uniforms]                   # optional: applied before any `mrslc render --set`
 //! light_dir = [0.3, 0.9, 0.3]
@@ -490,5 +488,55 @@ fn describe_value(v: &toml::Value) -> String {
         toml::Value::Boolean(b) => format!("boolean {b}"),
         toml::Value::Datetime(d) => format!("datetime {d}"),
         toml::Value::Table(_) => "a table".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<SceneFile, String> {
+        SceneFile::parse(text, Path::new("hall.toml")).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn camera_paths_are_a_walk_or_keyframes_and_sponza_walks_by_default() {
+        assert_eq!(parse("mesh = \"sponza\"").unwrap().path(), Some(CameraPath::Walk));
+        assert_eq!(parse("mesh = \"hall.glb\"").unwrap().path(), None);
+        assert_eq!(parse("mesh = \"hall.glb\"\ncamera_path = \"walk\"").unwrap().path(), Some(CameraPath::Walk));
+        let keys = "mesh = \"sponza\"\n[[camera_path]]\neye = [0, 1, 2]\ntarget = [3, 4, 5]\n\
+                    [[camera_path]]\neye = [1, 1, 2]\ntarget = [3, 4, 6]\n";
+        let expected = CameraPath::Keyframes(vec![
+            Keyframe { eye: [0.0, 1.0, 2.0], target: [3.0, 4.0, 5.0] },
+            Keyframe { eye: [1.0, 1.0, 2.0], target: [3.0, 4.0, 6.0] },
+        ]);
+        assert_eq!(parse(keys).unwrap().path(), Some(expected), "a file's keyframes win over Sponza's walk");
+    }
+
+    #[test]
+    fn camera_path_mistakes_name_their_key() {
+        for (text, message) in [
+            ("camera_path = \"run\"", "hall.toml: `camera_path`: expected \"walk\""),
+            ("[[camera_path]]\neye = [0, 1, 2]\ntarget = [3, 4, 5]", "at least 2 keyframes, found 1"),
+            (
+                "[[camera_path]]\neye = [0, 1, 2]\ntarget = [3, 4, 5]\n[[camera_path]]\neye = [0, 1]",
+                "`camera_path[1].eye`",
+            ),
+            (
+                "[[camera_path]]\neye = [0, 1, 2]\ntarget = [3, 4, 5]\n[[camera_path]]\neye = [0, 1, 2]",
+                "`camera_path[1].target`: missing",
+            ),
+            (
+                "[[camera_path]]\neye = [0, 1, 2]\ntarget = [0, 1, 2]\n[[camera_path]]\neye = [0, 1, 2]\ntarget = [1, 1, 1]",
+                "`camera_path[0]`: the eye and the target",
+            ),
+            (
+                "[[camera_path]]\neye = [0, 1, 2]\ntarget = [3, 4, 5]\nfov = 3\n[[camera_path]]\neye = [0, 1, 2]\ntarget = [1, 1, 1]",
+                "`camera_path[0].fov`: unknown key",
+            ),
+        ] {
+            let e = parse(&format!("mesh = \"sponza\"\n{text}")).unwrap_err();
+            assert!(e.contains(message), "{text}: {e}");
+        }
     }
 }
