@@ -7,8 +7,8 @@ use crate::render::{BoundScene, Resources, bind_scene, compile_program};
 use crate::report::{self, ControllerFrame, Point};
 use indicatif::{ProgressBar, ProgressStyle};
 use mrsl_abi::shading_rate::DEFAULT_RATE_TILE;
+use mrsl_lab::camera_path::CameraPath;
 use mrsl_lab::gpu::Gpu;
-use mrsl_lab::raster::Camera;
 use mrsl_runtime::controller::{Target, ThresholdController};
 use mrsl_runtime::rate_source::{Preset, RateOptions};
 use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader, Stats};
@@ -385,18 +385,6 @@ fn save_rgb(rgb: &[u8], size: (u32, u32), path: &Path) -> Result<(), String> {
         .map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
-/// The camera of frame `i` of `n` along the path: the eye walks half-way
-/// towards the target while the view swings 25 degrees left and right.
-pub fn path_camera(start: &Camera, i: usize, n: usize) -> Camera {
-    let t = if n > 1 { i as f32 / (n - 1) as f32 } else { 0.0 };
-    let d: [f32; 3] = std::array::from_fn(|k| start.target[k] - start.eye[k]);
-    let eye: [f32; 3] = std::array::from_fn(|k| start.eye[k] + 0.5 * t * d[k]);
-    let yaw = 25f32.to_radians() * (std::f32::consts::TAU * t).sin();
-    let (s, c) = yaw.sin_cos();
-    let turned = [c * d[0] + s * d[2], d[1], -s * d[0] + c * d[2]];
-    Camera { eye, target: std::array::from_fn(|k| eye[k] + turned[k]), ..*start }
-}
-
 /// The dynamic threshold: the hierarchical mode's similarity steered to a
 /// target shaded fraction, frame by frame along a camera path.
 fn controller_run(
@@ -425,7 +413,7 @@ fn controller_run(
     let mut frames = vec![];
     let mut bench = Bench { gpu, shader, runs: 1 };
     for i in 0..args.path_frames {
-        let camera = path_camera(&mesh.camera, i, args.path_frames);
+        let camera = CameraPath::Walk.camera(&mesh.camera, i, args.path_frames);
         let channels = mesh.gbuffer(gpu, &camera, args.size).map_err(|e| e.to_string())?;
         mesh.set_uniforms(&mut bench.shader, &camera).map_err(|e| e.to_string())?;
         let bindings = resources.bindings(program, &channels);
@@ -456,19 +444,6 @@ fn controller_run(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_path_starts_at_the_scene_camera_and_walks_forward() {
-        let start = Camera::look_at([0.0, 1.0, 0.0], [10.0, 1.0, 0.0], 60.0);
-        let first = path_camera(&start, 0, 10);
-        assert_eq!(first.eye, start.eye);
-        assert!((first.target[0] - 10.0).abs() < 1e-5 && first.target[2].abs() < 1e-5);
-        let last = path_camera(&start, 9, 10);
-        assert!((last.eye[0] - 5.0).abs() < 1e-5);
-        // Mid-way the view has turned.
-        let mid = path_camera(&start, 2, 10);
-        assert!(mid.target[2].abs() > 1.0);
-    }
 
     #[test]
     fn the_plan_sweeps_each_mode_and_forces_each_once() {

@@ -27,6 +27,22 @@ pub enum Legend {
     Effect(String),
     /// An error image: Magma over the mean absolute difference times `scale`.
     Error { scale: f32 },
+    /// A shading-rate image over its frame ([`rate_color`]), tiles of `tile` pixels.
+    Rates { tile: u32 },
+}
+
+/// The colour of a shading rate in the rate visualisations, after NVIDIA's
+/// VRS debug view (by the pixels one shading cell covers): 1x1 none (the
+/// frame shows through), 2 pixels (1x2, 2x1) blue, 4 (2x2) green, 8 (2x4,
+/// 4x2) yellow, 16 (4x4) red.
+pub fn rate_color(rate: mrsl_abi::ShadingRate) -> Option<[u8; 3]> {
+    match rate.pixels() {
+        1 => None,
+        2 => Some([40, 100, 255]),
+        4 => Some([30, 200, 60]),
+        8 => Some([250, 220, 20]),
+        _ => Some([240, 30, 30]),
+    }
 }
 
 /// The heatmaps' colour for a pixel where a fraction `f` (0 to 1) of the
@@ -114,6 +130,26 @@ fn draw(root: &Area, legend: &Legend, top: i32, width: i32) -> DrawResult {
                 font.clone(),
             ))?;
         }
+        Legend::Rates { tile } => {
+            use mrsl_abi::ShadingRate as R;
+            let keys = [
+                (R::R1x1, "1x1 (none)"),
+                (R::R1x2, "1x2, 2x1"),
+                (R::R2x2, "2x2"),
+                (R::R2x4, "2x4, 4x2"),
+                (R::R4x4, "4x4"),
+            ];
+            for (k, (rate, label)) in keys.into_iter().enumerate() {
+                // 1x1 has no colour: its swatch is the dimmed frame's grey.
+                let color = rate_color(rate).map_or(RGBColor(128, 128, 128), rgb);
+                swatch(root, (10 + 82 * k as i32, bar_top), color, label)?;
+            }
+            root.draw(&Text::new(
+                format!("shading rate of each {tile}x{tile} tile, over the frame dimmed"),
+                (10, top + 32),
+                font.clone(),
+            ))?;
+        }
     }
     Ok(())
 }
@@ -154,7 +190,12 @@ mod tests {
     #[test]
     fn the_key_is_drawn_below_an_unchanged_image() {
         let image = image::RgbImage::from_fn(64, 40, |x, y| image::Rgb([x as u8 * 3, y as u8 * 5, 7]));
-        for legend in [Legend::Fraction, Legend::Effect("diffuse".into()), Legend::Error { scale: 10.0 }] {
+        for legend in [
+            Legend::Fraction,
+            Legend::Effect("diffuse".into()),
+            Legend::Error { scale: 10.0 },
+            Legend::Rates { tile: 8 },
+        ] {
             let keyed = with_legend(&image, &legend).unwrap();
             assert_eq!(keyed.dimensions(), (MIN_WIDTH, 40 + STRIP));
             for (x, y, p) in image.enumerate_pixels() {
@@ -169,6 +210,18 @@ mod tests {
             let coloured = strip.iter().filter(|p| p.0.iter().max().unwrap() - p.0.iter().min().unwrap() > 60).count();
             assert!(dark > 100 && coloured > 300, "{dark} dark, {coloured} coloured pixels in the key");
         }
+    }
+
+    #[test]
+    fn rates_are_coloured_by_pixels_per_cell_as_nvidia_shows_them() {
+        use mrsl_abi::ShadingRate as R;
+        assert_eq!(rate_color(R::R1x1), None);
+        assert_eq!(rate_color(R::R1x2), rate_color(R::R2x1));
+        assert_eq!(rate_color(R::R2x4), rate_color(R::R4x2));
+        let distinct: std::collections::HashSet<_> =
+            [R::R1x2, R::R2x2, R::R2x4, R::R4x4].into_iter().filter_map(rate_color).collect();
+        assert_eq!(distinct.len(), 4);
+        assert_eq!(rate_color(R::R4x4), Some([240, 30, 30]), "4x4 is red");
     }
 
     #[test]

@@ -9,6 +9,7 @@ use std::process::ExitCode;
 
 mod ablation;
 mod bench;
+mod frames;
 mod legend;
 mod rates;
 mod render;
@@ -164,6 +165,12 @@ struct Render {
     /// Rate-image mode: pixels per side of a shading-rate tile.
     #[arg(long, default_value_t = mrsl_abi::shading_rate::DEFAULT_RATE_TILE, value_parser = parse_rate_tile)]
     rate_tile: u32,
+    /// Render N frames along the scene's camera path (Sponza's walk, or a scene file's
+    /// camera_path), writing PROGRAM.MODE.fNNN.png, the rate-image mode's rates per
+    /// frame and PROGRAM.frames.json; the rate-image mode takes its rates from the
+    /// previous frame and its motion vectors.
+    #[arg(long, value_parser = frames::parse_frames)]
+    frames: Option<usize>,
 }
 
 /// `--rate-tile`: one of the tile sizes the rate-image mode supports.
@@ -275,6 +282,7 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
                     tile: r.rate_tile,
                     ..mrsl_runtime::rate_source::RateOptions::preset(r.rate_preset.runtime())
                 },
+                frames: r.frames,
             };
             Ok(written(render::render(&args)))
         }
@@ -430,6 +438,25 @@ mod tests {
         bytes.push(0xFF);
         let error = std::str::from_utf8(&bytes).unwrap_err();
         assert_eq!(not_utf8("b.mrsl", &bytes, error), "b.mrsl: not valid UTF-8 at byte 14 (line 2, column 7)");
+    }
+
+    #[test]
+    fn render_takes_frames_as_a_count_and_defaults_to_a_still_frame() {
+        let frames = |args: &[&str]| -> Result<Option<usize>, String> {
+            let argv = ["mrslc", "render", "examples/sponza_lights.mrsl", "--scene", "sponza"];
+            let cli = Cli::try_parse_from(argv.iter().chain(args)).map_err(|e| e.to_string())?;
+            match cli.command {
+                Command::Render(r) => Ok(r.frames),
+                _ => Err("not render".into()),
+            }
+        };
+        assert_eq!(frames(&[]), Ok(None), "without --frames: a still frame");
+        assert_eq!(frames(&["--frames", "8"]), Ok(Some(8)));
+        assert_eq!(frames(&["--frames=1", "--mode", "rate-image", "--compare"]), Ok(Some(1)));
+        for bad in ["0", "-1", "two", "1.5"] {
+            let e = frames(&[&format!("--frames={bad}")]).unwrap_err();
+            assert!(e.contains("--frames") && e.contains("from 1 to 1000"), "{bad}: {e}");
+        }
     }
 
     #[test]

@@ -3,6 +3,7 @@
 
 use crate::legend::{self, Legend};
 use mrsl::Options;
+use mrsl_lab::camera_path::CameraPath;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::mesh_scene::MeshScene;
 use mrsl_lab::scene::Scene;
@@ -39,6 +40,9 @@ pub struct RenderArgs {
     pub rates: mrsl_runtime::rate_source::RateOptions,
     /// The rate-image mode at one rate everywhere instead of the rate source's.
     pub uniform_rate: Option<mrsl_abi::ShadingRate>,
+    /// `--frames N`: N frames along the scene's camera path (see
+    /// [`crate::frames`]) instead of a still frame.
+    pub frames: Option<usize>,
 }
 
 /// One mode's run, as written to the stats JSON.
@@ -62,7 +66,12 @@ struct Run {
 const PAIRS: usize = 3;
 
 /// One warm run of `options`, from encoding to idle: its wall time in ms.
-fn time_run(gpu: &Gpu, shader: &mut Shader, bindings: &Bindings, options: DispatchOptions) -> Result<f64, String> {
+pub(crate) fn time_run(
+    gpu: &Gpu,
+    shader: &mut Shader,
+    bindings: &Bindings,
+    options: DispatchOptions,
+) -> Result<f64, String> {
     let start = Instant::now();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     shader.encode(&gpu.device, &gpu.queue, &mut encoder, bindings, options).map_err(|e| e.to_string())?;
@@ -100,6 +109,9 @@ pub fn compile_program(
 
 /// Runs the render; returns the paths written.
 pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
+    if args.frames.is_some() && (args.output.is_some() || args.heatmap.is_some()) {
+        return Err("--frames names its files OUT/PROGRAM.MODE.fNNN.png: leave out -o and --heatmap".into());
+    }
     let stem = args.program.as_ref().and_then(|p| p.file_stem()).and_then(|s| s.to_str()).unwrap_or("demo").to_string();
     let start = Instant::now();
     // The kernels of the modes that run: those asked for, and the reference to compare with.
@@ -123,11 +135,14 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
     let mut scene = bind_scene(&gpu, &args.scene, args.size)?;
     let size = scene.size;
     progress(&format!("built the {} G-buffer at {}x{}", args.scene, size.0, size.1), start);
+    if args.frames.is_some() && scene.path.is_none() {
+        return Err(crate::frames::no_path(&args.scene));
+    }
     let mut shader = Shader::new(&gpu.device, &program).map_err(|e| e.to_string())?;
     shader.set_timestamp_period(&gpu.queue);
     // The scene's uniforms, then the command line's.
     let textures = scene.prepare(&gpu, &mut shader).map_err(|e| format!("{}: {e}", args.scene))?.warn();
-    let channels = scene.channels;
+    let channels = std::mem::take(&mut scene.channels);
     for (name, values) in &args.sets {
         shader.set_uniform(name, values).map_err(|e| e.to_string())?;
     }
@@ -135,6 +150,17 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
     resources.note_fallbacks();
     // Created only now, so that a run that fails before rendering leaves nothing behind.
     std::fs::create_dir_all(&args.out_dir).map_err(|e| format!("cannot create {}: {e}", args.out_dir.display()))?;
+    if let Some(n) = args.frames {
+        let setup = crate::frames::Setup {
+            gpu: &gpu,
+            program: &program,
+            name: &name,
+            stem: &stem,
+            scene: &scene,
+            resources: &resources,
+        };
+        return crate::frames::render_frames(&setup, &mut shader, args, n);
+    }
     let in_out = |file: String| args.out_dir.join(file);
     let outputs = &resources.outputs;
     let bindings = resources.bindings(&program, &channels);
@@ -308,6 +334,8 @@ pub struct BoundScene {
     pub channels: Vec<(String, wgpu::Texture)>,
     pub size: (u32, u32),
     pub mesh: Option<MeshScene>,
+    /// The camera path of `--frames`, if the scene has one.
+    pub path: Option<CameraPath>,
     pub file: Option<SceneFile>,
 }
 
@@ -371,7 +399,7 @@ fn bind_scene_quietly(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> Resul
             Some(m) => m.gbuffer(gpu, &m.camera, size).map_err(|e| e.to_string())?,
             None => builtin.textures_on(gpu, size.0, size.1).map_err(|e| e.to_string())?,
         };
-        return Ok(BoundScene { channels, size, mesh, file: None });
+        return Ok(BoundScene { channels, size, mesh, path: builtin.camera_path(), file: None });
     }
     let path = Path::new(scene);
     if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
@@ -380,7 +408,7 @@ fn bind_scene_quietly(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> Resul
         let size = size.or(file.size).unwrap_or(DEFAULT_SIZE);
         let mesh = file.mesh_scene(gpu, size).map_err(|e| e.to_string())?;
         let channels = mesh.gbuffer(gpu, &mesh.camera, size).map_err(|e| format!("{scene}: {e}"))?;
-        return Ok(BoundScene { channels, size, mesh: Some(mesh), file: Some(file) });
+        return Ok(BoundScene { channels, size, mesh: Some(mesh), path: file.path(), file: Some(file) });
     }
     Err(format!("unknown scene `{scene}` (expected {}, or a .toml scene file)", Scene::NAMES.join(", ")))
 }
@@ -503,13 +531,13 @@ fn checker_texture(gpu: &Gpu) -> wgpu::Texture {
 }
 
 /// Linear [0, 1] to an 8-bit sRGB value (the outputs are linear radiance).
-fn to_srgb8(v: f32) -> u8 {
+pub(crate) fn to_srgb8(v: f32) -> u8 {
     let v = if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 };
     let s = if v <= 0.0031308 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
     (s * 255.0 + 0.5) as u8
 }
 
-fn save_output(gpu: &Gpu, texture: &wgpu::Texture, path: &Path) -> Result<(), String> {
+pub(crate) fn save_output(gpu: &Gpu, texture: &wgpu::Texture, path: &Path) -> Result<(), String> {
     let (w, h) = (texture.width(), texture.height());
     let bytes = gpu.read_texture(texture).map_err(|e| e.to_string())?;
     let pixels: Vec<[f32; 4]> = match texture.format() {
@@ -576,7 +604,7 @@ fn save_heatmap(
 pub struct ModeList(pub Vec<Mode>);
 
 /// Parses `--mode`: a comma-separated list of mode names, where `all`
-/// stands for the seven modes in their usual order; every unknown name is
+/// stands for every mode in its usual order; every unknown name is
 /// reported at once.
 pub fn parse_modes(text: &str) -> Result<ModeList, String> {
     let mut modes = vec![];
@@ -653,7 +681,8 @@ mod tests {
                 Mode::Coarse2x2,
                 Mode::Coarse4x4,
                 Mode::Hierarchical,
-                Mode::Checkerboard
+                Mode::Checkerboard,
+                Mode::RateImage
             ]))
         );
     }
@@ -663,7 +692,7 @@ mod tests {
         assert_eq!(
             parse_modes("reference,coarse8x8"),
             Err("unknown mode `coarse8x8` (expected a comma-separated list of reference, coarse2x2, coarse4x4, \
-                 dynamic, hierarchical, checkerboard, or all)"
+                 dynamic, hierarchical, checkerboard, rate-image, or all)"
                 .into())
         );
         let e = parse_modes("fast,reference,,slow").unwrap_err();

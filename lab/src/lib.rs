@@ -7,7 +7,9 @@
 //! - [`scene`]: the built-in scenes: CPU test patterns and a ray-cast demo,
 //!   and the Dabrovic Sponza rasterised on the GPU.
 //! - [`material`]: surface materials (factors, textures, mipmaps).
-//! - [`mesh`], [`raster`]: OBJ/glTF loading and the G-buffer rasteriser.
+//! - [`mesh`], [`raster`]: OBJ/glTF loading and the G-buffer rasteriser
+//!   (with motion vectors from the previous frame's camera).
+//! - [`camera_path`]: cameras along a path, for sequences of frames.
 //! - [`rig`], [`mesh_scene`]: the light rig (point lights, a sun with a
 //!   shadow map) and a mesh on the GPU with its camera and rig.
 //! - [`scene_file`]: TOML scene files, and [`image_texture`]: the images
@@ -19,11 +21,13 @@
 //! - [`metrics`]: RMSE, PSNR, MSSIM and FLIP against a reference image.
 //!
 //! Module dependencies run one way: `gbuffer` ← `material` ← `mesh` ←
-//! `raster` ← `rig` ← `mesh_scene` ← `scene` ← `scene_file`, with `gpu`
+//! `raster` ← `rig` ← `mesh_scene` ← `scene` ← `scene_file`, and `raster`
+//! ← `camera_path` ← `scene`, with `gpu`
 //! beneath them all; `uniforms` (used from `rig` on) and `image_texture`
 //! (used by `scene_file`) depend on no other module but `gpu`, and
 //! `runtime_dir` on none.
 
+pub mod camera_path;
 pub mod gbuffer;
 pub mod gpu;
 pub mod image_texture;

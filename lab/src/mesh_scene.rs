@@ -41,6 +41,18 @@ impl MeshScene {
         self.rasterizer.render(gpu, &self.mesh, camera, size)
     }
 
+    /// [`MeshScene::gbuffer`] with the `velocity` channel of a move from
+    /// `previous` (see [`Rasterizer::render_moving`]).
+    pub fn gbuffer_moving(
+        &self,
+        gpu: &Gpu,
+        camera: &Camera,
+        previous: Option<&Camera>,
+        size: (u32, u32),
+    ) -> Result<Vec<(String, wgpu::Texture)>, RasterError> {
+        self.rasterizer.render_moving(gpu, &self.mesh, camera, previous, size)
+    }
+
     /// The rig's shadow map ([`DEFAULT_SHADOW_MAP_SIZE`] square), rendered on first use.
     pub fn shadow_map(&mut self, gpu: &Gpu) -> Result<&wgpu::Texture, RasterError> {
         if self.shadow_map.is_none() {

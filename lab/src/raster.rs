@@ -13,6 +13,7 @@
 //! | `albedo`    | `Rgba32Float` | linear base colour × factor × vertex colour; a: alpha    |
 //! | `roughness` | `R32Float`    | perceptual roughness, factor × texture (G)               |
 //! | `metallic`  | `R32Float`    | metalness, factor × texture (B)                          |
+//! | `velocity`  | `Rg32Float`   | current minus previous projected position, in pixels     |
 //!
 //! Each material is drawn with its own bind group: its factors and its
 //! textures, sampled with trilinear filtering from mipmaps made on the CPU
@@ -28,7 +29,8 @@
 //! WebGPU's default `max_color_attachment_bytes_per_sample` is 32 bytes,
 //! and position and normal alone take 32, so the mesh is drawn three times
 //! with a shared `Depth32Float` buffer: pass 1 writes position and normal
-//! (and the depth buffer), pass 2 uv, material and depth, pass 3 albedo,
+//! (and the depth buffer), pass 2 uv, material, depth and velocity (24
+//! bytes), pass 3 albedo,
 //! roughness and metallic, the last two where the depth equals pass 1's
 //! (the vertex position is `@invariant`). Where coplanar triangles tie,
 //! the last one drawn wins in every pass (pass 1 tests greater-or-equal),
@@ -43,6 +45,20 @@
 //! (0, 0, 0, 0), roughness 1 and metallic 0.
 //! Triangles are two-sided: a triangle seen from behind reports its normal
 //! flipped, so every normal in the G-buffer faces the camera.
+//!
+//! **Motion vectors.** [`Rasterizer::render_moving`] takes the previous
+//! frame's camera besides the current one: the scenes are static, so the
+//! camera alone moves things, and `velocity` is the surface point's pixel
+//! position projected by the current camera minus its position projected by
+//! the previous one (pixel units, x right, y down; `(x + 0.5, y + 0.5)` is a
+//! pixel's centre in both). Both projections are computed in the fragment
+//! shader from the interpolated world position with the same arithmetic, so
+//! an unmoved camera gives exactly zero. The background has velocity 0, as
+//! has a point behind the previous camera (it was not on screen; there is no
+//! position to come from). Without a previous camera ([`Rasterizer::render`])
+//! the channel is 0 everywhere, and programs that do not declare `in float2
+//! velocity` never see it (the runtime ignores channels a program does not
+//! read).
 
 use crate::gbuffer::{BACKGROUND, ChannelData, GBuffer};
 use crate::gpu::Gpu;
@@ -52,7 +68,7 @@ use wgpu::util::DeviceExt;
 
 /// Channel names and formats, in the order [`Rasterizer::render`] returns them
 /// (the same as [`GBuffer::upload`] makes for the CPU scenes).
-pub const CHANNELS: [(&str, wgpu::TextureFormat); 8] = [
+pub const CHANNELS: [(&str, wgpu::TextureFormat); 9] = [
     ("position", wgpu::TextureFormat::Rgba32Float),
     ("normal", wgpu::TextureFormat::Rgba32Float),
     ("uv", wgpu::TextureFormat::Rg32Float),
@@ -61,10 +77,14 @@ pub const CHANNELS: [(&str, wgpu::TextureFormat); 8] = [
     ("albedo", wgpu::TextureFormat::Rgba32Float),
     ("roughness", wgpu::TextureFormat::R32Float),
     ("metallic", wgpu::TextureFormat::R32Float),
+    ("velocity", wgpu::TextureFormat::Rg32Float),
 ];
 
-/// Which channels each pass writes (ranges of [`CHANNELS`]).
-const PASSES: [std::ops::Range<usize>; 3] = [0..2, 2..5, 5..8];
+/// Which channels each pass writes (indices into [`CHANNELS`], in the order
+/// of the fragment shaders' `@location`s). Velocity is last in [`CHANNELS`],
+/// so that the first eight keep the CPU scenes' order, but is written by
+/// pass 2, the one with room left under the 32-byte limit.
+const PASSES: [&[usize]; 3] = [&[0, 1], &[2, 3, 4, 8], &[5, 6, 7]];
 
 /// Why rasterising failed.
 #[derive(Debug, thiserror::Error)]
@@ -189,6 +209,8 @@ struct MaterialUniform {
 struct Globals {
     /// Column-major view-projection matrix.
     view_proj: [[f32; 4]; 4],
+    /// The previous frame's (the same as `view_proj` without one).
+    previous_view_proj: [[f32; 4]; 4],
     /// xyz: eye; w: background distance.
     eye: [f32; 4],
     /// xyz: right axis; w: tan(fov / 2) * aspect.
@@ -203,6 +225,7 @@ struct Globals {
 const SHADER: &str = r#"
 struct Globals {
     view_proj: mat4x4<f32>,
+    previous_view_proj: mat4x4<f32>,
     eye: vec4<f32>,
     right: vec4<f32>,
     up: vec4<f32>,
@@ -243,6 +266,7 @@ struct Pass2 {
     @location(0) uv: vec2<f32>,
     @location(1) material: u32,
     @location(2) depth: f32,
+    @location(3) velocity: vec2<f32>,
 };
 
 struct Pass3 {
@@ -309,10 +333,24 @@ fn fs_mesh1(v: VsOut, @builtin(front_facing) front: bool) -> Pass1 {
     return Pass1(vec4<f32>(v.world, 0.0), vec4<f32>(n, 0.0));
 }
 
+// A world point's position in pixels under a view-projection matrix, or
+// nothing when it lies behind that camera.
+fn project(m: mat4x4<f32>, p: vec3<f32>) -> vec3<f32> {
+    let clip = m * vec4<f32>(p, 1.0);
+    if (clip.w <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let ndc = clip.xy / clip.w;
+    return vec3<f32>((ndc.x * 0.5 + 0.5) * g.size.x, (0.5 - ndc.y * 0.5) * g.size.y, 1.0);
+}
+
 @fragment
 fn fs_mesh2(v: VsOut) -> Pass2 {
     alpha_test(base_color(v).a);
-    return Pass2(v.uv, v.material, distance(v.world, g.eye.xyz));
+    let now = project(g.view_proj, v.world);
+    let before = project(g.previous_view_proj, v.world);
+    let velocity = select(vec2<f32>(0.0), now.xy - before.xy, now.z > 0.0 && before.z > 0.0);
+    return Pass2(v.uv, v.material, distance(v.world, g.eye.xyz), velocity);
 }
 
 @fragment
@@ -344,7 +382,7 @@ fn fs_background1(@builtin(position) frag: vec4<f32>) -> Pass1 {
 
 @fragment
 fn fs_background2(@builtin(position) frag: vec4<f32>) -> Pass2 {
-    return Pass2(vec2<f32>(0.0, 0.0), BACKGROUND_ID, g.eye.w);
+    return Pass2(vec2<f32>(0.0, 0.0), BACKGROUND_ID, g.eye.w, vec2<f32>(0.0));
 }
 
 @fragment
@@ -457,9 +495,10 @@ impl Rasterizer {
             attributes: &attributes,
         };
         let targets = |pass: usize| -> Vec<Option<wgpu::ColorTargetState>> {
-            CHANNELS[PASSES[pass].clone()]
+            PASSES[pass]
                 .iter()
-                .map(|&(_, format)| {
+                .map(|&i| {
+                    let format = CHANNELS[i].1;
                     Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
                 })
                 .collect()
@@ -640,12 +679,26 @@ impl Rasterizer {
 
     /// Draws `mesh` from `camera` into new G-buffer textures, named and
     /// formatted as [`CHANNELS`], usable as `TEXTURE_BINDING` and `COPY_SRC`
-    /// (and `RENDER_ATTACHMENT`). The commands are submitted.
+    /// (and `RENDER_ATTACHMENT`). The commands are submitted. `velocity` is
+    /// 0: see [`Rasterizer::render_moving`].
     pub fn render(
         &self,
         gpu: &Gpu,
         mesh: &GpuMesh,
         camera: &Camera,
+        size: (u32, u32),
+    ) -> Result<Vec<(String, wgpu::Texture)>, RasterError> {
+        self.render_moving(gpu, mesh, camera, None, size)
+    }
+
+    /// [`Rasterizer::render`] with the previous frame's camera, if any, for
+    /// the `velocity` channel (see the module's documentation).
+    pub fn render_moving(
+        &self,
+        gpu: &Gpu,
+        mesh: &GpuMesh,
+        camera: &Camera,
+        previous: Option<&Camera>,
         size: (u32, u32),
     ) -> Result<Vec<(String, wgpu::Texture)>, RasterError> {
         let (width, height) = size;
@@ -657,16 +710,15 @@ impl Rasterizer {
         let tan_half = (camera.fov_y_degrees.to_radians() / 2.0).tan();
         let aspect = width as f32 / height as f32;
         let far = background_distance(mesh.bounds.as_ref(), camera);
-        // Reversed, infinite projection: clip = (x f / aspect, y f, near, -z_view).
         let near = mesh.bounds.map(|b| 1e-4 * b.diagonal()).unwrap_or(1e-3).max(1e-6);
-        let f = 1.0 / tan_half;
-        let row = |axis: [f32; 3], scale: f32| {
-            [axis[0] * scale, axis[1] * scale, axis[2] * scale, -dot(axis, camera.eye) * scale]
+        let view_proj = view_projection(camera, aspect, near)?;
+        let previous_view_proj = match previous {
+            Some(previous) => view_projection(previous, aspect, near)?,
+            None => view_proj,
         };
-        let rows = [row(right, f / aspect), row(up, f), [0.0, 0.0, 0.0, near], row(forward, 1.0)];
-        let view_proj: [[f32; 4]; 4] = std::array::from_fn(|col| std::array::from_fn(|r| rows[r][col]));
         let globals = Globals {
             view_proj,
+            previous_view_proj,
             eye: [camera.eye[0], camera.eye[1], camera.eye[2], far],
             right: [right[0], right[1], right[2], tan_half * aspect],
             up: [up[0], up[1], up[2], tan_half],
@@ -704,12 +756,12 @@ impl Rasterizer {
         let depth_view = depth.create_view(&Default::default());
         let views: Vec<wgpu::TextureView> = channels.iter().map(|(_, t)| t.create_view(&Default::default())).collect();
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mrsl raster") });
-        for (pass, range) in PASSES.iter().enumerate() {
-            let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = views[range.clone()]
+        for (pass, written) in PASSES.iter().enumerate() {
+            let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = written
                 .iter()
-                .map(|view| {
+                .map(|&i| {
                     Some(wgpu::RenderPassColorAttachment {
-                        view,
+                        view: &views[i],
                         depth_slice: None,
                         resolve_target: None,
                         ops: wgpu::Operations {
@@ -754,6 +806,18 @@ impl Rasterizer {
         }
         Ok(channels)
     }
+}
+
+/// The column-major view-projection matrix of `camera`: reversed depth
+/// with an infinite far plane, clip = (x f / aspect, y f, near, −z_view).
+fn view_projection(camera: &Camera, aspect: f32, near: f32) -> Result<[[f32; 4]; 4], RasterError> {
+    let (forward, right, up) = camera.basis()?;
+    let f = 1.0 / (camera.fov_y_degrees.to_radians() / 2.0).tan();
+    let row = |axis: [f32; 3], scale: f32| {
+        [axis[0] * scale, axis[1] * scale, axis[2] * scale, -dot(axis, camera.eye) * scale]
+    };
+    let rows = [row(right, f / aspect), row(up, f), [0.0, 0.0, 0.0, near], row(forward, 1.0)];
+    Ok(std::array::from_fn(|col| std::array::from_fn(|r| rows[r][col])))
 }
 
 /// Textures uploaded for one mesh (each image once per encoding, keyed by
@@ -876,7 +940,7 @@ pub fn read_gbuffer(gpu: &Gpu, channels: &[(String, wgpu::Texture)]) -> Result<G
                 let stored = format.components() as usize;
                 let kept = match name.as_str() {
                     "position" | "normal" => 3,
-                    "uv" => 2,
+                    "uv" | "velocity" => 2,
                     "depth" => 1,
                     _ => stored,
                 }

@@ -4,14 +4,16 @@
 //! Every scene provides the same channels, so any program reading a subset
 //! of them runs on any scene: `position` (float3, world space), `normal`
 //! (float3, unit), `uv` (float2), `material` (uint; 255 is the background),
-//! `depth` (float, distance from the camera), and the material channels of
+//! `depth` (float, distance from the camera), the material channels of
 //! a deferred renderer: `albedo` (float4, linear base colour and alpha),
-//! `roughness` and `metallic` (floats in [0, 1]).
+//! `roughness` and `metallic` (floats in [0, 1]), and `velocity` (float2,
+//! the screen-space motion in pixels: 0 here, where the camera never moves).
 //!
 //! [`Scene::Sponza`] is a real model, rasterised on the GPU by
 //! [`crate::raster`]: build it with [`Scene::render_on`] or
 //! [`Scene::textures_on`]. See docs/scenes.md.
 
+use crate::camera_path::CameraPath;
 pub use crate::gbuffer::{BACKGROUND, ChannelData, GBuffer};
 use crate::gpu::Gpu;
 use crate::mesh::MeshError;
@@ -93,6 +95,16 @@ impl Scene {
         match self {
             Scene::Sponza => Some(Scene::sponza_camera()),
             Scene::Dungeon => Some(Scene::dungeon_camera()),
+            _ => None,
+        }
+    }
+
+    /// The path `mrslc render --frames` follows: Sponza's default walk
+    /// ([`CameraPath::Walk`] from [`Scene::sponza_camera`]); the other
+    /// built-in scenes have none.
+    pub fn camera_path(self) -> Option<CameraPath> {
+        match self {
+            Scene::Sponza => Some(CameraPath::Walk),
             _ => None,
         }
     }
@@ -292,6 +304,7 @@ impl Builder {
         self.metallic.push(surface.2);
     }
     fn finish(self) -> GBuffer {
+        let n = (self.width * self.height) as usize;
         GBuffer {
             width: self.width,
             height: self.height,
@@ -304,6 +317,8 @@ impl Builder {
                 ("albedo".into(), ChannelData::Float { components: 4, data: self.albedo }),
                 ("roughness".into(), ChannelData::Float { components: 1, data: self.roughness }),
                 ("metallic".into(), ChannelData::Float { components: 1, data: self.metallic }),
+                // The CPU scenes' camera never moves.
+                ("velocity".into(), ChannelData::Float { components: 2, data: vec![0.0; 2 * n] }),
             ],
         }
     }

@@ -11,6 +11,10 @@
 //! up = [0, 1, 0]               # optional
 //! fov = 60                     # optional: vertical field of view in degrees (default 50)
 //!
+//! # [[camera_path]]            # optional: keyframes of `mrslc render --frames`, at least two,
+//! # eye = [-11.5, 2.2, -0.3]    # passed through in order by a Catmull-Rom spline (or
+//! # target = [10.0, 4.5, 0.4]   # `camera_path = "walk"` before any table; Sponza's default)
+//!
 //! [uniforms]                   # optional: applied before any `mrslc render --set`
 //! light_dir = [0.3, 0.9, 0.3]
 //! shininess = 20
@@ -26,6 +30,7 @@
 //! a warning ([`SceneBinding::applied`]), or is an error when the program
 //! has no default for it; a name the program does not declare is an error.
 
+use crate::camera_path::{CameraPath, Keyframe};
 use crate::gbuffer::GBuffer;
 use crate::gpu::Gpu;
 use crate::image_texture::{ColorSpace, ImageError, ImageTexture};
@@ -134,6 +139,8 @@ pub struct SceneFile {
     pub camera: Option<Camera>,
     pub size: Option<(u32, u32)>,
     pub crease_angle: Option<f32>,
+    /// `camera_path`, if the file has one (see [`SceneFile::path`]).
+    pub camera_path: Option<CameraPath>,
     /// Uniform values and images, in the order of the file.
     pub uniforms: Vec<(String, UniformValue)>,
 }
@@ -155,10 +162,10 @@ impl SceneFile {
         let key_error =
             |key: &str, message: String| SceneFileError::Key { path: path.to_path_buf(), key: key.into(), message };
         for key in table.keys() {
-            if !["mesh", "size", "crease_angle", "camera", "uniforms"].contains(&key.as_str()) {
+            if !["mesh", "size", "crease_angle", "camera", "camera_path", "uniforms"].contains(&key.as_str()) {
                 return Err(key_error(
                     key,
-                    "unknown key (expected mesh, size, crease_angle, camera or uniforms)".into(),
+                    "unknown key (expected mesh, size, crease_angle, camera, camera_path or uniforms)".into(),
                 ));
             }
         }
@@ -240,6 +247,10 @@ impl SceneFile {
             }
             Some(other) => return Err(key_error("camera", format!("expected a table, found {}", other.type_str()))),
         };
+        let camera_path = match table.get("camera_path") {
+            None => None,
+            Some(v) => Some(camera_path(v).map_err(|(key, message)| key_error(&key, message))?),
+        };
         let base = path.parent().unwrap_or(Path::new(""));
         let mut uniforms = vec![];
         match table.get("uniforms") {
@@ -267,7 +278,7 @@ impl SceneFile {
             }
             Some(other) => return Err(key_error("uniforms", format!("expected a table, found {}", other.type_str()))),
         }
-        Ok(SceneFile { path: path.to_path_buf(), mesh, camera, size, crease_angle, uniforms })
+        Ok(SceneFile { path: path.to_path_buf(), mesh, camera, size, crease_angle, camera_path, uniforms })
     }
 
     /// Sets the file's `[uniforms]` on `shader` and uploads its images, by
@@ -345,6 +356,17 @@ impl SceneFile {
         }
     }
 
+    /// The camera path of `mrslc render --frames`: the file's
+    /// `camera_path`, else Sponza's default walk for `mesh = "sponza"`;
+    /// other meshes have none.
+    pub fn path(&self) -> Option<CameraPath> {
+        match (&self.camera_path, &self.mesh) {
+            (Some(path), _) => Some(path.clone()),
+            (None, MeshSource::Sponza) => Some(CameraPath::Walk),
+            (None, MeshSource::File(_)) => None,
+        }
+    }
+
     /// Rasterises the scene: G-buffer textures (see [`crate::raster`]) and the camera used.
     pub fn textures_on(
         &self,
@@ -370,6 +392,48 @@ impl SceneFile {
         let (textures, _) = self.textures_on(gpu, size)?;
         crate::raster::read_gbuffer(gpu, &textures)
             .map_err(|source| SceneFileError::Raster { path: self.path.clone(), source })
+    }
+}
+
+/// `camera_path`: `"walk"`, or an array of at least two `{ eye, target }`
+/// tables. Errors name the key at fault.
+fn camera_path(v: &toml::Value) -> Result<CameraPath, (String, String)> {
+    let expected = "expected \"walk\" or [[camera_path]] tables with eye and target";
+    match v {
+        toml::Value::String(s) if s == "walk" => Ok(CameraPath::Walk),
+        toml::Value::Array(items) => {
+            if items.len() < 2 {
+                return Err((
+                    "camera_path".into(),
+                    format!("a path needs at least 2 keyframes, found {}", items.len()),
+                ));
+            }
+            let mut keys = vec![];
+            for (i, item) in items.iter().enumerate() {
+                let here = format!("camera_path[{i}]");
+                let toml::Value::Table(t) = item else {
+                    return Err((here, format!("{expected}, found {}", describe_value(item))));
+                };
+                if let Some(key) = t.keys().find(|k| !["eye", "target"].contains(&k.as_str())) {
+                    return Err((format!("{here}.{key}"), "unknown key (expected eye or target)".into()));
+                }
+                let vec3 = |key: &str| -> Result<[f32; 3], (String, String)> {
+                    let at = format!("{here}.{key}");
+                    let v = t.get(key).ok_or_else(|| (at.clone(), "missing: expected [x, y, z]".to_string()))?;
+                    numbers(v)
+                        .filter(|n| n.len() == 3 && n.iter().all(|x| x.is_finite()))
+                        .map(|n| [n[0] as f32, n[1] as f32, n[2] as f32])
+                        .ok_or_else(|| (at, format!("expected [x, y, z], found {}", describe_value(v))))
+                };
+                let (eye, target) = (vec3("eye")?, vec3("target")?);
+                if eye == target {
+                    return Err((here, "the eye and the target are the same point".into()));
+                }
+                keys.push(Keyframe { eye, target });
+            }
+            Ok(CameraPath::Keyframes(keys))
+        }
+        other => Err(("camera_path".into(), format!("{expected}, found {}", describe_value(other)))),
     }
 }
 
@@ -424,5 +488,55 @@ fn describe_value(v: &toml::Value) -> String {
         toml::Value::Boolean(b) => format!("boolean {b}"),
         toml::Value::Datetime(d) => format!("datetime {d}"),
         toml::Value::Table(_) => "a table".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<SceneFile, String> {
+        SceneFile::parse(text, Path::new("hall.toml")).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn camera_paths_are_a_walk_or_keyframes_and_sponza_walks_by_default() {
+        assert_eq!(parse("mesh = \"sponza\"").unwrap().path(), Some(CameraPath::Walk));
+        assert_eq!(parse("mesh = \"hall.glb\"").unwrap().path(), None);
+        assert_eq!(parse("mesh = \"hall.glb\"\ncamera_path = \"walk\"").unwrap().path(), Some(CameraPath::Walk));
+        let keys = "mesh = \"sponza\"\n[[camera_path]]\neye = [0, 1, 2]\ntarget = [3, 4, 5]\n\
+                    [[camera_path]]\neye = [1, 1, 2]\ntarget = [3, 4, 6]\n";
+        let expected = CameraPath::Keyframes(vec![
+            Keyframe { eye: [0.0, 1.0, 2.0], target: [3.0, 4.0, 5.0] },
+            Keyframe { eye: [1.0, 1.0, 2.0], target: [3.0, 4.0, 6.0] },
+        ]);
+        assert_eq!(parse(keys).unwrap().path(), Some(expected), "a file's keyframes win over Sponza's walk");
+    }
+
+    #[test]
+    fn camera_path_mistakes_name_their_key() {
+        for (text, message) in [
+            ("camera_path = \"run\"", "hall.toml: `camera_path`: expected \"walk\""),
+            ("[[camera_path]]\neye = [0, 1, 2]\ntarget = [3, 4, 5]", "at least 2 keyframes, found 1"),
+            (
+                "[[camera_path]]\neye = [0, 1, 2]\ntarget = [3, 4, 5]\n[[camera_path]]\neye = [0, 1]",
+                "`camera_path[1].eye`",
+            ),
+            (
+                "[[camera_path]]\neye = [0, 1, 2]\ntarget = [3, 4, 5]\n[[camera_path]]\neye = [0, 1, 2]",
+                "`camera_path[1].target`: missing",
+            ),
+            (
+                "[[camera_path]]\neye = [0, 1, 2]\ntarget = [0, 1, 2]\n[[camera_path]]\neye = [0, 1, 2]\ntarget = [1, 1, 1]",
+                "`camera_path[0]`: the eye and the target",
+            ),
+            (
+                "[[camera_path]]\neye = [0, 1, 2]\ntarget = [3, 4, 5]\nfov = 3\n[[camera_path]]\neye = [0, 1, 2]\ntarget = [1, 1, 1]",
+                "`camera_path[0].fov`: unknown key",
+            ),
+        ] {
+            let e = parse(&format!("mesh = \"sponza\"\n{text}")).unwrap_err();
+            assert!(e.contains(message), "{text}: {e}");
+        }
     }
 }

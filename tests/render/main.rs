@@ -11,6 +11,7 @@ mod harness;
 
 mod binding;
 mod errors;
+mod frames;
 mod modes;
 mod rate_image;
 mod rate_source;
@@ -28,6 +29,15 @@ const GPU_TESTS: &[GpuTest] = &[
     ("binding::textured_materials_are_lit_over_a_mesh_scene", binding::textured_materials_are_lit_over_a_mesh_scene),
     ("binding::mismatches_without_defaults_are_typed_errors", binding::mismatches_without_defaults_are_typed_errors),
     ("errors::binding_mismatches_are_typed_errors", errors::binding_mismatches_are_typed_errors),
+    (
+        "frames::velocity_is_the_projection_difference_of_a_camera_move",
+        frames::velocity_is_the_projection_difference_of_a_camera_move,
+    ),
+    ("frames::an_unmoved_camera_gives_zero_velocity", frames::an_unmoved_camera_gives_zero_velocity),
+    (
+        "frames::a_fast_pan_lowers_the_rates_through_the_velocity",
+        frames::a_fast_pan_lowers_the_rates_through_the_velocity,
+    ),
     ("errors::extra_channels_are_ignored", errors::extra_channels_are_ignored),
     ("errors::modes_without_kernels_are_unsupported", errors::modes_without_kernels_are_unsupported),
     ("errors::precompiled_and_load_time_kernels_render_alike", errors::precompiled_and_load_time_kernels_render_alike),

@@ -193,7 +193,10 @@ pub fn rasterised_quads_match_the_analytic_gbuffer(gpu: &Gpu) {
         let g = raster::rasterize_gbuffer(gpu, &mesh, &camera, (w, h)).unwrap();
         assert_eq!((g.width, g.height), (w, h));
         let names: Vec<&str> = g.channels.iter().map(|(n, _)| n.as_str()).collect();
-        assert_eq!(names, ["position", "normal", "uv", "material", "depth", "albedo", "roughness", "metallic"]);
+        assert_eq!(
+            names,
+            ["position", "normal", "uv", "material", "depth", "albedo", "roughness", "metallic", "velocity"]
+        );
         let (position, _) = floats(&g, "position");
         let (normal, _) = floats(&g, "normal");
         let (uv, _) = floats(&g, "uv");
