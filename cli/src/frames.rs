@@ -55,6 +55,11 @@ struct ModeFrame {
     speed_vs_reference: Option<f64>,
     /// Against this frame's reference (with `--compare`).
     metrics: Option<Metrics>,
+    /// FLIP's weighted quartiles (the errors below which 25, 50 and 75% of
+    /// the summed error lies) and its histogram in 20 bins over [0, 1], as
+    /// FLIP's tool and VALAR report them (with `--compare`).
+    flip_weighted_quartiles: Option<[f32; 3]>,
+    flip_histogram: Option<Vec<u64>>,
     /// [`mean_change`] from this mode's previous frame (none on frame 0).
     change: Option<f64>,
     /// `change` minus the reference's own change over the same frames:
@@ -152,7 +157,7 @@ pub fn render_frames(setup: &Setup, shader: &mut Shader, args: &RenderArgs, n: u
             mrsl_lab::uniforms::check(shader.layout(), "the camera path", "camera_pos", &Offered::float3()),
             Ok(Verdict::Bind)
         );
-    let rate_options = RateOptions { motion: true, reproject: true, ..args.rates };
+    let rate_options = RateOptions { motion: args.motion, reproject: args.motion, ..args.rates };
     let mut source = RateSource::new(&gpu.device).map_err(|e| e.to_string())?;
     // The rate-image mode's previous output, kept apart from the shared
     // output textures that the other modes overwrite.
@@ -265,7 +270,7 @@ pub fn render_frames(setup: &Setup, shader: &mut Shader, args: &RenderArgs, n: u
                 (Some((reference, reference_ms, reference_change)), m) if m != Mode::Reference => {
                     let metrics = if args.compare {
                         Some(
-                            mrsl_lab::metrics::compare(&pixels, reference, size.0, size.1)
+                            mrsl_lab::metrics::compare_with_flip_map(&pixels, reference, size.0, size.1)
                                 .map_err(|e| e.to_string())?,
                         )
                     } else {
@@ -275,6 +280,10 @@ pub fn render_frames(setup: &Setup, shader: &mut Shader, args: &RenderArgs, n: u
                     (metrics, Some(reference_ms / wall_ms), flicker)
                 }
                 _ => (None, None, None),
+            };
+            let (metrics, flip_weighted_quartiles, flip_histogram) = match metrics {
+                Some((m, map)) => (Some(m), Some(map.weighted_quartiles()), Some(map.histogram(20))),
+                None => (None, None, None),
             };
             if mode == Mode::Reference {
                 reference = Some((pixels.clone(), wall_ms, change));
@@ -286,6 +295,8 @@ pub fn render_frames(setup: &Setup, shader: &mut Shader, args: &RenderArgs, n: u
                 wall_ms,
                 speed_vs_reference,
                 metrics,
+                flip_weighted_quartiles,
+                flip_histogram,
                 change,
                 flicker,
                 rates,

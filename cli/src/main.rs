@@ -165,6 +165,12 @@ struct Render {
     /// Rate-image mode: pixels per side of a shading-rate tile.
     #[arg(long, default_value_t = mrsl_abi::shading_rate::DEFAULT_RATE_TILE, value_parser = parse_rate_tile)]
     rate_tile: u32,
+    /// Rate-image mode: the Weber–Fechner variant of the rate source (more conservative in the dark).
+    #[arg(long)]
+    weber_fechner: bool,
+    /// Rate-image mode with --frames: decide without the motion vectors (no motion terms, no reprojection).
+    #[arg(long)]
+    no_motion: bool,
     /// Render N frames along the scene's camera path (Sponza's walk, or a scene file's
     /// camera_path), writing PROGRAM.MODE.fNNN.png, the rate-image mode's rates per
     /// frame and PROGRAM.frames.json; the rate-image mode takes its rates from the
@@ -280,8 +286,10 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
                 uniform_rate: r.uniform_rate,
                 rates: mrsl_runtime::rate_source::RateOptions {
                     tile: r.rate_tile,
+                    weber_fechner: r.weber_fechner,
                     ..mrsl_runtime::rate_source::RateOptions::preset(r.rate_preset.runtime())
                 },
+                motion: !r.no_motion,
                 frames: r.frames,
             };
             Ok(written(render::render(&args)))

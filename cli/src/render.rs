@@ -40,6 +40,8 @@ pub struct RenderArgs {
     pub rates: mrsl_runtime::rate_source::RateOptions,
     /// The rate-image mode at one rate everywhere instead of the rate source's.
     pub uniform_rate: Option<mrsl_abi::ShadingRate>,
+    /// With `--frames`: whether the rate source reads the motion vectors.
+    pub motion: bool,
     /// `--frames N`: N frames along the scene's camera path (see
     /// [`crate::frames`]) instead of a still frame.
     pub frames: Option<usize>,

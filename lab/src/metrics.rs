@@ -126,11 +126,21 @@ pub struct Metrics {
 /// Fails like its parts: on invalid sizes, lengths or values, and with [`MetricsError::TooSmallForSsim`] for images
 /// smaller than 11x11 (use [`rmse`], [`psnr`] and [`flip`] separately for those).
 pub fn compare(test: &[[f32; 4]], reference: &[[f32; 4]], width: u32, height: u32) -> Result<Metrics, MetricsError> {
+    compare_with_flip_map(test, reference, width, height).map(|(metrics, _)| metrics)
+}
+
+/// [`compare`], also returning the FLIP map (for its histogram and weighted quartiles).
+pub fn compare_with_flip_map(
+    test: &[[f32; 4]],
+    reference: &[[f32; 4]],
+    width: u32,
+    height: u32,
+) -> Result<(Metrics, FlipMap), MetricsError> {
     let pair = Pair::new(test, reference, width, height)?;
     let rmse = pair.rmse();
     let mssim = ssim_planes(&luminance_plane(pair.test), &luminance_plane(pair.reference), width, height, |_| {})?;
     let flip = pair.flip(DEFAULT_PPD)?;
-    Ok(Metrics { rmse, psnr: psnr_from_rmse(rmse), mssim, flip: f64::from(flip.mean) })
+    Ok((Metrics { rmse, psnr: psnr_from_rmse(rmse), mssim, flip: f64::from(flip.mean) }, flip))
 }
 
 /// Root mean squared difference over R, G and B, values as given.
@@ -208,6 +218,42 @@ impl FlipMap {
     /// The map through the Magma colour map, as opaque sRGB RGBA8 bytes (FLIP's own heatmap).
     pub fn to_rgba8(&self) -> Vec<u8> {
         self.values.iter().flat_map(|&v| magma_rgba8(v)).collect()
+    }
+
+    /// How many pixels fall in each of `bins` equal bins over `[0, 1]` (the
+    /// last bin includes 1): the histogram NVIDIA's FLIP tool and VALAR plot.
+    pub fn histogram(&self, bins: usize) -> Vec<u64> {
+        let mut counts = vec![0u64; bins.max(1)];
+        for &v in &self.values {
+            let bin = ((v.clamp(0.0, 1.0) * bins as f32) as usize).min(counts.len() - 1);
+            counts[bin] += 1;
+        }
+        counts
+    }
+
+    /// The weighted quartiles of the errors, as FLIP's tool reports them
+    /// (each pixel weighted by its own error, so the quartiles describe where
+    /// the error mass lies rather than the many error-free pixels): the
+    /// errors below which 25%, 50% and 75% of the summed error lies. All 0
+    /// for identical images.
+    pub fn weighted_quartiles(&self) -> [f32; 3] {
+        let mut sorted: Vec<f32> = self.values.iter().copied().filter(|v| *v > 0.0).collect();
+        sorted.sort_by(f32::total_cmp);
+        let total: f64 = sorted.iter().map(|&v| f64::from(v)).sum();
+        if total == 0.0 {
+            return [0.0; 3];
+        }
+        let mut out = [0.0f32; 3];
+        let mut sum = 0.0f64;
+        let mut next = 0;
+        for &v in &sorted {
+            sum += f64::from(v);
+            while next < 3 && sum >= total * (next as f64 + 1.0) / 4.0 {
+                out[next] = v;
+                next += 1;
+            }
+        }
+        out
     }
 }
 
@@ -427,4 +473,21 @@ fn ssim_planes(
         row(&out);
     }
     Ok(sum / (ow * oh) as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flip_histograms_and_weighted_quartiles() {
+        let map = FlipMap { width: 4, height: 2, values: vec![0.0, 0.0, 0.0, 0.0, 0.1, 0.1, 0.2, 0.6], mean: 0.125 };
+        assert_eq!(map.histogram(10), vec![4, 2, 1, 0, 0, 0, 1, 0, 0, 0]);
+        // Summed error 1.0, sorted 0.1, 0.1, 0.2, 0.6: the running sums 0.1, 0.2, 0.4, 1.0 pass
+        // a quarter at the 0.2 and half and three quarters at the 0.6, which holds most of it.
+        assert_eq!(map.weighted_quartiles(), [0.2, 0.6, 0.6]);
+        let zero = FlipMap { width: 1, height: 1, values: vec![0.0], mean: 0.0 };
+        assert_eq!(zero.weighted_quartiles(), [0.0; 3]);
+        assert_eq!(zero.histogram(4), vec![1, 0, 0, 0]);
+    }
 }
