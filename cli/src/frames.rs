@@ -10,7 +10,7 @@
 //! reference, and the temporal-stability figure) go to `STEM.frames.json`.
 
 use crate::legend::{self, Legend};
-use crate::render::{BoundScene, RenderArgs, Resources, save_output, time_run, to_srgb8};
+use crate::render::{BoundScene, PAIRS, RenderArgs, Resources, median, save_output, time_run, to_srgb8};
 use mrsl_abi::ShadingRate;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::metrics::Metrics;
@@ -51,7 +51,10 @@ struct ModeFrame {
     shaded_fraction: f64,
     /// Warm wall time of the frame's run, from encoding to idle, in ms.
     wall_ms: f64,
-    /// The reference's wall time of the same frame divided by this mode's.
+    /// The reference's speed relative to this mode's on this frame: the
+    /// inverse of the median over [`PAIRS`] runs of this mode's wall time
+    /// divided by that of a reference run beside it (alternately before and
+    /// after), so that both are timed at the same moment of a shared machine.
     speed_vs_reference: Option<f64>,
     /// Against this frame's reference (with `--compare`).
     metrics: Option<Metrics>,
@@ -231,7 +234,28 @@ pub fn render_frames(setup: &Setup, shader: &mut Shader, args: &RenderArgs, n: u
                 // The first run builds pipelines: time the second.
                 time_run(gpu, shader, &bindings, dispatch)?;
             }
-            let wall_ms = time_run(gpu, shader, &bindings, dispatch)?;
+            let mut wall_ms = time_run(gpu, shader, &bindings, dispatch)?;
+            // Paired with reference runs of the same frame, when the reference runs too.
+            let mut paired = None;
+            if mode != Mode::Reference && reference.is_some() {
+                let reference_dispatch = DispatchOptions { mode: Mode::Reference, ..dispatch };
+                let (mut walls, mut ratios) = (vec![], vec![]);
+                for pair in 0..PAIRS {
+                    let (wall, reference_wall) = if pair % 2 == 0 {
+                        let r = time_run(gpu, shader, &bindings, reference_dispatch)?;
+                        (time_run(gpu, shader, &bindings, dispatch)?, r)
+                    } else {
+                        let w = time_run(gpu, shader, &bindings, dispatch)?;
+                        (w, time_run(gpu, shader, &bindings, reference_dispatch)?)
+                    };
+                    walls.push(wall);
+                    ratios.push(wall / reference_wall);
+                }
+                // The image and statistics below are this mode's again.
+                time_run(gpu, shader, &bindings, dispatch)?;
+                wall_ms = median(walls);
+                paired = Some(1.0 / median(ratios));
+            }
             let stats = shader.read_stats(&gpu.device).map_err(|e| e.to_string())?;
             let pixels = if float_output { gpu.read_rgba32f(first_output).map_err(|e| e.to_string())? } else { vec![] };
             let mut rates = None;
@@ -277,7 +301,7 @@ pub fn render_frames(setup: &Setup, shader: &mut Shader, args: &RenderArgs, n: u
                         None
                     };
                     let flicker = change.zip(*reference_change).map(|(c, r)| c - r);
-                    (metrics, Some(reference_ms / wall_ms), flicker)
+                    (metrics, paired.or(Some(reference_ms / wall_ms)), flicker)
                 }
                 _ => (None, None, None),
             };

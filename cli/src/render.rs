@@ -65,7 +65,7 @@ struct Run {
 /// Runs of each mode paired with reference runs for the timing of
 /// `--compare` (alternately before and after), so that the ratio is taken
 /// between runs at the same moment of a shared machine.
-const PAIRS: usize = 3;
+pub(crate) const PAIRS: usize = 3;
 
 /// One warm run of `options`, from encoding to idle: its wall time in ms.
 pub(crate) fn time_run(
