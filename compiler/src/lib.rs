@@ -93,9 +93,10 @@ pub mod internals {
 /// Which kernels to generate, and for which block sizes.
 ///
 /// [`compile`] generates and validates only the kernels these options ask
-/// for ([`Options::kernels`]). The default asks for all nine: coarse and
+/// for ([`Options::kernels`]). The default asks for all eleven: coarse and
 /// fine for blocks 2 and 4, the reference, the dynamic mode's coarse (2x2)
-/// and fine (4x4) kernels, the hierarchical and the checkerboard kernel.
+/// and fine (4x4) kernels, the hierarchical and the checkerboard kernel,
+/// and the rate-image mode's coarse and fine kernels.
 /// A caller that runs fewer modes asks for their kernels alone, which takes
 /// a fraction of the time: `Options { block_sizes: vec![4], coarse: true,
 /// fine: true, ..Options::none() }` for the coarse 4x4 mode (the runtime's
