@@ -642,14 +642,7 @@ impl Shader {
         if self.rate_buffers.as_ref().is_some_and(|(_, s)| *s == size) {
             return;
         }
-        let storage = |label, bytes: u64, extra| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: bytes.max(4),
-                usage: wgpu::BufferUsages::STORAGE | extra,
-                mapped_at_creation: false,
-            })
-        };
+        let storage = |label, bytes, extra| storage_buffer(device, label, bytes, extra);
         let buffers = RateBuffers {
             work: storage(
                 "mrsl rate-image sample list",
@@ -735,14 +728,7 @@ impl Shader {
         }
         let (w, h) = (size.0 as u64, size.1 as u64);
         let work_words = geometry::work_list_words(size);
-        let storage = |label, bytes: u64, extra| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: bytes.max(4),
-                usage: wgpu::BufferUsages::STORAGE | extra,
-                mapped_at_creation: false,
-            })
-        };
+        let storage = |label, bytes, extra| storage_buffer(device, label, bytes, extra);
         let record = self.layout.hierarchical.record_words as u64;
         let buffers = HierBuffers {
             values: storage("mrsl hierarchical values", w * h * record * 4, wgpu::BufferUsages::empty()),
@@ -982,6 +968,16 @@ impl Shader {
     fn has_kernel(&self, kind: KernelKind, block: Option<u32>) -> bool {
         kind.entry_points().iter().all(|e| self.pipelines.contains_key(&(kind, block, *e)))
     }
+}
+
+/// A storage buffer of `bytes` (at least 4) with `extra` usages besides `STORAGE`.
+fn storage_buffer(device: &wgpu::Device, label: &str, bytes: u64, extra: wgpu::BufferUsages) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(4),
+        usage: wgpu::BufferUsages::STORAGE | extra,
+        mapped_at_creation: false,
+    })
 }
 
 fn read_buffer<T: bytemuck::Pod>(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<T>, Error> {

@@ -155,6 +155,11 @@ pub fn ulps(a: f32, b: f32) -> u32 {
     (key(a) as i64 - key(b) as i64).unsigned_abs().min(u32::MAX as u64) as u32
 }
 
+/// Largest distance in ulps over every channel of every pixel (0 when bit-identical).
+pub fn worst_ulps(a: &[[f32; 4]], b: &[[f32; 4]]) -> u32 {
+    a.iter().zip(b).flat_map(|(p, q)| (0..4).map(move |c| ulps(p[c], q[c]))).max().unwrap_or(0)
+}
+
 /// Largest absolute difference over every channel of every pixel.
 pub fn max_abs_diff(a: &[[f32; 4]], b: &[[f32; 4]]) -> f32 {
     a.iter().zip(b).flat_map(|(p, q)| (0..4).map(move |c| (p[c] - q[c]).abs())).fold(0.0, f32::max)

@@ -1,6 +1,6 @@
 //! Every mode against the reference of the same program.
 
-use crate::{compile, max_abs_diff, run, ulps};
+use crate::{compile, max_abs_diff, run, worst_ulps};
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
 use mrsl_runtime::Mode;
@@ -30,13 +30,7 @@ pub fn forced_refinement_equals_reference_for_every_example(gpu: &Gpu) {
         let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
         for mode in COARSE_MODES {
             let out = run(gpu, &program, &gbuffer, mode, true).unwrap();
-            let worst = out
-                .pixels
-                .iter()
-                .zip(&reference.pixels)
-                .flat_map(|(a, b)| (0..4).map(move |c| ulps(a[c], b[c])))
-                .max()
-                .unwrap();
+            let worst = worst_ulps(&out.pixels, &reference.pixels);
             assert_eq!(worst, 0, "{name} {mode}: forced refinement differs from the reference by up to {worst} ulps");
             for e in out.stats.effects.iter().filter(|e| e.rate == mrsl_abi::Rate::Coarse) {
                 assert_eq!(
@@ -386,13 +380,7 @@ pub fn derivative_chains_render_in_every_mode(gpu: &Gpu) {
         for mode in COARSE_MODES {
             let program = compile(&[mode]);
             let forced = run(gpu, &program, &gbuffer, mode, true).unwrap();
-            let worst = forced
-                .pixels
-                .iter()
-                .zip(&reference.pixels)
-                .flat_map(|(a, b)| (0..4).map(move |c| ulps(a[c], b[c])))
-                .max()
-                .unwrap();
+            let worst = worst_ulps(&forced.pixels, &reference.pixels);
             assert_eq!(worst, 0, "{name} {mode}: forced refinement differs from the reference by up to {worst} ulps");
             // The chain refines where its values change fast. The checkerboard
             // baseline does not refine: across the scene's silhouettes (no `@key`

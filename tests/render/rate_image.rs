@@ -3,7 +3,7 @@
 //! tile border shared with a coarser tile is resampled. The model is written
 //! from the rule in docs/rate-image.md, not from the kernels.
 
-use crate::{compile, run, run_at_rates, ulps};
+use crate::{compile, run, run_at_rates, worst_ulps};
 use mrsl_abi::ShadingRate;
 use mrsl_abi::shading_rate::rate_image_size;
 use mrsl_lab::gpu::Gpu;
@@ -274,13 +274,7 @@ pub fn forced_refinement_equals_reference_at_every_rate(gpu: &Gpu) {
             images.push(mrsl_lab::shading_rate::pattern(tiles));
             for rates in images {
                 let out = run_at_rates(gpu, &program, &gbuffer, Mode::RateImage, true, tile, &rates).unwrap();
-                let worst = out
-                    .pixels
-                    .iter()
-                    .zip(&reference.pixels)
-                    .flat_map(|(a, b)| (0..4).map(move |c| ulps(a[c], b[c])))
-                    .max()
-                    .unwrap();
+                let worst = worst_ulps(&out.pixels, &reference.pixels);
                 assert_eq!(worst, 0, "{w}x{h} tile {tile} {}: {worst} ulps off the reference", rates[0]);
             }
         }

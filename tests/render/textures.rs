@@ -6,7 +6,7 @@
 //! based deferred example over a textured scene in every mode.
 
 use crate::sponza::{base64, floats, temp_dir};
-use crate::{Output, compile, ulps};
+use crate::{Output, compile, worst_ulps};
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::material::srgb_to_linear;
 use mrsl_lab::mesh::{Mesh, MeshWarning};
@@ -557,13 +557,7 @@ pub fn pbr_example_renders_textured_content_in_every_mode(gpu: &Gpu) {
     assert!(lit > reference.pixels.len() / 2, "only {lit} lit pixels");
     for mode in Mode::ALL.into_iter().filter(|m| *m != Mode::Reference) {
         let forced = run(mode, true);
-        let worst = forced
-            .pixels
-            .iter()
-            .zip(&reference.pixels)
-            .flat_map(|(a, b)| (0..4).map(move |c| ulps(a[c], b[c])))
-            .max()
-            .unwrap();
+        let worst = worst_ulps(&forced.pixels, &reference.pixels);
         assert_eq!(worst, 0, "{mode}: forced refinement differs from the reference by up to {worst} ulps");
         let adaptive = run(mode, false);
         assert!(adaptive.pixels.iter().all(|p| p.iter().all(|v| v.is_finite())), "{mode}");
