@@ -20,8 +20,12 @@ pub struct Control {
     pub similarity: f32,
     /// Rate-image mode: pixels per side of one shading-rate tile (8 or 16).
     pub rate_tile: u32,
+    /// Nonzero: the per-pixel kernels count their re-evaluations (layout
+    /// `stats`) and write the rate image. Zero leaves both out, so timed
+    /// runs carry no instrumentation.
+    pub statistics: u32,
     /// Padding to a multiple of 16 bytes.
-    pub reserved: [u32; 2],
+    pub reserved: u32,
 }
 
 /// One field of the control block as the layout and the generated WGSL describe it.
@@ -43,7 +47,7 @@ const UINT: ValueType = ValueType::Scalar(Scalar::Uint);
 const FLOAT: ValueType = ValueType::Scalar(Scalar::Float);
 
 /// The fields of [`Control`], in order, with their offsets.
-pub static CONTROL_FIELDS: [ControlField; 5] = [
+pub static CONTROL_FIELDS: [ControlField; 6] = [
     ControlField { name: "size", ty: UINT2, wgsl_type: "vec2<u32>", offset: 0, size: 8, default: None, comment: None },
     ControlField {
         name: "force_refine",
@@ -73,6 +77,15 @@ pub static CONTROL_FIELDS: [ControlField; 5] = [
         default: Some(8.0),
         comment: Some("rate-image mode: pixels per side of a shading-rate tile"),
     },
+    ControlField {
+        name: "statistics",
+        ty: UINT,
+        wgsl_type: "u32",
+        offset: 24,
+        size: 4,
+        default: Some(1.0),
+        comment: Some("nonzero: count per-pixel re-evaluations and write the rate image"),
+    },
 ];
 
 impl Control {
@@ -92,6 +105,7 @@ mod tests {
         assert_eq!(std::mem::offset_of!(Control, frame) as u32, CONTROL_FIELDS[2].offset);
         assert_eq!(std::mem::offset_of!(Control, similarity) as u32, CONTROL_FIELDS[3].offset);
         assert_eq!(std::mem::offset_of!(Control, rate_tile) as u32, CONTROL_FIELDS[4].offset);
+        assert_eq!(std::mem::offset_of!(Control, statistics) as u32, CONTROL_FIELDS[5].offset);
         for f in &CONTROL_FIELDS {
             assert_eq!(f.ty.components() * 4, f.size, "{}", f.name);
         }

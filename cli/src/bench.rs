@@ -99,7 +99,10 @@ impl Bench<'_> {
         let mut gpus = vec![];
         let mut coarse = vec![];
         let mut fine = vec![];
-        self.time_once(bindings, options)?;
+        // Timed runs carry no instrumentation; the statistics come from the untimed run after them.
+        let timed = DispatchOptions { statistics: false, ..options };
+        let reference = reference.map(|r| DispatchOptions { statistics: false, ..r });
+        self.time_once(bindings, timed)?;
         if let Some(r) = reference {
             self.time_once(bindings, r)?;
         }
@@ -107,14 +110,14 @@ impl Bench<'_> {
             let (wall, paired) = match reference {
                 Some(r) if run % 2 == 0 => {
                     let t_ref = self.time_once(bindings, r)?;
-                    (self.time_once(bindings, options)?, t_ref)
+                    (self.time_once(bindings, timed)?, t_ref)
                 }
                 Some(r) => {
-                    let t = self.time_once(bindings, options)?;
+                    let t = self.time_once(bindings, timed)?;
                     (t, self.time_once(bindings, r)?)
                 }
                 None => {
-                    let t = self.time_once(bindings, options)?;
+                    let t = self.time_once(bindings, timed)?;
                     (t, t)
                 }
             };

@@ -230,32 +230,34 @@ pub fn render_frames(setup: &Setup, shader: &mut Shader, args: &RenderArgs, n: u
                 gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| e.to_string())?;
                 source_ms = Some(start.elapsed().as_secs_f64() * 1e3);
             }
+            // Timed runs carry no instrumentation; the statistics come from one more run after them.
+            let timed = DispatchOptions { statistics: false, ..dispatch };
             if k == 0 {
                 // The first run builds pipelines: time the second.
-                time_run(gpu, shader, &bindings, dispatch)?;
+                time_run(gpu, shader, &bindings, timed)?;
             }
-            let mut wall_ms = time_run(gpu, shader, &bindings, dispatch)?;
+            let mut wall_ms = time_run(gpu, shader, &bindings, timed)?;
             // Paired with reference runs of the same frame, when the reference runs too.
             let mut paired = None;
             if mode != Mode::Reference && reference.is_some() {
-                let reference_dispatch = DispatchOptions { mode: Mode::Reference, ..dispatch };
+                let reference_dispatch = DispatchOptions { mode: Mode::Reference, ..timed };
                 let (mut walls, mut ratios) = (vec![], vec![]);
                 for pair in 0..PAIRS {
                     let (wall, reference_wall) = if pair % 2 == 0 {
                         let r = time_run(gpu, shader, &bindings, reference_dispatch)?;
-                        (time_run(gpu, shader, &bindings, dispatch)?, r)
+                        (time_run(gpu, shader, &bindings, timed)?, r)
                     } else {
-                        let w = time_run(gpu, shader, &bindings, dispatch)?;
+                        let w = time_run(gpu, shader, &bindings, timed)?;
                         (w, time_run(gpu, shader, &bindings, reference_dispatch)?)
                     };
                     walls.push(wall);
                     ratios.push(wall / reference_wall);
                 }
-                // The image and statistics below are this mode's again.
-                time_run(gpu, shader, &bindings, dispatch)?;
                 wall_ms = median(walls);
                 paired = Some(1.0 / median(ratios));
             }
+            // The image and statistics below are this mode's, from an untimed run.
+            time_run(gpu, shader, &bindings, dispatch)?;
             let stats = shader.read_stats(&gpu.device).map_err(|e| e.to_string())?;
             let pixels = if float_output { gpu.read_rgba32f(first_output).map_err(|e| e.to_string())? } else { vec![] };
             let mut rates = None;

@@ -224,25 +224,27 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
             stats.timings = None;
         }
         progress(&format!("rendered {mode} (first run, pipelines warming up)"), start);
-        // Warm wall time; with --compare, paired with reference runs.
+        // Warm wall time, without instrumentation (the statistics are the
+        // first run's); with --compare, paired with reference runs.
+        let timed = |mode| DispatchOptions { statistics: false, ..options(mode) };
         let (wall_ms, relative_to_reference) = if args.compare && mode != Mode::Reference {
             let (mut walls, mut ratios) = (vec![], vec![]);
             for pair in 0..PAIRS {
                 let (wall, reference) = if pair % 2 == 0 {
-                    let r = time_run(&gpu, &mut shader, &bindings, options(Mode::Reference))?;
-                    (time_run(&gpu, &mut shader, &bindings, options(mode))?, r)
+                    let r = time_run(&gpu, &mut shader, &bindings, timed(Mode::Reference))?;
+                    (time_run(&gpu, &mut shader, &bindings, timed(mode))?, r)
                 } else {
-                    let t = time_run(&gpu, &mut shader, &bindings, options(mode))?;
-                    (t, time_run(&gpu, &mut shader, &bindings, options(Mode::Reference))?)
+                    let t = time_run(&gpu, &mut shader, &bindings, timed(mode))?;
+                    (t, time_run(&gpu, &mut shader, &bindings, timed(Mode::Reference))?)
                 };
                 walls.push(wall);
                 ratios.push(wall / reference);
             }
-            // The images and statistics below are this mode's again.
-            time_run(&gpu, &mut shader, &bindings, options(mode))?;
+            // The images below are this mode's again (the rate image is still the first run's).
+            time_run(&gpu, &mut shader, &bindings, timed(mode))?;
             (median(walls), Some(median(ratios)))
         } else {
-            (time_run(&gpu, &mut shader, &bindings, options(mode))?, None)
+            (time_run(&gpu, &mut shader, &bindings, timed(mode))?, None)
         };
         match relative_to_reference {
             Some(r) => eprintln!(

@@ -42,6 +42,8 @@ pub enum Error {
     Pipeline(String),
     #[error("reading results back failed: {0}")]
     Readback(String),
+    #[error("the last dispatch ran with DispatchOptions::statistics off, so it counted nothing")]
+    StatisticsOff,
     /// The program did not compile (the `compile` feature); the rendered diagnostics.
     #[cfg(feature = "compile")]
     #[error("the program does not compile:\n{0}")]

@@ -44,6 +44,12 @@ pub struct DispatchOptions {
     pub similarity: f32,
     /// Rate-image mode: pixels per side of a shading-rate tile (8 or 16).
     pub rate_tile: u32,
+    /// Count per-pixel re-evaluations ([`Shader::read_stats`]) and write the
+    /// per-pixel refine mask ([`Shader::rate_image`]). On by default; turn it
+    /// off for frames that are only displayed or timed: the counters are
+    /// workgroup atomics and a barrier per tile, about 7% of a coarse 4x4
+    /// frame on lavapipe (docs/evaluation.md).
+    pub statistics: bool,
 }
 
 impl DispatchOptions {
@@ -56,6 +62,7 @@ impl DispatchOptions {
             force_refine: false,
             similarity: Self::DEFAULT_SIMILARITY,
             rate_tile: mrsl_abi::shading_rate::DEFAULT_RATE_TILE,
+            statistics: true,
         }
     }
 }
@@ -448,7 +455,8 @@ impl Shader {
             frame: self.frame,
             similarity: options.similarity,
             rate_tile: options.rate_tile,
-            reserved: [0; 2],
+            statistics: u32::from(options.statistics),
+            reserved: 0,
         };
         queue.write_buffer(&self.control, 0, bytemuck::bytes_of(&control));
         if let Some(buffer) = &self.uniforms {
@@ -914,14 +922,19 @@ impl Shader {
 
     /// The per-pixel refine mask of the last coarse-mode dispatch: bit k set
     /// when coarse effect k (`layout().stats.counters[k]`) was evaluated per
-    /// pixel. `None` before any coarse-mode dispatch.
+    /// pixel. `None` before any coarse-mode dispatch; a dispatch with
+    /// `DispatchOptions::statistics` off leaves it as it was.
     pub fn rate_image(&self) -> Option<&wgpu::Texture> {
         self.rate.as_ref().map(|(t, _)| t)
     }
 
     /// Reads the statistics of the last submitted dispatch (waits for the GPU).
+    /// [`Error::StatisticsOff`] when it ran with `DispatchOptions::statistics` off.
     pub fn read_stats(&self, device: &wgpu::Device) -> Result<Stats, Error> {
         let (options, size) = self.last.ok_or_else(|| Error::Readback("nothing was dispatched yet".into()))?;
+        if !options.statistics {
+            return Err(Error::StatisticsOff);
+        }
         let counters: Vec<u32> = read_buffer(device, &self.stats_readback)?;
         let timings = match &self.timestamps {
             Some(t) => {

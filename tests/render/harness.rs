@@ -80,7 +80,35 @@ pub fn run_at_rates(
     tile: u32,
     rates: &[mrsl_abi::ShadingRate],
 ) -> Result<Output, Error> {
+    let options = DispatchOptions { force_refine, rate_tile: tile, ..DispatchOptions::new(mode) };
+    let [dispatch] = dispatch_in_turn(gpu, program, gbuffer, rates, [options])?;
+    let Dispatched { pixels, stats, .. } = dispatch;
+    Ok(Output { pixels, stats: stats?, width: gbuffer.width })
+}
+
+/// What one of [`dispatch_in_turn`]'s dispatches left.
+pub struct Dispatched {
+    /// The first output, as RGBA floats.
+    pub pixels: Vec<[f32; 4]>,
+    /// [`Shader::read_stats`] after the dispatch.
+    pub stats: Result<Stats, Error>,
+    /// The `.x` words of [`Shader::rate_image`] after the dispatch (the
+    /// per-pixel refine masks), if the shader has one.
+    pub refine_masks: Option<Vec<u32>>,
+}
+
+/// Dispatches `options` one after the other with one shader over one
+/// G-buffer (prepared as [`run`] does; `rates` is the shading-rate image of
+/// `options[0].rate_tile`), reading back after each.
+pub fn dispatch_in_turn<const N: usize>(
+    gpu: &Gpu,
+    program: &CompiledProgram,
+    gbuffer: &GBuffer,
+    rates: &[mrsl_abi::ShadingRate],
+    options: [DispatchOptions; N],
+) -> Result<[Dispatched; N], Error> {
     let size = (gbuffer.width, gbuffer.height);
+    let tile = options.first().map_or(mrsl_abi::shading_rate::DEFAULT_RATE_TILE, |o| o.rate_tile);
     let channels = gbuffer.upload(gpu);
     let mut shader = Shader::new(&gpu.device, program)?;
     if let Some(block) = &program.layout.uniforms {
@@ -129,18 +157,24 @@ pub fn run_at_rates(
     // Only the rate-image mode reads it.
     let shading_rate = mrsl_lab::shading_rate::upload(gpu, size, tile, rates);
     bindings.shading_rate = Some(&shading_rate);
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    shader.encode(
-        &gpu.device,
-        &gpu.queue,
-        &mut encoder,
-        &bindings,
-        DispatchOptions { force_refine, rate_tile: tile, ..DispatchOptions::new(mode) },
-    )?;
-    gpu.queue.submit([encoder.finish()]);
-    let stats = shader.read_stats(&gpu.device)?;
-    let pixels = gpu.read_rgba32f(&outputs[0].1).map_err(|e| Error::Readback(e.to_string()))?;
-    Ok(Output { pixels, stats, width: size.0 })
+    let mut dispatched = vec![];
+    for options in options {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options)?;
+        gpu.queue.submit([encoder.finish()]);
+        let stats = shader.read_stats(&gpu.device);
+        let pixels = gpu.read_rgba32f(&outputs[0].1).map_err(|e| Error::Readback(e.to_string()))?;
+        let refine_masks = match shader.rate_image() {
+            Some(t) => {
+                let texels = gpu.read_texture(t).map_err(|e| Error::Readback(e.to_string()))?;
+                // rg32uint: the mask is the first word of each 8-byte texel.
+                Some(texels.chunks_exact(8).map(|t| u32::from_le_bytes([t[0], t[1], t[2], t[3]])).collect())
+            }
+            None => None,
+        };
+        dispatched.push(Dispatched { pixels, stats, refine_masks });
+    }
+    Ok(dispatched.try_into().unwrap_or_else(|_| unreachable!("one result per dispatch")))
 }
 
 /// Distance in units in the last place between two floats (0 when bit-equal).

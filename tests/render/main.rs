@@ -51,6 +51,10 @@ const GPU_TESTS: &[GpuTest] = &[
     ),
     ("modes::derivative_chains_render_in_every_mode", modes::derivative_chains_render_in_every_mode),
     ("modes::steps_keep_their_edges", modes::steps_keep_their_edges),
+    (
+        "modes::statistics_off_changes_nothing_but_the_instrumentation",
+        modes::statistics_off_changes_nothing_but_the_instrumentation,
+    ),
     ("modes::keys_refine_only_the_effects_that_read_them", modes::keys_refine_only_the_effects_that_read_them),
     ("modes::compacted_fine_pass_equals_the_plain_one", modes::compacted_fine_pass_equals_the_plain_one),
     ("modes::silhouettes_are_never_blended", modes::silhouettes_are_never_blended),

@@ -1,9 +1,9 @@
 //! Every mode against the reference of the same program.
 
-use crate::{compile, max_abs_diff, run, worst_ulps};
+use crate::{compile, dispatch_in_turn, max_abs_diff, run, worst_ulps};
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
-use mrsl_runtime::Mode;
+use mrsl_runtime::{DispatchOptions, Error, Mode};
 
 const COARSE_MODES: [Mode; 6] =
     [Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic, Mode::Hierarchical, Mode::Checkerboard, Mode::RateImage];
@@ -420,5 +420,38 @@ pub fn compacted_fine_pass_equals_the_plain_one(gpu: &Gpu) {
                 assert_eq!(got.stats.effects, want.stats.effects, "{name} {mode} (forced: {forced})");
             }
         }
+    }
+}
+
+/// `DispatchOptions::statistics` off leaves the instrumentation out and
+/// nothing else: in every coarse mode the image is bit-identical to the
+/// instrumented dispatch's, `read_stats` says the dispatch counted nothing,
+/// and the per-pixel refine masks keep the last instrumented dispatch's
+/// even through a forced dispatch, which would have set every bit.
+pub fn statistics_off_changes_nothing_but_the_instrumentation(gpu: &Gpu) {
+    let gbuffer = Scene::Demo.render(75, 43);
+    let source = examples().into_iter().find(|(name, _)| name == "demo.mrsl").expect("examples/demo.mrsl").1;
+    let program = compile(&source);
+    let tile = mrsl_abi::shading_rate::DEFAULT_RATE_TILE;
+    let rates = mrsl_lab::shading_rate::pattern(mrsl_abi::shading_rate::rate_image_size((75, 43), tile));
+    for mode in COARSE_MODES {
+        let on = DispatchOptions::new(mode);
+        let off = DispatchOptions { statistics: false, ..on };
+        let forced_off = DispatchOptions { force_refine: true, ..off };
+        let [counted, quiet, forced] =
+            dispatch_in_turn(gpu, &program, &gbuffer, &rates, [on, off, forced_off]).unwrap();
+        let stats = counted.stats.unwrap();
+        assert!(stats.coarse_shaded_fraction < 1.0, "{mode}: the demo refines everywhere, so the masks prove nothing");
+        assert!(quiet.pixels == counted.pixels, "{mode}: the image changed with statistics off");
+        for (what, d) in [("adaptive", &quiet), ("forced", &forced)] {
+            assert!(
+                matches!(d.stats, Err(Error::StatisticsOff)),
+                "{mode} {what}: read_stats gave {:?}",
+                d.stats.as_ref().err()
+            );
+            assert!(d.refine_masks == counted.refine_masks, "{mode} {what}: the refine masks were written");
+        }
+        let masks = counted.refine_masks.expect("coarse modes keep a rate image");
+        assert!(masks.contains(&0), "{mode}: no pixel resampled everything");
     }
 }

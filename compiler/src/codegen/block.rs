@@ -517,10 +517,12 @@ impl Writer<'_, '_, '_> {
                 } else {
                     ("mrsl_b", "0u")
                 };
-                w.template(2, include_str!("templates/rate.wgsl"), &[("LAST", &last), ("FROM_INNER", &from_inner)]);
+                w.statistics_on(2);
+                w.template(3, include_str!("templates/rate.wgsl"), &[("LAST", &last), ("FROM_INNER", &from_inner)]);
                 for k in 0..coarse {
                     w.count_refined(k, &format!("mrsl_is_refined(mrsl_last, {k}u)"));
                 }
+                w.line(2, "}");
             },
             |w, e, indent| w.effect_chain(&[e], indent),
         );

@@ -87,7 +87,7 @@ impl Writer<'_, '_, '_> {
                     let all = if coarse >= 32 { u32::MAX } else { (1u32 << coarse) - 1 };
                     w.template(0, stats, &[("ALL", &all)]);
                     for k in 0..coarse {
-                        w.line(3, format!("atomicAdd(&mrsl_wg_stats[{k}], 1u);"));
+                        w.line(4, format!("atomicAdd(&mrsl_wg_stats[{k}], 1u);"));
                     }
                     w.template(0, end, &[]);
                 }

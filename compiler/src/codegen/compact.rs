@@ -91,10 +91,12 @@ impl Writer<'_, '_, '_> {
         self.line(1, "if (mrsl_in) {");
         self.resolve_preamble(2, "");
         self.line(2, "mrsl_cb[mrsl_li] = mrsl_b;");
-        self.template(2, include_str!("templates/rate.wgsl"), &[("LAST", &"mrsl_b"), ("FROM_INNER", &"0u")]);
+        self.statistics_on(2);
+        self.template(3, include_str!("templates/rate.wgsl"), &[("LAST", &"mrsl_b"), ("FROM_INNER", &"0u")]);
         for j in 0..k {
             self.count_refined(j, &format!("mrsl_is_refined(mrsl_last, {j}u)"));
         }
+        self.line(2, "}");
         for &e in &coarse {
             let j = self.coarse_index[&e];
             self.line(

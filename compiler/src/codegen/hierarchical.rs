@@ -135,11 +135,13 @@ impl Writer<'_, '_, '_> {
                 if coarse == 0 {
                     return;
                 }
-                w.template(0, include_str!("templates/hierarchical_final.wgsl"), &[("FLAG_WORDS", &flag_words)]);
+                let [head, end] = cut(include_str!("templates/hierarchical_final.wgsl"), &["COUNTS"]);
+                w.template(0, head, &[("FLAG_WORDS", &flag_words)]);
                 for k in 0..coarse {
                     let (word, mask) = bit(k as u32);
                     w.count_refined(k, &format!("(mrsl_values[mrsl_r0 + {}u] & {mask}u) != 0u", flag_words + word));
                 }
+                w.template(0, end, &[]);
             },
             |w, e, indent| {
                 let name = &w.checked().effects[e.index()].name;

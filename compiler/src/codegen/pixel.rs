@@ -116,9 +116,17 @@ impl Writer<'_, '_, '_> {
         self.line(0, "}");
     }
 
-    /// Counts coarse effect `k` as re-evaluated by this pixel where `condition` holds.
+    /// Counts coarse effect `k` as re-evaluated by this pixel where `condition`
+    /// holds (inside a `statistics_on` block, hence the indentation).
     pub(super) fn count_refined(&mut self, k: usize, condition: &str) {
-        self.line(2, format!("if ({condition}) {{ atomicAdd(&mrsl_wg_stats[{k}], 1u); }}"));
+        self.line(3, format!("if ({condition}) {{ atomicAdd(&mrsl_wg_stats[{k}], 1u); }}"));
+    }
+
+    /// Opens the block of instrumentation a dispatch runs only with
+    /// statistics on (control field `statistics`): the rate image and the
+    /// counters. Timed runs leave it out; the branch is uniform.
+    pub(super) fn statistics_on(&mut self, indent: usize) {
+        self.line(indent, "if (mrsl_ctl.statistics != 0u) {");
     }
 
     pub(super) fn output_stores(&mut self, order: &[EffectId], indent: usize) {

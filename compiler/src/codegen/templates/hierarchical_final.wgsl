@@ -1,3 +1,6 @@
         let mrsl_r0 = mrsl_rec(mrsl_pos);
-        let mrsl_mask = mrsl_values[mrsl_r0 + {{FLAG_WORDS}}u];
-        textureStore(mrsl_rate, mrsl_pos, vec4<u32>(mrsl_mask, 0u, 0u, 1u));
+        if (mrsl_ctl.statistics != 0u) {
+            let mrsl_mask = mrsl_values[mrsl_r0 + {{FLAG_WORDS}}u];
+            textureStore(mrsl_rate, mrsl_pos, vec4<u32>(mrsl_mask, 0u, 0u, 1u));
+{{#COUNTS}}
+        }

@@ -1,4 +1,6 @@
-    workgroupBarrier();
-    for (var k = mrsl_li; k < {{COUNTERS}}u; k += {{WORKGROUP}}u) {
-        atomicAdd(&mrsl_stats[k], atomicLoad(&mrsl_wg_stats[k]));
+    if (mrsl_ctl.statistics != 0u) {
+        workgroupBarrier();
+        for (var k = mrsl_li; k < {{COUNTERS}}u; k += {{WORKGROUP}}u) {
+            atomicAdd(&mrsl_stats[k], atomicLoad(&mrsl_wg_stats[k]));
+        }
     }
