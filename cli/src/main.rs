@@ -133,9 +133,10 @@ struct Render {
     /// Set a uniform: NAME=VALUE or NAME=X,Y,Z (repeatable).
     #[arg(long = "set", value_parser = render::parse_set)]
     sets: Vec<(String, Vec<f64>)>,
-    /// Directory of the files written (created if missing), except those named by -o and --heatmap.
-    #[arg(long = "out", default_value = "out")]
-    out_dir: PathBuf,
+    /// Directory of the files written (created if missing), except those named by -o and --heatmap
+    /// (default: the directory of -o's file when -o is given, else `out`).
+    #[arg(long = "out")]
+    out_dir: Option<PathBuf>,
     /// Output PNG (default: OUT/PROGRAM.MODE.png).
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -223,6 +224,18 @@ enum Emit {
     Layout,
 }
 
+/// Where `render` writes the files -o and --heatmap do not name: `--out`,
+/// else beside -o's file (so `-o /tmp/x.png` writes nothing into the working
+/// directory), else `out`.
+fn render_out_dir(out: Option<&std::path::Path>, output: Option<&std::path::Path>) -> PathBuf {
+    match (out, output.map(|o| o.parent())) {
+        (Some(dir), _) => dir.to_path_buf(),
+        (None, Some(Some(dir))) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
+        (None, Some(_)) => PathBuf::from("."),
+        (None, None) => PathBuf::from("out"),
+    }
+}
+
 fn main() -> ExitCode {
     // Before anything can start a thread or load Vulkan (see the function).
     // SAFETY: no other thread exists yet: nothing has run but `main`'s start.
@@ -278,7 +291,7 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
                 sets: r.sets.clone(),
                 output: r.output.clone(),
                 heatmap: r.heatmap.clone(),
-                out_dir: r.out_dir.clone(),
+                out_dir: render_out_dir(r.out_dir.as_deref(), r.output.as_deref()),
                 stats: r.stats,
                 force_refine: r.force_refine,
                 compare: r.compare,
@@ -435,6 +448,15 @@ fn report(color: Color, diagnostics: &[Diagnostic], name: &str, source: &str) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn render_writes_beside_the_output_unless_told() {
+        use std::path::Path;
+        assert_eq!(render_out_dir(None, None), PathBuf::from("out"));
+        assert_eq!(render_out_dir(None, Some(Path::new("/tmp/r/a.png"))), PathBuf::from("/tmp/r"));
+        assert_eq!(render_out_dir(None, Some(Path::new("a.png"))), PathBuf::from("."));
+        assert_eq!(render_out_dir(Some(Path::new("d")), Some(Path::new("/tmp/r/a.png"))), PathBuf::from("d"));
+    }
 
     #[test]
     fn a_file_that_is_not_utf8_is_refused_with_the_place_of_its_first_bad_byte() {
