@@ -336,11 +336,27 @@ impl<'b> Writer<'_, '_, 'b> {
         needed
     }
 
-    /// Effects with a refine flag that the neighbour functions evaluate, and
-    /// so get a value-only function `mrsl_val_<effect>`.
+    /// Whether the kernel reads the refine flags its evaluations set: the
+    /// kernels that decide refinement (the coarse samples and the
+    /// hierarchical levels). The per-pixel kernels (reference, fine, final
+    /// passes) evaluate an effect where refinement is already decided, so
+    /// its flag would be discarded: they evaluate values alone
+    /// (`mrsl_val_<effect>`), without what only decides the flag, such as
+    /// the derivatives in a predicate, which re-evaluate effects at the
+    /// neighbours. The value is the same computation either way.
+    pub(super) fn keeps_refine_flags(&self) -> bool {
+        self.kind.is_coarse() || self.kind == KernelKind::Hierarchical
+    }
+
+    /// Effects with a refine flag that this kernel evaluates for their value
+    /// alone (at the neighbours, or everywhere in a kernel that discards the
+    /// flags), and so get a value-only function `mrsl_val_<effect>`.
     pub(super) fn value_only_effects(&self) -> BTreeSet<EffectId> {
         let c = self.checked();
         let mut effects = BTreeSet::new();
+        if !self.keeps_refine_flags() {
+            effects.extend(self.kernel_effects().into_iter().filter(|e| c.effects[e.index()].has_refine));
+        }
         for e in self.effects_at_neighbours() {
             effects.extend(self.i.graph.closure(e, c).into_iter().filter(|x| c.effects[x.index()].has_refine));
         }
@@ -401,12 +417,13 @@ impl<'b> Writer<'_, '_, 'b> {
     /// Evaluates effect `e` at `mrsl_pos` into `{declare}{name}` (`declare`
     /// is `"let "`, or empty for a variable already declared), declaring its
     /// refine flag first if it has one.
-    /// In the neighbour functions (`value_only`), an effect that can refine
-    /// is evaluated by `mrsl_val_<effect>`, with no flag.
+    /// In the neighbour functions (`value_only`) and in kernels that discard
+    /// refine flags, an effect that can refine is evaluated by
+    /// `mrsl_val_<effect>`, with no flag.
     pub(super) fn evaluate(&mut self, e: EffectId, indent: usize, declare: &str) {
         let info = &self.checked().effects[e.index()];
         let mut args = vec!["mrsl_pos".to_string()];
-        let function = if info.has_refine && self.value_only {
+        let function = if info.has_refine && (self.value_only || !self.keeps_refine_flags()) {
             "val"
         } else {
             if info.has_refine {

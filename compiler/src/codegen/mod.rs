@@ -242,8 +242,12 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             self.cached(Piece::Function(f), |w| w.function(f));
         }
         let value_only = self.value_only_effects();
+        let keeps_flags = self.keeps_refine_flags();
         for e in self.kernel_effects() {
-            self.cached(Piece::Effect(e, false), |w| w.eval_function(e, false));
+            // A kernel that discards refine flags never calls `mrsl_eval_` of an effect that can refine.
+            if keeps_flags || !c.effects[e.index()].has_refine {
+                self.cached(Piece::Effect(e, false), |w| w.eval_function(e, false));
+            }
             if value_only.contains(&e) {
                 self.cached(Piece::Effect(e, true), |w| w.eval_function(e, true));
             }
