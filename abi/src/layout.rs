@@ -373,4 +373,11 @@ pub struct EffectLayout {
     /// static trip counts, texture reads weighted 4). Times the evaluations
     /// a mode makes, a platform-independent measure of shading work.
     pub operations: Option<u64>,
+    /// The same model for an evaluation of the value alone, without the
+    /// statements that only decide the refine flag: what the per-pixel
+    /// kernels (reference, fine, final passes) execute, since refinement is
+    /// decided before they run. Equal to `operations` for an effect that
+    /// cannot refine.
+    #[serde(default)]
+    pub value_operations: Option<u64>,
 }

@@ -153,19 +153,23 @@ impl Bench<'_> {
 }
 
 /// The shading operations of one frame by the compiler's cost model (the
-/// layout's `operations` per evaluation, times the evaluations the
+/// layout's operations per evaluation, times the evaluations the
 /// statistics count), and those of the reference, which evaluates every
-/// effect once per pixel.
+/// effect once per pixel. Evaluations that decide refinement (the coarse
+/// samples, the hierarchical levels) count `operations`; per-pixel
+/// evaluations, where refinement is already decided, count
+/// `value_operations`, as the kernels run them.
 fn shading_operations(program: &mrsl::Program, stats: &Stats) -> (f64, f64) {
     let pixels = f64::from(stats.width) * f64::from(stats.height);
+    let per_pixel_decides = stats.mode == Mode::Hierarchical.name();
     let mut mode = 0.0;
     let mut reference = 0.0;
     for e in &stats.effects {
-        let Some(ops) = program.layout.effects.iter().find(|l| l.name == e.name).and_then(|l| l.operations) else {
-            continue;
-        };
-        mode += ops as f64 * (e.coarse_evaluations + e.pixel_evaluations) as f64;
-        reference += ops as f64 * pixels;
+        let Some(layout) = program.layout.effects.iter().find(|l| l.name == e.name) else { continue };
+        let (Some(full), Some(value)) = (layout.operations, layout.value_operations) else { continue };
+        let per_pixel = if per_pixel_decides { full } else { value };
+        mode += full as f64 * e.coarse_evaluations as f64 + per_pixel as f64 * e.pixel_evaluations as f64;
+        reference += value as f64 * pixels;
     }
     (mode, reference)
 }

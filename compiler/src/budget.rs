@@ -57,6 +57,10 @@ const NAMED: usize = 5;
 pub struct Costs {
     /// Per live effect, in `graph.order`: its evaluation at its own position, fully inlined.
     pub effects: Vec<(EffectId, u64)>,
+    /// The same for an evaluation of its value alone (`mrsl_val_<effect>`:
+    /// without what only decides the refine flag), as the per-pixel kernels
+    /// evaluate it; equal to `effects` for an effect that cannot refine.
+    pub values: Vec<(EffectId, u64)>,
     /// The sum of `effects`.
     pub total: u64,
 }
@@ -123,8 +127,9 @@ fn count(checked: &Checked, graph: &EffectGraph, deriv: &DerivInfo, executed: bo
         counter.at(e);
     }
     let effects: Vec<(EffectId, u64)> = graph.order.iter().map(|&e| (e, counter.effect(e, false))).collect();
+    let values: Vec<(EffectId, u64)> = graph.order.iter().map(|&e| (e, counter.effect(e, true))).collect();
     let total = effects.iter().fold(0u64, |sum, (_, cost)| sum.saturating_add(*cost));
-    Costs { effects, total }
+    Costs { effects, values, total }
 }
 
 /// E0701 when an effect's inlined code, or the program's, exceeds the budget.

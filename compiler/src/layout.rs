@@ -40,6 +40,7 @@ pub fn channel_format(ty: &Type) -> (TextureFormat, SampleType) {
 
 pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface, costs: &Costs) -> Layout {
     let operations: HashMap<EffectId, u64> = costs.effects.iter().copied().collect();
+    let value_operations: HashMap<EffectId, u64> = costs.values.iter().copied().collect();
     let control = ControlBlock {
         group: GROUP_RESOURCES,
         binding: BINDING_CONTROL,
@@ -172,6 +173,7 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface, cost
                 },
                 pass_condition: condition,
                 operations: operations.get(&id).copied(),
+                value_operations: value_operations.get(&id).copied(),
             }
         })
         .collect();

@@ -144,3 +144,27 @@ fn the_cost_model_counts_loop_trips_texture_reads_and_neighbour_evaluations() {
     let derivative = ops("    acc += ddx(normal.x * normal.y);");
     assert!(derivative > once + 4, "{derivative} {once}");
 }
+
+/// `value_operations` counts what a per-pixel kernel executes: the value
+/// without the statements that only decide the refine flag. A predicate on
+/// a derivative re-evaluates its operand at the neighbours, so it costs in
+/// `operations` and not in `value_operations`; an effect that cannot refine
+/// counts the same in both.
+#[test]
+fn the_cost_model_counts_the_value_alone_for_per_pixel_evaluations() {
+    let source = "in float3 normal;\n\
+        coarse effect float heavy {\n    float acc = 0.0;\n    for (int i = 0; i < 16; i++) { acc += sin(normal.x * float(i)); }\n    heavy = acc;\n}\n\
+        coarse effect float shade {\n    shade = heavy * 0.5;\n    if (fwidth(heavy) > 0.1) refine;\n}\n\
+        fine out float4 color = float4(shade);\n";
+    let program = mrsl::compile(source, &Options::default()).unwrap_or_else(|d| panic!("{d:?}"));
+    let costs = |name: &str| {
+        let e = program.layout.effects.iter().find(|x| x.name == name).unwrap();
+        (e.operations.unwrap(), e.value_operations.unwrap())
+    };
+    let (heavy, heavy_value) = costs("heavy");
+    assert_eq!(heavy, heavy_value, "`heavy` cannot refine");
+    let (shade, shade_value) = costs("shade");
+    assert!(shade_value < 10, "the value is a product: {shade_value}");
+    // The predicate evaluates `heavy` at four neighbours (two per difference).
+    assert!(shade >= shade_value + 4 * heavy, "{shade} {shade_value} {heavy}");
+}
