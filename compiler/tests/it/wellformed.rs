@@ -285,6 +285,11 @@ struct Gen<'c> {
     functions: Vec<Func>,
     /// Effects written so far, each with where its declaration ends in `out`.
     effects: Vec<(Var, usize)>,
+    /// Effects whose evaluation takes a derivative, directly or through the
+    /// effects they read: a derivative may not read them, since each link
+    /// of such a chain evaluates the next at more neighbours and a chain
+    /// grows past the size budget E0701 (which `tests/it/limits.rs` covers).
+    differentiating: BTreeSet<String>,
     used: BTreeSet<String>,
     /// Nodes left: bounds the program's size.
     budget: i64,
@@ -302,6 +307,7 @@ impl<'c> Gen<'c> {
             samplers: vec![],
             functions: vec![],
             effects: vec![],
+            differentiating: BTreeSet::new(),
             used: BTreeSet::new(),
             budget: 0,
         }
@@ -640,6 +646,7 @@ impl<'c> Gen<'c> {
             stmt_depth: 0,
         };
         let header = format!("{attr}{rate_text} {} {name}", ty.name());
+        let start = self.out.len();
         if self.chance(1, 3) {
             self.feat("expression-form effect");
             let value = self.expr(&ctx, ty, 0, false);
@@ -672,6 +679,13 @@ impl<'c> Gen<'c> {
                 self.stmt(&mut ctx, &mut body, 1, None);
             }
             let _ = writeln!(self.out, "{header} {{\n{body}}}");
+        }
+        let text = &self.out[start..];
+        let reads = names_in(text);
+        if ["ddx(", "ddy(", "fwidth("].iter().any(|d| text.contains(d))
+            || reads.iter().any(|r| self.differentiating.contains(*r))
+        {
+            self.differentiating.insert(name.clone());
         }
         self.effects.push((Var { name, ty, kind: Kind::Effect(rate) }, self.out.len()));
     }
@@ -1082,7 +1096,10 @@ impl<'c> Gen<'c> {
 
     /// Variables usable as a leaf here.
     fn leaves(&self, ctx: &Ctx) -> Vec<Var> {
-        self.visible(ctx).into_iter().filter(|v| !ctx.deriv || dsafe(v)).collect()
+        self.visible(ctx)
+            .into_iter()
+            .filter(|v| !ctx.deriv || (dsafe(v) && !self.differentiating.contains(&v.name)))
+            .collect()
     }
 
     fn var_expr(&mut self, v: &Var) -> E {
