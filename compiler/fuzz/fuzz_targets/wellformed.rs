@@ -31,6 +31,13 @@ fuzz_target!(|data: &[u8]| {
     let idle_key = |d: &mrsl::Diagnostic| d.code == "W0002";
     let mut diagnostics = mrsl::check(&source);
     diagnostics.retain(|d| !idle_key(d));
+    // E0701 (over the size budget) alone is a refusal by design that the
+    // generator cannot foresee: its node budget does not see how calls and
+    // derivative operands multiply once inlined (findings F17-F19). Such an
+    // input is skipped; the corpus cases err/0081-0083 keep the diagnostic tested.
+    if !diagnostics.is_empty() && diagnostics.iter().all(|d| d.code == "E0701") {
+        return;
+    }
     assert!(
         diagnostics.is_empty(),
         "a generated program has diagnostics:\n{source}\n{}",
