@@ -1,7 +1,7 @@
 //! The kernels a program compiles to: their names, entry points in dispatch
 //! order and workgroup sizes, stated once in [`KernelKind`] and [`entry`].
 
-use crate::geometry::{COARSE_WORKGROUP, PIXEL_WORKGROUP, WORK_LIST_WORKGROUP};
+use crate::geometry::{COARSE_WORKGROUP, FINE_WORKGROUP, PIXEL_WORKGROUP, WORK_LIST_WORKGROUP};
 use serde::{Deserialize, Serialize};
 
 /// Entry-point names of the generated kernels. The runtime looks pipelines
@@ -165,9 +165,12 @@ impl KernelKind {
         matches!(self, KernelKind::Coarse | KernelKind::Fine)
     }
 
-    /// Workgroup size of the main entry point.
+    /// Workgroup size of the main entry point. (The compacted fine kernel of
+    /// `mrsl::Options::compact` shades one pixel per lane: [`PIXEL_WORKGROUP`].)
     pub fn workgroup_size(self) -> [u32; 3] {
-        if self == KernelKind::RateCoarse {
+        if self == KernelKind::Fine {
+            [FINE_WORKGROUP, 1, 1]
+        } else if self == KernelKind::RateCoarse {
             [WORK_LIST_WORKGROUP, 1, 1]
         } else if self.is_coarse() {
             [COARSE_WORKGROUP, COARSE_WORKGROUP, 1]

@@ -101,7 +101,9 @@ fn no_flag_reads(w: &str) -> Option<String> {
     edit_lines(w, |l| {
         let t = l.trim_start();
         let (lhs, rhs) = t.strip_prefix("let f")?.split_once(" = ")?;
-        (rhs.starts_with("mrsl_interface[") && lhs.contains('_')).then(|| format!("{}let f{lhs} = 0u;", indent(l)))
+        // Read from the buffer, or from the lane's preloaded corners (`c.w<word>`).
+        let read = rhs.starts_with("mrsl_interface[") || rhs.starts_with("c.w");
+        (read && lhs.contains('_')).then(|| format!("{}let f{lhs} = 0u;", indent(l)))
     })
 }
 
@@ -109,15 +111,17 @@ fn no_flag_reads(w: &str) -> Option<String> {
 fn no_resampling(w: &str) -> Option<String> {
     edit_lines(w, |l| {
         let t = l.trim_start();
-        (t.contains(" = mrsl_resample_") && t.ends_with("(mrsl_b);") && !t.starts_with("let ")).then(String::new)
+        let resamples = t.ends_with("(mrsl_b);") || t.ends_with("(mrsl_b, mrsl_c);");
+        (t.contains(" = mrsl_resample_") && resamples && !t.starts_with("let ")).then(String::new)
     })
 }
 
 /// Everything the fine pass does per pixel.
 fn no_fine_work(w: &str) -> Option<String> {
     edit_lines(w, |l| match l.trim_start() {
-        "if (all(mrsl_pos < mrsl_grid())) {" => {
-            Some(format!("{}if (false && all(mrsl_pos < mrsl_grid())) {{", indent(l)))
+        // The guard of each pixel (a block fine kernel's lane has several).
+        t if t.starts_with("if (all(") && t.ends_with(" < mrsl_grid())) {") => {
+            Some(format!("{}if (false && {}", indent(l), &t["if (".len()..]))
         }
         "let mrsl_in = all(mrsl_pos < mrsl_grid());" => Some(format!("{}let mrsl_in = false;", indent(l))),
         _ => None,

@@ -7,7 +7,7 @@
 
 use super::Writer;
 use super::effects::Key;
-use super::words::{bit, pack_words, test_bit, unpack_words};
+use super::words::{bit, pack_words, test_bit, unpack_with, unpack_words};
 use super::writer::cut;
 use crate::check::EffectId;
 use crate::layout;
@@ -26,6 +26,11 @@ pub(super) struct Level {
     /// its records carry a validity tag.
     pub(super) parent: bool,
 }
+
+/// The corners of a block, in the order of `MrslBlock::corners`, and the
+/// pixels their keys are loaded at (in `mrsl_resolve` and `mrsl_corners`).
+const CORNERS: [&str; 4] = ["k00", "k10", "k01", "k11"];
+const CORNER_PIXELS: [&str; 4] = ["p0", "vec2<i32>(p1.x, p0.y)", "vec2<i32>(p0.x, p1.y)", "p1"];
 
 /// The number of coarse samples along each axis of a `block` grid over an
 /// image of `size`, as WGSL: the rule of [`mrsl_abi::geometry::sample_grid`].
@@ -181,8 +186,49 @@ impl Writer<'_, '_, '_> {
             self.fine_level(&Level::DYNAMIC_OUTER);
             self.fine_level(&Level::DYNAMIC_INNER);
         } else {
+            if self.preloads_corners() {
+                self.corners_function();
+            }
             self.fine_level(&Level { suffix: "", block: self.block, buffer: "mrsl_interface", parent: false });
         }
+    }
+
+    /// Whether the kernel's resolvers and resamplers take the block's
+    /// corners preloaded (`MrslCorners`): the block modes' fine kernels,
+    /// whose lanes shade [`mrsl_abi::geometry::FINE_PIXELS_PER_LANE`] pixels of one block.
+    pub(super) fn preloads_corners(&self) -> bool {
+        self.kind == KernelKind::Fine
+    }
+
+    /// `MrslCorners` and `mrsl_corners`: the keys and record words of a block's four coarse samples.
+    fn corners_function(&mut self) {
+        let stride = self.i.interface.stride;
+        let keys = self.keys_of(&self.coarse_live());
+        let [head, middle, tail] = cut(include_str!("templates/corners.wgsl"), &["FIELDS", "LOADS"]);
+        self.template(0, head, &[]);
+        for key in &keys {
+            for corner in CORNERS {
+                self.line(1, format!("{corner}_{}: {},", key.name, key.ty));
+            }
+        }
+        for w in 0..stride {
+            self.line(1, format!("w{w}: vec4<u32>,"));
+        }
+        let (grid, block) = (sample_grid(self.block), self.block);
+        let values: &super::writer::Values = &[("GRID", &grid), ("BLOCK", &block), ("STRIDE", &stride)];
+        self.template(0, middle, values);
+        for key in &keys {
+            let name = key.name;
+            for (corner, at) in CORNERS.iter().zip(CORNER_PIXELS) {
+                self.line(1, format!("c.{corner}_{name} = mrsl_load_{name}({at});"));
+            }
+        }
+        for w in 0..stride {
+            let words: Vec<String> =
+                ["x", "y", "z", "w"].iter().map(|l| format!("mrsl_interface[s.{l} + {w}u]")).collect();
+            self.line(1, format!("c.w{w} = vec4<u32>({});", words.join(", ")));
+        }
+        self.template(0, tail, values);
     }
 
     /// `mrsl_resolve{suffix}`: where a pixel takes its coarse values from at
@@ -220,9 +266,12 @@ impl Writer<'_, '_, '_> {
         let resolve =
             if rate { include_str!("templates/rate_resolve.wgsl") } else { include_str!("templates/resolve.wgsl") };
         let [head, corners, refined] = cut(resolve, &["CORNERS", "REFINED"]);
+        let preloaded = self.preloads_corners();
         let params = if level.parent {
             self.inner_level_note(bk);
             "pos: vec2<i32>, parent: MrslBlock"
+        } else if preloaded {
+            "pos: vec2<i32>, c: MrslCorners"
         } else {
             "pos: vec2<i32>"
         };
@@ -247,15 +296,29 @@ impl Writer<'_, '_, '_> {
                 );
                 continue;
             }
-            let mut tests: Vec<String> = ["k00", "k10", "k01", "k11"]
-                .iter()
-                .map(|corner| key.differs(&format!("k_{name}"), &format!("{corner}_{name}")))
-                .collect();
+            let mut tests: Vec<String> =
+                CORNERS.iter().map(|corner| key.differs(&format!("k_{name}"), &format!("{corner}_{name}"))).collect();
             tests.extend(corners_differ(&key));
+            let at: Vec<String> = CORNERS
+                .iter()
+                .zip(CORNER_PIXELS)
+                .map(
+                    |(corner, pixel)| {
+                        if preloaded { format!("c.{corner}_{name}") } else { format!("mrsl_load_{name}({pixel})") }
+                    },
+                )
+                .collect();
             self.template(
                 0,
                 include_str!("templates/resolve_key.wgsl"),
-                &[("NAME", &name), ("TESTS", &tests.join(" || "))],
+                &[
+                    ("NAME", &name),
+                    ("K00", &at[0]),
+                    ("K10", &at[1]),
+                    ("K01", &at[2]),
+                    ("K11", &at[3]),
+                    ("TESTS", &tests.join(" || ")),
+                ],
             );
         }
         let words: Vec<u32> = match only {
@@ -264,7 +327,12 @@ impl Writer<'_, '_, '_> {
         };
         for (ci, sample) in samples.iter().enumerate().take(4) {
             for &w in &words {
-                self.line(1, format!("let f{ci}_{w} = {buf}[{sample} * {stride}u + {w}u];"));
+                let word = if preloaded {
+                    format!("c.w{w}.{}", ["x", "y", "z", "w"][ci])
+                } else {
+                    format!("{buf}[{sample} * {stride}u + {w}u]")
+                };
+                self.line(1, format!("let f{ci}_{w} = {word};"));
             }
         }
         if rate && !words.is_empty() {
@@ -436,6 +504,22 @@ impl Writer<'_, '_, '_> {
                 ("FILTER", &filter),
                 ("VALUE", &value),
             ];
+            if self.preloads_corners() {
+                let corner = |lane: &str| unpack_with(&info.ty, |k| format!("c.w{}.{lane}", slot.offset + k));
+                let (v0, v1, v2, v3) = (corner("x"), corner("y"), corner("z"), corner("w"));
+                let values: &super::writer::Values = &[
+                    ("NAME", &info.name),
+                    ("TYPE", &info.ty.wgsl()),
+                    ("V0", &v0),
+                    ("V1", &v1),
+                    ("V2", &v2),
+                    ("V3", &v3),
+                    ("FILTER", &filter),
+                    ("VALUE", &value),
+                ];
+                self.template(0, include_str!("templates/resample_corners.wgsl"), values);
+                continue;
+            }
             if self.kind != KernelKind::RateFine {
                 self.template(0, include_str!("templates/resample.wgsl"), values);
                 continue;
@@ -465,7 +549,13 @@ impl Writer<'_, '_, '_> {
     /// `mrsl_pos` in the fine kernels; nothing elsewhere. `name` is the suffix
     /// of a neighbour function's own resolvers (`mrsl_resolve_<effect>`), or empty.
     pub(super) fn resolve_preamble(&mut self, indent: usize, name: &str) {
-        if self.kind.is_fine() {
+        if self.preloads_corners() {
+            // The entry point loads its lane's corners once; elsewhere each position loads its own.
+            if !self.corners_loaded {
+                self.line(indent, "let mrsl_c = mrsl_corners(mrsl_pos);");
+            }
+            self.line(indent, format!("let mrsl_b = mrsl_resolve{name}(mrsl_pos, mrsl_c);"));
+        } else if self.kind.is_fine() {
             self.line(indent, format!("let mrsl_b = mrsl_resolve{name}(mrsl_pos);"));
             if self.kind == KernelKind::DynamicFine {
                 self.resolve_inner(indent, name);
@@ -486,7 +576,8 @@ impl Writer<'_, '_, '_> {
         self.evaluate(e, indent + 1, "");
         if self.i.interface.is_passed(e) {
             self.line(indent, "} else {");
-            self.line(indent + 1, format!("{name} = mrsl_resample_{}(mrsl_b);", info.name));
+            let corners = if self.preloads_corners() { ", mrsl_c" } else { "" };
+            self.line(indent + 1, format!("{name} = mrsl_resample_{}(mrsl_b{corners});", info.name));
         }
         self.line(indent, "}");
     }
@@ -495,13 +586,15 @@ impl Writer<'_, '_, '_> {
     pub(super) fn pixel_entry(&mut self) {
         // The reference kernel has no blocks; it lays its tiles out in 2x2 ones.
         // The rate-image mode's cells are at most 4x4: 4x4 blocks keep a cell's pixels on neighbouring lanes.
-        self.tile_pixel_blocks(match self.kind {
-            KernelKind::RateFine => 4,
-            kind if kind.is_fine() => self.block,
-            _ => 2,
-        });
         if self.compacts() {
+            self.tile_pixel_blocks(self.block);
             return self.compacted_fine_entry();
+        }
+        match self.kind {
+            KernelKind::Fine => self.tile_pair(),
+            KernelKind::RateFine => self.tile_pixel_blocks(4),
+            kind if kind.is_fine() => self.tile_pixel_blocks(self.block),
+            _ => self.tile_pixel_blocks(2),
         }
         let counted = self.counts_stats();
         let coarse = self.coarse_live().len();

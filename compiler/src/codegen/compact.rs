@@ -76,8 +76,8 @@ impl Writer<'_, '_, '_> {
             self.line(0, format!("var<workgroup> mrsl_cv_{}: array<{}, {wg}>;", info.name, info.ty.wgsl()));
         }
         self.line(0, "");
-        let [x, y, z] = self.kind.workgroup_size();
-        self.line(0, format!("@compute @workgroup_size({x}, {y}, {z})"));
+        // One pixel per lane, unlike the ordinary fine kernel's pairs.
+        self.line(0, format!("@compute @workgroup_size({wg}, 1, 1)"));
         self.line(
             0,
             format!(
@@ -158,7 +158,8 @@ impl Writer<'_, '_, '_> {
         self.line(indent + 1, format!("{var} = mrsl_cv_{}[{lane}];", info.name));
         if self.i.interface.is_passed(e) {
             self.line(indent, "} else {");
-            self.line(indent + 1, format!("{var} = mrsl_resample_{}(mrsl_b);", info.name));
+            // The lane's corners were loaded before the barriers; loading them again is cheaper than keeping them.
+            self.line(indent + 1, format!("{var} = mrsl_resample_{}(mrsl_b, mrsl_corners(mrsl_pos));", info.name));
         }
         self.line(indent, "}");
     }

@@ -19,6 +19,8 @@ use std::collections::{BTreeSet, HashMap, HashSet};
 /// differ, keeps them from sharing coarse values.
 pub(super) struct Key<'c> {
     pub(super) name: &'c str,
+    /// The channel's WGSL type.
+    pub(super) ty: String,
     compare: KeyCompare,
     scalar: bool,
 }
@@ -61,7 +63,7 @@ impl<'b> Writer<'_, '_, 'b> {
             .map(|i| {
                 let x = &c.inputs[i.index()];
                 let compare = x.key.expect("EffectGraph::keys holds key channels only");
-                Key { name: &x.name, compare, scalar: x.ty.components() == 1 }
+                Key { name: &x.name, ty: x.ty.wgsl(), compare, scalar: x.ty.components() == 1 }
             })
             .collect()
     }

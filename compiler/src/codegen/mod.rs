@@ -65,7 +65,9 @@ use crate::interface::Interface;
 use crate::syntax::ast::NodeId;
 use crate::syntax::ast::{Rate, Span};
 use body::{Mode, wgsl_ident};
-use mrsl_abi::geometry::{DYNAMIC_INNER_BLOCK, DYNAMIC_OUTER_BLOCK, DYNAMIC_TAG_WORDS, HIERARCHICAL_LEVEL0};
+use mrsl_abi::geometry::{
+    DYNAMIC_INNER_BLOCK, DYNAMIC_OUTER_BLOCK, DYNAMIC_TAG_WORDS, FINE_PIXELS_PER_LANE, HIERARCHICAL_LEVEL0,
+};
 use mrsl_abi::{KernelKind, Layout};
 use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
@@ -139,6 +141,9 @@ struct Writer<'i, 'a, 'b> {
     /// While writing the neighbour functions: effects are evaluated for their
     /// value alone, with `mrsl_val_<effect>` where the effect can refine.
     value_only: bool,
+    /// While writing the block fine kernel's entry point: `mrsl_c`, the
+    /// corners of the lane's block (`mrsl_corners`), is in scope.
+    corners_loaded: bool,
 }
 
 impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
@@ -151,7 +156,16 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             .enumerate()
             .map(|(k, e)| (*e, k as u32))
             .collect();
-        Writer { i, kind, block, code: Code::default(), coarse_index, skipped: None, value_only: false }
+        Writer {
+            i,
+            kind,
+            block,
+            code: Code::default(),
+            coarse_index,
+            skipped: None,
+            value_only: false,
+            corners_loaded: false,
+        }
     }
 
     fn checked(&self) -> &'b Checked<'a> {
@@ -278,7 +292,9 @@ fn describe(kind: KernelKind, block: u32) -> String {
     let (outer, inner) = (DYNAMIC_OUTER_BLOCK, DYNAMIC_INNER_BLOCK);
     match kind {
         KernelKind::Coarse => format!("coarse kernel, {block}x{block} blocks: one invocation per coarse sample"),
-        KernelKind::Fine => format!("fine kernel, {block}x{block} blocks: one invocation per pixel"),
+        KernelKind::Fine => {
+            format!("fine kernel, {block}x{block} blocks: one invocation per {FINE_PIXELS_PER_LANE} pixels of a block")
+        }
         KernelKind::Reference => "reference kernel: every effect per pixel".to_string(),
         KernelKind::DynamicCoarse => format!(
             "dynamic mode, second level: one invocation per {inner}x{inner} coarse sample inside refined {outer}x{outer} blocks"

@@ -9,7 +9,7 @@ use crate::check::EffectId;
 use crate::syntax::ast::Rate;
 use crate::types::{Scalar, Type};
 use mrsl_abi::KernelKind;
-use mrsl_abi::geometry::{PIXEL_WORKGROUP, TILE};
+use mrsl_abi::geometry::{FINE_PIXELS_PER_LANE, TILE};
 
 impl Writer<'_, '_, '_> {
     /// Whether the kernel counts per-pixel re-evaluations of coarse effects
@@ -58,6 +58,24 @@ impl Writer<'_, '_, '_> {
         );
     }
 
+    /// `mrsl_tile_pair` for the block modes' fine kernels: the first of the
+    /// [`FINE_PIXELS_PER_LANE`] pixels a lane shades in one block.
+    pub(super) fn tile_pair(&mut self) {
+        let block = self.block;
+        assert_eq!(block % FINE_PIXELS_PER_LANE, 0, "a block's rows split evenly among a lane's pixels");
+        self.template(
+            0,
+            include_str!("templates/tile_pair.wgsl"),
+            &[
+                ("TILE", &TILE),
+                ("BLOCK", &block),
+                ("HALF", &(block / FINE_PIXELS_PER_LANE)),
+                ("PER_BLOCK", &(block * block / FINE_PIXELS_PER_LANE)),
+                ("BLOCKS_X", &(TILE / block)),
+            ],
+        );
+    }
+
     /// `mrsl_tile_pixel` for tiles shaded in row-major order.
     pub(super) fn tile_pixel_rows(&mut self) {
         self.template(0, include_str!("templates/tile_pixel_rows.wgsl"), &[("TILE", &TILE)]);
@@ -72,27 +90,76 @@ impl Writer<'_, '_, '_> {
     /// Pixels outside the image return at once unless the kernel counts
     /// statistics: then every lane must reach the barrier before the
     /// workgroup's counters are added up, so they skip the work instead.
+    ///
+    /// In the block modes' fine kernels a lane shades
+    /// [`FINE_PIXELS_PER_LANE`] pixels of one block, one after the other,
+    /// with the block's corners loaded once (`mrsl_c`). The pixels are
+    /// written out one after the other, not as a loop: llvmpipe ran the
+    /// re-evaluations inside a loop at about the one-pixel kernel's time,
+    /// written out at 0.75 of it (paired, 1920x1080, docs/evaluation.md).
     pub(super) fn pixel_main(
         &mut self,
-        prologue: impl FnOnce(&mut Self),
+        mut prologue: impl FnMut(&mut Self),
         mut coarse: impl FnMut(&mut Self, EffectId, usize),
     ) {
         let [x, y, z] = self.kind.workgroup_size();
+        let pairs = self.kind == KernelKind::Fine;
         self.template(
             0,
             include_str!("templates/pixel_main.wgsl"),
-            &[("WORKGROUP", &format!("{x}, {y}, {z}")), ("ENTRY", &self.kind.main_entry_point())],
+            &[
+                ("WORKGROUP", &format!("{x}, {y}, {z}")),
+                ("ENTRY", &self.kind.main_entry_point()),
+                ("TILE_PIXEL", &if pairs { "mrsl_first = mrsl_tile_pair" } else { "mrsl_pos = mrsl_tile_pixel" }),
+            ],
         );
         let counted = self.counts_stats();
-        // The record modes' final passes keep one shape, counting or not.
-        let returns = !counted && !matches!(self.kind, KernelKind::Hierarchical | KernelKind::Checkerboard);
-        let indent = if returns {
-            self.line(1, "if (any(mrsl_pos >= mrsl_grid())) { return; }");
-            1
+        if pairs {
+            if !self.coarse_live().is_empty() {
+                // A lane past the image's edge still loads (clamped) corners: it skips its pixels below.
+                self.line(1, "let mrsl_c = mrsl_corners(min(mrsl_first, mrsl_grid() - vec2<i32>(1)));");
+                self.corners_loaded = true;
+            }
+            for k in 0..FINE_PIXELS_PER_LANE {
+                let at = match k * self.block / FINE_PIXELS_PER_LANE {
+                    0 => "mrsl_first".to_string(),
+                    dy => format!("(mrsl_first + vec2<i32>(0, {dy}))"),
+                };
+                self.line(1, format!("if (all({at} < mrsl_grid())) {{"));
+                self.line(2, format!("let mrsl_pos = {at};"));
+                self.pixel_body(2, &mut prologue, &mut coarse);
+                self.line(1, "}");
+            }
+            self.corners_loaded = false;
         } else {
-            self.line(1, "if (all(mrsl_pos < mrsl_grid())) {");
-            2
-        };
+            // The record modes' final passes keep one shape, counting or not.
+            let returns = !counted && !matches!(self.kind, KernelKind::Hierarchical | KernelKind::Checkerboard);
+            if returns {
+                self.line(1, "if (any(mrsl_pos >= mrsl_grid())) { return; }");
+                self.pixel_body(1, &mut prologue, &mut coarse);
+            } else {
+                self.line(1, "if (all(mrsl_pos < mrsl_grid())) {");
+                self.pixel_body(2, &mut prologue, &mut coarse);
+                self.line(1, "}");
+            }
+        }
+        if counted {
+            self.template(
+                0,
+                include_str!("templates/stats_flush.wgsl"),
+                &[("COUNTERS", &self.coarse_live().len()), ("WORKGROUP", &x)],
+            );
+        }
+        self.line(0, "}");
+    }
+
+    /// One pixel's work at `mrsl_pos` (see [`Writer::pixel_main`]).
+    fn pixel_body(
+        &mut self,
+        indent: usize,
+        prologue: &mut impl FnMut(&mut Self),
+        coarse: &mut impl FnMut(&mut Self, EffectId, usize),
+    ) {
         prologue(self);
         let order = self.i.graph.order.clone();
         for &e in &order {
@@ -103,17 +170,6 @@ impl Writer<'_, '_, '_> {
             }
         }
         self.output_stores(&order, indent);
-        if !returns {
-            self.line(1, "}");
-        }
-        if counted {
-            self.template(
-                0,
-                include_str!("templates/stats_flush.wgsl"),
-                &[("COUNTERS", &self.coarse_live().len()), ("WORKGROUP", &PIXEL_WORKGROUP)],
-            );
-        }
-        self.line(0, "}");
     }
 
     /// Counts coarse effect `k` as re-evaluated by this pixel where `condition`

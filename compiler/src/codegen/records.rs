@@ -86,7 +86,7 @@ impl Writer<'_, '_, '_> {
     /// the others evaluated, then the outputs (see [`Writer::pixel_main`]).
     pub(super) fn record_final(
         &mut self,
-        prologue: impl FnOnce(&mut Self),
+        prologue: impl FnMut(&mut Self),
         coarse: impl FnMut(&mut Self, EffectId, usize),
     ) {
         self.tile_pixel_rows();

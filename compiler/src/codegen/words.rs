@@ -28,7 +28,11 @@ pub(super) fn pack_words(value: &str, ty: &Type) -> Vec<String> {
 
 /// A WGSL expression reading a value from `buffer` at word `base`.
 pub(super) fn unpack_words(ty: &Type, buffer: &str) -> String {
-    let word = |k: u32| format!("{buffer}[base + {k}u]");
+    unpack_with(ty, |k| format!("{buffer}[base + {k}u]"))
+}
+
+/// A WGSL expression for a value whose `k`th word is `word(k)`.
+pub(super) fn unpack_with(ty: &Type, word: impl Fn(u32) -> String) -> String {
     let scalar = |k: u32, s: Scalar| match s {
         Scalar::Float => format!("bitcast<f32>({})", word(k)),
         Scalar::Int => format!("bitcast<i32>({})", word(k)),

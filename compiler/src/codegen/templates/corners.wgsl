@@ -1,0 +1,23 @@
+// The four coarse samples around a block as the fine kernel reads them: each
+// discontinuity key at their pixels (`k00_<key>`, `k10_`, `k01_`, `k11_`) and word w
+// of their records (`w<w>`: c00, c10, c01, c11). A lane loads them once for the pixels
+// it shades in the block; the shader compiler drops the loads a caller never reads.
+struct MrslCorners {
+    index: vec4<u32>, // coarse samples c00, c10, c01, c11
+{{#FIELDS}}
+}
+
+fn mrsl_corners(pos: vec2<i32>) -> MrslCorners {
+    let size = vec2<i32>(mrsl_ctl.size);
+    let n = {{GRID}};
+    let i0 = pos / {{BLOCK}};
+    let i1 = min(i0 + vec2<i32>(1), n - vec2<i32>(1));
+    let p0 = min(i0 * {{BLOCK}}, size - vec2<i32>(1));
+    let p1 = min(i1 * {{BLOCK}}, size - vec2<i32>(1));
+    var c: MrslCorners;
+    c.index = vec4<u32>(u32(i0.y * n.x + i0.x), u32(i0.y * n.x + i1.x), u32(i1.y * n.x + i0.x), u32(i1.y * n.x + i1.x));
+    let s = c.index * {{STRIDE}}u;
+{{#LOADS}}
+    return c;
+}
+

@@ -1,0 +1,14 @@
+// The first pixel lane `li` shades in a {{TILE}}x{{TILE}} tile of {{BLOCK}}x{{BLOCK}} blocks; its second, at
+// +(0, {{HALF}}), is in the same block, so the lane loads the block's coarse samples once
+// for both. Consecutive lanes (a SIMD group) cover whole blocks and share their refine
+// decisions.
+fn mrsl_tile_pair(wg: vec2<u32>, li: u32) -> vec2<i32> {
+    let per_block = {{PER_BLOCK}}u;
+    let blocks_x = {{BLOCKS_X}}u;
+    let blk = li / per_block;
+    let within = li % per_block;
+    let x = (blk % blocks_x) * {{BLOCK}}u + within % {{BLOCK}}u;
+    let y = (blk / blocks_x) * {{BLOCK}}u + within / {{BLOCK}}u;
+    return vec2<i32>(wg * {{TILE}}u + vec2<u32>(x, y));
+}
+
