@@ -100,8 +100,8 @@ impl Bench<'_> {
         let mut coarse = vec![];
         let mut fine = vec![];
         // Timed runs carry no instrumentation; the statistics come from the untimed run after them.
-        let timed = DispatchOptions { statistics: false, ..options };
-        let reference = reference.map(|r| DispatchOptions { statistics: false, ..r });
+        let timed = options.uninstrumented();
+        let reference = reference.map(DispatchOptions::uninstrumented);
         self.time_once(bindings, timed)?;
         if let Some(r) = reference {
             self.time_once(bindings, r)?;

@@ -231,7 +231,7 @@ pub fn render_frames(setup: &Setup, shader: &mut Shader, args: &RenderArgs, n: u
                 source_ms = Some(start.elapsed().as_secs_f64() * 1e3);
             }
             // Timed runs carry no instrumentation; the statistics come from one more run after them.
-            let timed = DispatchOptions { statistics: false, ..dispatch };
+            let timed = dispatch.uninstrumented();
             if k == 0 {
                 // The first run builds pipelines: time the second.
                 time_run(gpu, shader, &bindings, timed)?;

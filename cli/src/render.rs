@@ -226,7 +226,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
         progress(&format!("rendered {mode} (first run, pipelines warming up)"), start);
         // Warm wall time, without instrumentation (the statistics are the
         // first run's); with --compare, paired with reference runs.
-        let timed = |mode| DispatchOptions { statistics: false, ..options(mode) };
+        let timed = |mode| options(mode).uninstrumented();
         let (wall_ms, relative_to_reference) = if args.compare && mode != Mode::Reference {
             let (mut walls, mut ratios) = (vec![], vec![]);
             for pair in 0..PAIRS {

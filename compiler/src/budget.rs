@@ -21,7 +21,10 @@
 //! - an operation is an expression node or a statement;
 //! - a derivative site costs its operand's evaluation at a neighbour (`mrsl_d<k>`)
 //!   twice per difference: twice for `ddx` and `ddy`, four times for
-//!   `fwidth` and `sample`;
+//!   `fwidth` and `sample`. The helper's text has both calls; outside the
+//!   record modes it runs one of them and takes the operand at the position
+//!   itself from its caller (`mrsl_here`), so there the count is an upper
+//!   bound of the work executed, and so are the layout's `operations`;
 //! - the operand is evaluated with single-definition locals inlined, inputs
 //!   loaded, and each effect it reads costing that effect's neighbour
 //!   evaluation: its dependency closure, each effect that can refine

@@ -65,6 +65,12 @@ impl DispatchOptions {
             statistics: true,
         }
     }
+
+    /// The same dispatch with `statistics` off: no per-pixel counters and no
+    /// rate image, as a timed run measures it.
+    pub fn uninstrumented(self) -> DispatchOptions {
+        DispatchOptions { statistics: false, ..self }
+    }
 }
 
 /// Buffers of the hierarchical mode.

@@ -374,6 +374,12 @@ impl Writer<'_, '_, '_> {
                 let site = &self.i.deriv.sites[site_index];
                 let mut call_args = vec!["mrsl_pos".to_string()];
                 call_args.extend(site.params.iter().map(|p| local_name(c, *p)));
+                // The operand here, as this code already computes it (an
+                // effect's or input's local), where that is what the helpers
+                // would recompute: they evaluate only the quad pair's other position.
+                if self.reuses_operand_here(site_index) {
+                    call_args.push(self.expr(site.operand, mode));
+                }
                 let call_args = call_args.join(", ");
                 let dx = format!("mrsl_ddx_{site_index}({call_args})");
                 let dy = format!("mrsl_ddy_{site_index}({call_args})");

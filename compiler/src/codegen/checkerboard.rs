@@ -85,7 +85,7 @@ impl Writer<'_, '_, '_> {
                 w.template(0, head, &[]);
                 if coarse > 0 {
                     let all = if coarse >= 32 { u32::MAX } else { (1u32 << coarse) - 1 };
-                    w.template(0, stats, &[("ALL", &all)]);
+                    w.template(0, stats, &[("ALL", &all), ("STATISTICS_ON", &super::pixel::STATISTICS_ON)]);
                     for k in 0..coarse {
                         w.line(4, format!("atomicAdd(&mrsl_wg_stats[{k}], 1u);"));
                     }

@@ -142,7 +142,7 @@ impl Writer<'_, '_, '_> {
         self.template(
             0,
             include_str!("templates/stats_flush.wgsl"),
-            &[("COUNTERS", &k), ("WORKGROUP", &PIXEL_WORKGROUP)],
+            &[("COUNTERS", &k), ("WORKGROUP", &PIXEL_WORKGROUP), ("STATISTICS_ON", &super::pixel::STATISTICS_ON)],
         );
         self.line(0, "}");
     }

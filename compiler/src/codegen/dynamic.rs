@@ -85,6 +85,7 @@ impl Writer<'_, '_, '_> {
                 ("OUTER", &DYNAMIC_OUTER_BLOCK),
                 // The counter after the per-effect ones (layout `stats.counters`).
                 ("SAMPLES", &self.coarse_live().len()),
+                ("STATISTICS_ON", &super::pixel::STATISTICS_ON),
             ],
         );
     }

@@ -5,10 +5,10 @@
 //! evaluated in a chain, and how discontinuity keys are compared, which the
 //! entry points of every family use.
 
-use super::Writer;
 use super::body::{Mode, float_literal, local_name, wgsl_ident};
 use super::words::bit;
 use super::writer::cut;
+use super::{Derivatives, Writer};
 use crate::check::{EffectId, InputId, KeyCompare, Symbol};
 use crate::syntax::ast::*;
 use crate::syntax::{visit_expr, visit_stmt_exprs};
@@ -290,7 +290,7 @@ impl<'b> Writer<'_, '_, 'b> {
     /// differences across the position's quad, `mrsl_ddx_<k>` and `mrsl_ddy_<k>`.
     pub(super) fn derivative_helpers(&mut self) {
         for k in self.live_sites() {
-            self.cached(super::Piece::Derivative(k), |w| w.derivative_helper(k));
+            self.cached(super::Piece::Derivative(k, self.derivatives()), |w| w.derivative_helper(k));
         }
     }
 
@@ -312,19 +312,46 @@ impl<'b> Writer<'_, '_, 'b> {
             let text = &self.i.source[site.operand.span.range()];
             let text: String = text.split_whitespace().collect::<Vec<_>>().join(" ");
             let operand = self.expr(site.operand, Mode::Neighbour(site));
-            self.template(
-                0,
-                include_str!("templates/derivative.wgsl"),
-                &[
-                    ("SITE", &k),
-                    ("EFFECT", &c.effects[site.effect.index()].name),
-                    ("TEXT", &text),
-                    ("PARAMS", &params.join(", ")),
-                    ("TYPE", &ty.wgsl()),
-                    ("OPERAND", &operand),
-                    ("ARGS", &args),
-                ],
-            );
+            let values: &super::writer::Values = &[
+                ("SITE", &k),
+                ("EFFECT", &c.effects[site.effect.index()].name),
+                ("TEXT", &text),
+                ("PARAMS", &params.join(", ")),
+                ("TYPE", &ty.wgsl()),
+                ("OPERAND", &operand),
+                ("ARGS", &args),
+            ];
+            let [operand_helper, differences] = cut(include_str!("templates/derivative.wgsl"), &["DIFFERENCES"]);
+            self.template(0, operand_helper, values);
+            if self.reuses_operand_here(k) {
+                self.template(0, differences, values);
+            } else {
+                self.template(0, include_str!("templates/derivative_both.wgsl"), values);
+            }
+        }
+    }
+
+    /// Whether derivative site `k`'s helpers take the operand's value at
+    /// the position itself from the caller (`mrsl_here`) and evaluate only
+    /// the pair's other position. That value equals what `mrsl_d<k>` would
+    /// recompute there wherever the kernel's value of every effect at a
+    /// position is what `mrsl_at_<effect>` computes there: in every kernel
+    /// but the record modes', whose pixels may hold an interpolated or
+    /// reconstructed value while their neighbour functions evaluate
+    /// (docs/language.md, section 9); there only an operand that reads no
+    /// effect is taken from the caller.
+    pub(super) fn reuses_operand_here(&self, k: usize) -> bool {
+        match self.derivatives() {
+            Derivatives::Here => true,
+            Derivatives::HereWithoutEffects => self.i.deriv.sites[k].effects.is_empty(),
+        }
+    }
+
+    pub(super) fn derivatives(&self) -> Derivatives {
+        if matches!(self.kind, KernelKind::Hierarchical | KernelKind::Checkerboard) {
+            Derivatives::HereWithoutEffects
+        } else {
+            Derivatives::Here
         }
     }
 

@@ -136,7 +136,7 @@ impl Writer<'_, '_, '_> {
                     return;
                 }
                 let [head, end] = cut(include_str!("templates/hierarchical_final.wgsl"), &["COUNTS"]);
-                w.template(0, head, &[("FLAG_WORDS", &flag_words)]);
+                w.template(0, head, &[("FLAG_WORDS", &flag_words), ("STATISTICS_ON", &super::pixel::STATISTICS_ON)]);
                 for k in 0..coarse {
                     let (word, mask) = bit(k as u32);
                     w.count_refined(k, &format!("(mrsl_values[mrsl_r0 + {}u] & {mask}u) != 0u", flag_words + word));

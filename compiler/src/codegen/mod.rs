@@ -98,14 +98,25 @@ pub(crate) struct Cache {
     pieces: RefCell<HashMap<Piece, String>>,
 }
 
-/// A function whose text is the same in every kernel.
+/// A function whose text is the same in every kernel, or in every kernel
+/// of one [`Derivatives`] kind.
 #[derive(Clone, Copy, PartialEq, Eq, Hash)]
 enum Piece {
-    /// `mrsl_eval_<effect>`, or (`true`) `mrsl_val_<effect>`.
-    Effect(EffectId, bool),
+    /// `mrsl_eval_<effect>`, or (`true`) `mrsl_val_<effect>`: their derivative calls differ by kind.
+    Effect(EffectId, bool, Derivatives),
     /// `mrsl_d<k>`, `mrsl_ddx_<k>` and `mrsl_ddy_<k>`.
-    Derivative(usize),
+    Derivative(usize, Derivatives),
     Function(FunctionId),
+}
+
+/// How a kernel's derivative helpers get the operand at the position
+/// itself ([`Writer::reuses_operand_here`]).
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+enum Derivatives {
+    /// From the caller, always.
+    Here,
+    /// From the caller where the operand reads no effect (the record modes).
+    HereWithoutEffects,
 }
 
 impl Cache {
@@ -260,10 +271,10 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         for e in self.kernel_effects() {
             // A kernel that discards refine flags never calls `mrsl_eval_` of an effect that can refine.
             if keeps_flags || !c.effects[e.index()].has_refine {
-                self.cached(Piece::Effect(e, false), |w| w.eval_function(e, false));
+                self.cached(Piece::Effect(e, false, self.derivatives()), |w| w.eval_function(e, false));
             }
             if value_only.contains(&e) {
-                self.cached(Piece::Effect(e, true), |w| w.eval_function(e, true));
+                self.cached(Piece::Effect(e, true, self.derivatives()), |w| w.eval_function(e, true));
             }
         }
         self.derivative_helpers();

@@ -11,6 +11,10 @@ use crate::types::{Scalar, Type};
 use mrsl_abi::KernelKind;
 use mrsl_abi::geometry::{FINE_PIXELS_PER_LANE, TILE};
 
+/// The condition of the instrumentation a dispatch runs only with statistics
+/// on (control field `statistics`): the rate image and the counters.
+pub(super) const STATISTICS_ON: &str = "mrsl_ctl.statistics != 0u";
+
 impl Writer<'_, '_, '_> {
     /// Whether the kernel counts per-pixel re-evaluations of coarse effects
     /// (statistics and rate image): the per-pixel kernels that can reuse
@@ -147,7 +151,7 @@ impl Writer<'_, '_, '_> {
             self.template(
                 0,
                 include_str!("templates/stats_flush.wgsl"),
-                &[("COUNTERS", &self.coarse_live().len()), ("WORKGROUP", &x)],
+                &[("COUNTERS", &self.coarse_live().len()), ("WORKGROUP", &x), ("STATISTICS_ON", &STATISTICS_ON)],
             );
         }
         self.line(0, "}");
@@ -182,7 +186,7 @@ impl Writer<'_, '_, '_> {
     /// statistics on (control field `statistics`): the rate image and the
     /// counters. Timed runs leave it out; the branch is uniform.
     pub(super) fn statistics_on(&mut self, indent: usize) {
-        self.line(indent, "if (mrsl_ctl.statistics != 0u) {");
+        self.line(indent, format!("if ({STATISTICS_ON}) {{"));
     }
 
     pub(super) fn output_stores(&mut self, order: &[EffectId], indent: usize) {

@@ -112,6 +112,30 @@ fn kernels_declare_the_stage_bindings_of_the_contract() {
     }
 }
 
+/// Every kernel's main entry point declares the workgroup size of the
+/// contract (`KernelKind::workgroup_size`), which the dispatch geometry
+/// assumes: a tile of 8x8 pixels per workgroup, one pixel per lane, or in
+/// the block fine kernels `FINE_PIXELS_PER_LANE` pixels of one block per lane.
+#[test]
+fn main_entry_points_declare_the_workgroup_size_of_the_contract() {
+    for (stem, source) in examples() {
+        let program = mrsl::compile(&source, &Options::default()).unwrap();
+        for kernel in &program.kernels {
+            let entry = format!("fn {}(", kernel.kind.main_entry_point());
+            let lines: Vec<&str> = kernel.wgsl.lines().collect();
+            let at = lines.iter().position(|l| l.starts_with(&entry)).unwrap_or_else(|| panic!("{stem}: {entry}"));
+            let [x, y, z] = kernel.kind.workgroup_size();
+            assert_eq!(
+                lines[at - 1],
+                format!("@compute @workgroup_size({x}, {y}, {z})"),
+                "{stem}: {} kernel ({:?})",
+                kernel.kind,
+                kernel.block_size
+            );
+        }
+    }
+}
+
 /// The layout's cost model counts what one evaluation executes: a loop's
 /// body once per iteration of its static trip count, a texture read as 4,
 /// and a derivative as its operand evaluated again at the neighbours.

@@ -3,7 +3,7 @@
         // No usable tap (isolated by discontinuities): shaded here instead.
         let mrsl_alone = !mrsl_shaded && !(mrsl_ok[0] || mrsl_ok[1] || mrsl_ok[2] || mrsl_ok[3]);
 {{#STATS}}
-        if (mrsl_ctl.statistics != 0u) {
+        if ({{STATISTICS_ON}}) {
             textureStore(mrsl_rate, mrsl_pos, vec4<u32>(select(0u, {{ALL}}u, mrsl_shaded || mrsl_alone), 0u, 0u, 1u));
             if (mrsl_shaded || mrsl_alone) {
 {{#COUNTS}}

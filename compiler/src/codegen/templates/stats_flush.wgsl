@@ -1,4 +1,4 @@
-    if (mrsl_ctl.statistics != 0u) {
+    if ({{STATISTICS_ON}}) {
         workgroupBarrier();
         for (var k = mrsl_li; k < {{COUNTERS}}u; k += {{WORKGROUP}}u) {
             atomicAdd(&mrsl_stats[k], atomicLoad(&mrsl_wg_stats[k]));
