@@ -10,11 +10,12 @@ pub const TILE: u32 = 8;
 /// Invocations of a per-pixel workgroup (one tile, one pixel each).
 pub const PIXEL_WORKGROUP: u32 = TILE * TILE;
 
-/// Pixels each invocation of a block mode's fine kernel shades: two pixels of
-/// one block, which share its four coarse samples, loaded once per lane.
+/// Pixels each invocation of a block mode's fine kernel (and of the dynamic
+/// fine kernel) shades: two pixels of one block, which share its four
+/// coarse samples, loaded once per lane.
 pub const FINE_PIXELS_PER_LANE: u32 = 2;
 
-/// Invocations of a block mode's fine workgroup (one tile,
+/// Invocations of a block mode's or the dynamic mode's fine workgroup (one tile,
 /// [`FINE_PIXELS_PER_LANE`] pixels each).
 pub const FINE_WORKGROUP: u32 = PIXEL_WORKGROUP / FINE_PIXELS_PER_LANE;
 

@@ -168,7 +168,7 @@ impl KernelKind {
     /// Workgroup size of the main entry point. (The compacted fine kernel of
     /// `mrsl::Options::compact` shades one pixel per lane: [`PIXEL_WORKGROUP`].)
     pub fn workgroup_size(self) -> [u32; 3] {
-        if self == KernelKind::Fine {
+        if matches!(self, KernelKind::Fine | KernelKind::DynamicFine) {
             [FINE_WORKGROUP, 1, 1]
         } else if self == KernelKind::RateCoarse {
             [WORK_LIST_WORKGROUP, 1, 1]

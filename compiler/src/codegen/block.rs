@@ -181,23 +181,24 @@ impl Writer<'_, '_, '_> {
             word = format!("select({word}, b.refined{w}, k >= {}u)", 32 * w);
         }
         self.template(0, tail, &[("WORD", &word)]);
+        if self.preloads_corners() {
+            self.corners_function();
+        }
         if self.kind == KernelKind::DynamicFine {
             self.any_refined(mask_words);
             self.fine_level(&Level::DYNAMIC_OUTER);
             self.fine_level(&Level::DYNAMIC_INNER);
         } else {
-            if self.preloads_corners() {
-                self.corners_function();
-            }
             self.fine_level(&Level { suffix: "", block: self.block, buffer: "mrsl_interface", parent: false });
         }
     }
 
-    /// Whether the kernel's resolvers and resamplers take the block's
-    /// corners preloaded (`MrslCorners`): the block modes' fine kernels,
-    /// whose lanes shade [`mrsl_abi::geometry::FINE_PIXELS_PER_LANE`] pixels of one block.
+    /// Whether the kernel's resolvers and resamplers of its first level
+    /// take the block's corners preloaded (`MrslCorners`): the block modes'
+    /// fine kernels and the dynamic fine kernel (its 4x4 level), whose lanes
+    /// shade [`mrsl_abi::geometry::FINE_PIXELS_PER_LANE`] pixels of one block.
     pub(super) fn preloads_corners(&self) -> bool {
-        self.kind == KernelKind::Fine
+        matches!(self.kind, KernelKind::Fine | KernelKind::DynamicFine)
     }
 
     /// `MrslCorners` and `mrsl_corners`: the keys and record words of a block's four coarse samples.
@@ -266,7 +267,7 @@ impl Writer<'_, '_, '_> {
         let resolve =
             if rate { include_str!("templates/rate_resolve.wgsl") } else { include_str!("templates/resolve.wgsl") };
         let [head, corners, refined] = cut(resolve, &["CORNERS", "REFINED"]);
-        let preloaded = self.preloads_corners();
+        let preloaded = self.preloads_corners() && !level.parent;
         let params = if level.parent {
             self.inner_level_note(bk);
             "pos: vec2<i32>, parent: MrslBlock"
@@ -504,7 +505,7 @@ impl Writer<'_, '_, '_> {
                 ("FILTER", &filter),
                 ("VALUE", &value),
             ];
-            if self.preloads_corners() {
+            if self.preloads_corners() && !level.parent {
                 let corner = |lane: &str| unpack_with(&info.ty, |k| format!("c.w{}.{lane}", slot.offset + k));
                 let (v0, v1, v2, v3) = (corner("x"), corner("y"), corner("z"), corner("w"));
                 let values: &super::writer::Values = &[
@@ -557,9 +558,9 @@ impl Writer<'_, '_, '_> {
             self.line(indent, format!("let mrsl_b = mrsl_resolve{name}(mrsl_pos, mrsl_c);"));
         } else if self.kind.is_fine() {
             self.line(indent, format!("let mrsl_b = mrsl_resolve{name}(mrsl_pos);"));
-            if self.kind == KernelKind::DynamicFine {
-                self.resolve_inner(indent, name);
-            }
+        }
+        if self.kind == KernelKind::DynamicFine {
+            self.resolve_inner(indent, name);
         }
     }
 
@@ -591,7 +592,7 @@ impl Writer<'_, '_, '_> {
             return self.compacted_fine_entry();
         }
         match self.kind {
-            KernelKind::Fine => self.tile_pair(),
+            KernelKind::Fine | KernelKind::DynamicFine => self.tile_pair(),
             KernelKind::RateFine => self.tile_pixel_blocks(4),
             kind if kind.is_fine() => self.tile_pixel_blocks(self.block),
             _ => self.tile_pixel_blocks(2),

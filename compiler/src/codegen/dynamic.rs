@@ -126,7 +126,7 @@ impl Writer<'_, '_, '_> {
         let (index, name) = (self.coarse_index[&e], self.effect_name(e));
         if self.i.interface.is_passed(e) {
             self.line(indent, format!("if (!mrsl_is_refined(mrsl_b, {index}u)) {{"));
-            self.line(indent + 1, format!("{name} = mrsl_resample_{}(mrsl_b);", info.name));
+            self.line(indent + 1, format!("{name} = mrsl_resample_{}(mrsl_b, mrsl_c);", info.name));
             self.line(indent, format!("}} else if (!mrsl_is_refined(mrsl_b2, {index}u)) {{"));
             self.line(indent + 1, format!("{name} = mrsl_resample2_{}(mrsl_b2);", info.name));
             self.line(indent, "} else {");

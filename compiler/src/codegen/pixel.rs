@@ -107,7 +107,7 @@ impl Writer<'_, '_, '_> {
         mut coarse: impl FnMut(&mut Self, EffectId, usize),
     ) {
         let [x, y, z] = self.kind.workgroup_size();
-        let pairs = self.kind == KernelKind::Fine;
+        let pairs = matches!(self.kind, KernelKind::Fine | KernelKind::DynamicFine);
         self.template(
             0,
             include_str!("templates/pixel_main.wgsl"),
