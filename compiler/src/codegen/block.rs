@@ -8,12 +8,12 @@
 use super::Writer;
 use super::effects::Key;
 use super::words::{bit, pack_words, test_bit, unpack_with, unpack_words};
-use super::writer::cut;
+use super::writer::{cut, fill};
 use crate::check::EffectId;
 use crate::layout;
 use crate::syntax::ast::Rate;
 use mrsl_abi::KernelKind;
-use mrsl_abi::geometry::DYNAMIC_TAG_WORDS;
+use mrsl_abi::geometry::{DYNAMIC_TAG_WORDS, FINE_PIXELS_PER_LANE};
 use std::collections::{BTreeSet, HashMap};
 
 /// One level of coarse samples as a fine kernel reads it.
@@ -36,6 +36,14 @@ const CORNER_PIXELS: [&str; 4] = ["p0", "vec2<i32>(p1.x, p0.y)", "vec2<i32>(p0.x
 /// image of `size`, as WGSL: the rule of [`mrsl_abi::geometry::sample_grid`].
 pub(super) fn sample_grid(block: u32) -> String {
     format!("(size + vec2<i32>({})) / {block} + vec2<i32>(1)", block as i32 - 2)
+}
+
+/// The statements that place `pos` in its block of a `block` grid: `size`,
+/// the sample grid `n`, the corner samples `i0`/`i1` and their pixels
+/// `p0`/`p1` (in `mrsl_resolve` and `mrsl_corners`).
+fn block_geometry(block: u32) -> String {
+    let text = fill(include_str!("templates/block_geometry.wgsl"), &[("GRID", &sample_grid(block)), ("BLOCK", &block)]);
+    text.trim_end().to_string()
 }
 
 /// Tests of `key` between corner `k00_<key>` and the corners `k10_`, `k01_`,
@@ -196,7 +204,7 @@ impl Writer<'_, '_, '_> {
     /// Whether the kernel's resolvers and resamplers of its first level
     /// take the block's corners preloaded (`MrslCorners`): the block modes'
     /// fine kernels and the dynamic fine kernel (its 4x4 level), whose lanes
-    /// shade [`mrsl_abi::geometry::FINE_PIXELS_PER_LANE`] pixels of one block.
+    /// shade [`FINE_PIXELS_PER_LANE`] pixels of one block.
     pub(super) fn preloads_corners(&self) -> bool {
         matches!(self.kind, KernelKind::Fine | KernelKind::DynamicFine)
     }
@@ -215,8 +223,8 @@ impl Writer<'_, '_, '_> {
         for w in 0..stride {
             self.line(1, format!("w{w}: vec4<u32>,"));
         }
-        let (grid, block) = (sample_grid(self.block), self.block);
-        let values: &super::writer::Values = &[("GRID", &grid), ("BLOCK", &block), ("STRIDE", &stride)];
+        let geometry = block_geometry(self.block);
+        let values: &super::writer::Values = &[("GEOMETRY", &geometry), ("STRIDE", &stride)];
         self.template(0, middle, values);
         for key in &keys {
             let name = key.name;
@@ -280,7 +288,8 @@ impl Writer<'_, '_, '_> {
             Some((effect, _)) => format!("{sfx}_{effect}"),
             None => sfx.to_string(),
         };
-        self.template(0, head, &[("SUFFIX", &name), ("PARAMS", &params), ("GRID", &sample_grid(bk)), ("BLOCK", &bk)]);
+        let geometry = block_geometry(bk);
+        self.template(0, head, &[("SUFFIX", &name), ("PARAMS", &params), ("GEOMETRY", &geometry)]);
         if level.parent {
             self.stale_corners(buf, stride);
         }
@@ -588,14 +597,13 @@ impl Writer<'_, '_, '_> {
         // The reference kernel has no blocks; it lays its tiles out in 2x2 ones.
         // The rate-image mode's cells are at most 4x4: 4x4 blocks keep a cell's pixels on neighbouring lanes.
         if self.compacts() {
-            self.tile_pixel_blocks(self.block);
+            self.tile_pixel_blocks(self.block, 1);
             return self.compacted_fine_entry();
         }
         match self.kind {
-            KernelKind::Fine | KernelKind::DynamicFine => self.tile_pair(),
-            KernelKind::RateFine => self.tile_pixel_blocks(4),
-            kind if kind.is_fine() => self.tile_pixel_blocks(self.block),
-            _ => self.tile_pixel_blocks(2),
+            KernelKind::Fine | KernelKind::DynamicFine => self.tile_pixel_blocks(self.block, FINE_PIXELS_PER_LANE),
+            KernelKind::RateFine => self.tile_pixel_blocks(4, 1),
+            _ => self.tile_pixel_blocks(2, 1),
         }
         let counted = self.counts_stats();
         let coarse = self.coarse_live().len();

@@ -158,7 +158,7 @@ impl Writer<'_, '_, '_> {
         self.line(indent + 1, format!("{var} = mrsl_cv_{}[{lane}];", info.name));
         if self.i.interface.is_passed(e) {
             self.line(indent, "} else {");
-            // The lane's corners were loaded before the barriers; loading them again is cheaper than keeping them.
+            // The corners are not kept across the barriers: each position loads its own again.
             self.line(indent + 1, format!("{var} = mrsl_resample_{}(mrsl_b, mrsl_corners(mrsl_pos));", info.name));
         }
         self.line(indent, "}");

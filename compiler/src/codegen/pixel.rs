@@ -53,31 +53,28 @@ impl Writer<'_, '_, '_> {
     }
 
     /// `mrsl_tile_pixel` for tiles shaded in `block`x`block` blocks: consecutive
-    /// lanes cover whole blocks.
-    pub(super) fn tile_pixel_blocks(&mut self, block: u32) {
-        self.template(
-            0,
-            include_str!("templates/tile_pixel_blocks.wgsl"),
-            &[("TILE", &TILE), ("BLOCK", &block), ("PER_BLOCK", &(block * block)), ("BLOCKS_X", &(TILE / block))],
-        );
-    }
-
-    /// `mrsl_tile_pair` for the block modes' fine kernels: the first of the
-    /// [`FINE_PIXELS_PER_LANE`] pixels a lane shades in one block.
-    pub(super) fn tile_pair(&mut self) {
-        let block = self.block;
-        assert_eq!(block % FINE_PIXELS_PER_LANE, 0, "a block's rows split evenly among a lane's pixels");
-        self.template(
-            0,
-            include_str!("templates/tile_pair.wgsl"),
-            &[
-                ("TILE", &TILE),
-                ("BLOCK", &block),
-                ("HALF", &(block / FINE_PIXELS_PER_LANE)),
-                ("PER_BLOCK", &(block * block / FINE_PIXELS_PER_LANE)),
-                ("BLOCKS_X", &(TILE / block)),
-            ],
-        );
+    /// lanes cover whole blocks. With `per_lane` pixels per lane (the block
+    /// fine kernels' [`FINE_PIXELS_PER_LANE`]), the lane's first pixel; the
+    /// others lie `block / per_lane` rows apart in the same block.
+    pub(super) fn tile_pixel_blocks(&mut self, block: u32, per_lane: u32) {
+        assert_eq!(block % per_lane, 0, "a block's rows split evenly among a lane's pixels");
+        let values: &super::writer::Values = &[
+            ("TILE", &TILE),
+            ("BLOCK", &block),
+            ("PER_BLOCK", &(block * block / per_lane)),
+            ("BLOCKS_X", &(TILE / block)),
+        ];
+        let [comment, function] = cut(include_str!("templates/tile_pixel_blocks.wgsl"), &["LANES"]);
+        self.template(0, comment, values);
+        if per_lane > 1 {
+            let rows = block / per_lane;
+            self.line(
+                0,
+                format!("// With {per_lane} pixels per lane, the lane's first: the others follow at steps of"),
+            );
+            self.line(0, format!("// +(0, {rows}) in the same block and share its coarse samples."));
+        }
+        self.template(0, function, values);
     }
 
     /// `mrsl_tile_pixel` for tiles shaded in row-major order.
@@ -114,7 +111,7 @@ impl Writer<'_, '_, '_> {
             &[
                 ("WORKGROUP", &format!("{x}, {y}, {z}")),
                 ("ENTRY", &self.kind.main_entry_point()),
-                ("TILE_PIXEL", &if pairs { "mrsl_first = mrsl_tile_pair" } else { "mrsl_pos = mrsl_tile_pixel" }),
+                ("FIRST", &if pairs { "mrsl_first" } else { "mrsl_pos" }),
             ],
         );
         let counted = self.counts_stats();

@@ -71,7 +71,7 @@ impl Code {
 }
 
 /// `template` with every `{{NAME}}` replaced by the value given for `NAME`.
-fn fill(template: &str, values: &Values) -> String {
+pub(super) fn fill(template: &str, values: &Values) -> String {
     let mut out = String::with_capacity(template.len());
     let mut rest = template;
     while let Some(start) = rest.find("{{") {

@@ -8,12 +8,7 @@ struct MrslCorners {
 }
 
 fn mrsl_corners(pos: vec2<i32>) -> MrslCorners {
-    let size = vec2<i32>(mrsl_ctl.size);
-    let n = {{GRID}};
-    let i0 = pos / {{BLOCK}};
-    let i1 = min(i0 + vec2<i32>(1), n - vec2<i32>(1));
-    let p0 = min(i0 * {{BLOCK}}, size - vec2<i32>(1));
-    let p1 = min(i1 * {{BLOCK}}, size - vec2<i32>(1));
+{{GEOMETRY}}
     var c: MrslCorners;
     c.index = vec4<u32>(u32(i0.y * n.x + i0.x), u32(i0.y * n.x + i1.x), u32(i1.y * n.x + i0.x), u32(i1.y * n.x + i1.x));
     let s = c.index * {{STRIDE}}u;

@@ -1,3 +1,3 @@
 @compute @workgroup_size({{WORKGROUP}})
 fn {{ENTRY}}(@builtin(workgroup_id) mrsl_wg: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {
-    let {{TILE_PIXEL}}(mrsl_wg.xy, mrsl_li);
+    let {{FIRST}} = mrsl_tile_pixel(mrsl_wg.xy, mrsl_li);

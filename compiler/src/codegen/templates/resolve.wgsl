@@ -1,10 +1,5 @@
 fn mrsl_resolve{{SUFFIX}}({{PARAMS}}) -> MrslBlock {
-    let size = vec2<i32>(mrsl_ctl.size);
-    let n = {{GRID}};
-    let i0 = pos / {{BLOCK}};
-    let i1 = min(i0 + vec2<i32>(1), n - vec2<i32>(1));
-    let p0 = min(i0 * {{BLOCK}}, size - vec2<i32>(1));
-    let p1 = min(i1 * {{BLOCK}}, size - vec2<i32>(1));
+{{GEOMETRY}}
     let extent = p1 - p0;
     let t = select(vec2<f32>(0.0), vec2<f32>(pos - p0) / vec2<f32>(max(extent, vec2<i32>(1))), extent > vec2<i32>(0));
     var b: MrslBlock;

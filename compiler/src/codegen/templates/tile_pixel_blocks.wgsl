@@ -1,5 +1,6 @@
 // Pixel of a {{TILE}}x{{TILE}} tile for lane `li`: {{BLOCK}}x{{BLOCK}} blocks are laid out so that
 // consecutive lanes (a SIMD group) cover whole blocks and share their refine decisions.
+{{#LANES}}
 fn mrsl_tile_pixel(wg: vec2<u32>, li: u32) -> vec2<i32> {
     let per_block = {{PER_BLOCK}}u;
     let blocks_x = {{BLOCKS_X}}u;
