@@ -53,6 +53,14 @@ pub const HIERARCHICAL_QUEUE_BYTES: u64 = (HIERARCHICAL_LEVEL_COUNT * QUEUE_WORD
 /// The largest storage binding the runtime relies on (WebGPU's default limit).
 pub const MAX_STORAGE_BINDING_BYTES: u64 = 128 << 20;
 
+/// The largest side of a 2D texture the runtime relies on (WebGPU's default
+/// `maxTextureDimension2D`): the record texture's sample grid must fit it.
+pub const MAX_TEXTURE_SIDE: u32 = 8192;
+
+/// The most layers of a texture array the runtime relies on (WebGPU's
+/// default `maxTextureArrayLayers`): the record texture's layers must fit it.
+pub const MAX_TEXTURE_LAYERS: u32 = 256;
+
 /// The largest image side the runtime accepts.
 pub const MAX_SIDE: u32 = 16384;
 

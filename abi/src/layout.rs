@@ -10,7 +10,7 @@ use crate::types::{SampleType, TextureFormat, ValueType};
 use serde::{Deserialize, Serialize};
 
 /// The layout format this crate reads and writes (the `format` field).
-pub const LAYOUT_FORMAT: &str = "mrsl-layout/4";
+pub const LAYOUT_FORMAT: &str = "mrsl-layout/5";
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Layout {
@@ -75,24 +75,25 @@ impl Layout {
         let h = &self.hierarchical;
         let buffer =
             |slot, binding, read_only| StageBinding { binding, slot, resource: StageResource::Buffer { read_only } };
+        // The block modes' coarse samples: a texture array of records ([`InterfaceLayout`]).
+        let records = |resource| StageBinding { binding: self.interface.binding, slot: S::Interface, resource };
         let shading_rate = StageBinding {
             binding: self.shading_rate.binding,
             slot: S::ShadingRate,
             resource: StageResource::UintTexture,
         };
         let mut bindings = match kind {
-            KernelKind::Coarse => vec![buffer(S::Interface, self.interface.binding, false)],
-            KernelKind::Fine => vec![buffer(S::Interface, self.interface.binding, true)],
+            KernelKind::Coarse => vec![records(StageResource::RecordStorageTexture)],
+            KernelKind::Fine => vec![records(StageResource::RecordTexture)],
             // Reads the 4x4 level, writes the 2x2 level and counts its samples.
             KernelKind::DynamicCoarse => vec![
-                buffer(S::Interface, self.interface.binding, true),
+                records(StageResource::RecordTexture),
                 buffer(S::Interface2, self.interface2.binding, false),
                 buffer(S::Stats, self.stats.binding, false),
             ],
-            KernelKind::DynamicFine => vec![
-                buffer(S::Interface, self.interface.binding, true),
-                buffer(S::Interface2, self.interface2.binding, true),
-            ],
+            KernelKind::DynamicFine => {
+                vec![records(StageResource::RecordTexture), buffer(S::Interface2, self.interface2.binding, true)]
+            }
             KernelKind::Reference => vec![],
             KernelKind::Hierarchical => vec![
                 buffer(S::Records, h.values_binding, false),
@@ -141,7 +142,9 @@ pub struct StageBinding {
 /// The runtime-owned (or engine-owned, for outputs) resource a stage binding takes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StageSlot {
-    /// The coarse samples of the mode's block size (the dynamic mode's 4x4 level).
+    /// The coarse samples of the mode's block size (the dynamic mode's 4x4
+    /// level): the record texture of [`InterfaceLayout`]; in the rate-image
+    /// mode a buffer of one record per pixel.
     Interface,
     /// The dynamic mode's 2x2 level (tagged records).
     Interface2,
@@ -170,6 +173,13 @@ pub enum StageResource {
     StorageTexture(TextureFormat),
     /// A sampled `texture_2d<u32>` read with `textureLoad` (the shading-rate image).
     UintTexture,
+    /// The block modes' records, as the fine kernels read them: a sampled
+    /// `texture_2d_array<u32>` of format `rgba32uint` ([`InterfaceLayout`]),
+    /// read with `textureLoad`.
+    RecordTexture,
+    /// The same texture as the coarse kernel writes it: a write-only
+    /// `texture_storage_2d_array<rgba32uint, write>`.
+    RecordStorageTexture,
 }
 
 /// Buffers of the hierarchical and checkerboard modes (group 2): a record per
@@ -294,7 +304,16 @@ pub enum KeyCompare {
     Threshold { threshold: f64 },
 }
 
-/// The coarse-to-fine interface buffer of the block modes.
+/// The coarse-to-fine interface of the block modes: a record per coarse
+/// sample. The block modes (and the dynamic mode's 4x4 level) keep the
+/// records in an `rgba32uint` texture array of `nx` x `ny` texels (the
+/// sample grid, [`InterfaceLayout::samples`]) and [`InterfaceLayout::layers`]
+/// layers: word `w` of sample `(i, j)` is component `w % 4` of texel `(i, j)`
+/// of layer `w / 4`. (A texture and not a storage buffer: llvmpipe loads a
+/// storage-buffer word lane by lane behind a branch, a texel for all lanes
+/// at once, about 6x cheaper for the fine kernels' corner loads.) The
+/// rate-image mode keeps one record per pixel in a storage buffer of
+/// `stride_words` words per record.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct InterfaceLayout {
     pub group: u32,
@@ -309,6 +328,16 @@ pub struct InterfaceLayout {
     /// How many coarse samples there are for a `W`x`H` image and block size `B`
     /// ([`crate::geometry::SAMPLE_GRID_RULE`]).
     pub samples: String,
+}
+
+impl InterfaceLayout {
+    /// Words per texel of the record texture.
+    pub const WORDS_PER_TEXEL: u32 = 4;
+
+    /// Layers of the record texture: the record's words, four per texel (at least one).
+    pub fn layers(&self) -> u32 {
+        self.stride_words.div_ceil(Self::WORDS_PER_TEXEL).max(1)
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -3,7 +3,10 @@
 
 use crate::error::Error;
 use crate::{Mode, Stats};
-use mrsl_abi::geometry::{self, HIERARCHICAL_LEVEL0, HIERARCHICAL_LEVELS, MAX_SIDE, MAX_STORAGE_BINDING_BYTES};
+use mrsl_abi::geometry::{
+    self, HIERARCHICAL_LEVEL0, HIERARCHICAL_LEVELS, MAX_SIDE, MAX_STORAGE_BINDING_BYTES, MAX_TEXTURE_LAYERS,
+    MAX_TEXTURE_SIDE,
+};
 use mrsl_abi::{
     BINDING_ARGS, CompiledProgram, Control, GROUP_ARGS, KernelKind, Layout, SampleType, Scalar, StageResource,
     StageSlot, TextureFormat, ValueType, entry,
@@ -121,8 +124,11 @@ pub struct Shader {
     control: wgpu::Buffer,
     uniforms: Option<wgpu::Buffer>,
     uniform_values: HashMap<String, Vec<f64>>,
-    /// Interface buffers by (block size, tagged), with the size they were made for.
+    /// Interface buffers by (block size, tagged), with the size they were made
+    /// for: the dynamic mode's 2x2 level and the rate-image mode's records.
     interfaces: HashMap<(u32, bool), (wgpu::Buffer, (u32, u32))>,
+    /// The block modes' record textures by block size, with the size they were made for.
+    record_textures: HashMap<u32, (wgpu::TextureView, (u32, u32))>,
     /// Dispatch counter, written to the control block (validity tags of the dynamic mode).
     frame: u32,
     /// The fine kernel's per-pixel refine mask, with the size it was made for.
@@ -266,6 +272,7 @@ impl Shader {
             uniforms,
             uniform_values: HashMap::new(),
             interfaces: HashMap::new(),
+            record_textures: HashMap::new(),
             frame: 0,
             rate: None,
             stats,
@@ -358,7 +365,15 @@ impl Shader {
         };
         let pixels = u64::from(width) * u64::from(height);
         if let Some(block) = mode.block_size() {
-            fits("the interface", samples(block) * u64::from(self.layout.interface.stride_words))?;
+            let (nx, ny) = geometry::sample_grid(bindings.size, block);
+            let layers = self.layout.interface.layers();
+            if nx.max(ny) > MAX_TEXTURE_SIDE || layers > MAX_TEXTURE_LAYERS {
+                let reason = format!(
+                    "the record texture would need {nx}x{ny} texels and {layers} layers, more than \
+                     {MAX_TEXTURE_SIDE}x{MAX_TEXTURE_SIDE} texels and {MAX_TEXTURE_LAYERS} layers"
+                );
+                return Err(Error::BadSize { width, height, reason });
+            }
         }
         if mode == Mode::Dynamic {
             let words = u64::from(self.layout.interface.stride_words + geometry::DYNAMIC_TAG_WORDS);
@@ -489,7 +504,7 @@ impl Shader {
         } else {
             match mode.block_size() {
                 None => {
-                    let stage = self.stage_group(device, KernelKind::Reference, None, None, &views, None);
+                    let stage = self.stage_group(device, KernelKind::Reference, Interface::None, None, &views, None);
                     self.pass(
                         encoder,
                         "mrsl reference",
@@ -500,7 +515,7 @@ impl Shader {
                     );
                 }
                 Some(block) => {
-                    let interface = self.interface(device, block, false, bindings.size).clone();
+                    let records = self.record_texture(device, block, bindings.size).clone();
                     self.ensure_rate_image(device, bindings.size);
                     let dynamic = mode == Mode::Dynamic;
                     let inner = if dynamic {
@@ -508,11 +523,10 @@ impl Shader {
                     } else {
                         None
                     };
-                    let coarse_stage =
-                        self.stage_group(device, KernelKind::Coarse, Some(&interface), None, &views, None);
+                    let interface = Interface::Records(&records);
+                    let coarse_stage = self.stage_group(device, KernelKind::Coarse, interface, None, &views, None);
                     let fine_kind = if dynamic { KernelKind::DynamicFine } else { KernelKind::Fine };
-                    let fine_stage =
-                        self.stage_group(device, fine_kind, Some(&interface), inner.as_ref(), &views, None);
+                    let fine_stage = self.stage_group(device, fine_kind, interface, inner.as_ref(), &views, None);
                     self.pass(
                         encoder,
                         "mrsl coarse",
@@ -525,7 +539,7 @@ impl Shader {
                         let stage = self.stage_group(
                             device,
                             KernelKind::DynamicCoarse,
-                            Some(&interface),
+                            interface,
                             inner.as_ref(),
                             &views,
                             None,
@@ -621,9 +635,9 @@ impl Shader {
         self.ensure_rate_image(device, size);
         self.ensure_rate_buffers(device, size);
         let shading_rate = bindings.shading_rate.expect("validated").create_view(&Default::default());
-        let coarse =
-            self.stage_group(device, KernelKind::RateCoarse, Some(&interface), None, views, Some(&shading_rate));
-        let fine = self.stage_group(device, KernelKind::RateFine, Some(&interface), None, views, Some(&shading_rate));
+        let interface = Interface::Buffer(&interface);
+        let coarse = self.stage_group(device, KernelKind::RateCoarse, interface, None, views, Some(&shading_rate));
+        let fine = self.stage_group(device, KernelKind::RateFine, interface, None, views, Some(&shading_rate));
         let (buffers, _) = self.rate_buffers.as_ref().expect("created above");
         encoder.clear_buffer(&buffers.queue, 0, None);
         let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -733,7 +747,7 @@ impl Shader {
     ) -> wgpu::BindGroup {
         self.ensure_rate_image(device, size);
         self.ensure_hier_buffers(device, size);
-        self.stage_group(device, kind, None, None, views, None)
+        self.stage_group(device, kind, Interface::None, None, views, None)
     }
 
     fn ensure_hier_buffers(&mut self, device: &wgpu::Device, size: (u32, u32)) {
@@ -816,6 +830,32 @@ impl Shader {
         &self.interfaces[&(block, tagged)].0
     }
 
+    /// The record texture of the block modes for `block`, (re)created when
+    /// the size changes: the sample grid in texels, a layer per four words
+    /// of a record ([`mrsl_abi::InterfaceLayout`]).
+    fn record_texture(&mut self, device: &wgpu::Device, block: u32, size: (u32, u32)) -> &wgpu::TextureView {
+        let fresh = self.record_textures.get(&block).is_none_or(|(_, s)| *s != size);
+        if fresh {
+            let (nx, ny) = geometry::sample_grid(size, block);
+            let texture = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("mrsl records"),
+                size: wgpu::Extent3d { width: nx, height: ny, depth_or_array_layers: self.layout.interface.layers() },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba32Uint,
+                usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            });
+            let view = texture.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            });
+            self.record_textures.insert(block, (view, size));
+        }
+        &self.record_textures[&block].0
+    }
+
     fn resources_group(&self, device: &wgpu::Device, bindings: &Bindings) -> wgpu::BindGroup {
         let l = &self.layout;
         let mut entries =
@@ -862,13 +902,14 @@ impl Shader {
 
     /// Group 2 of the kernel of `kind`: every binding the layout says it
     /// declares ([`Layout::stage_bindings`]), each bound to what its slot names.
-    /// `interface` and `inner` are the block modes' interface buffers; the
-    /// rate image and the record buffers must exist when the kernel uses them.
+    /// `interface` is the mode's coarse samples and `inner` the dynamic
+    /// mode's 2x2 level; the rate image and the record buffers must exist
+    /// when the kernel uses them.
     fn stage_group(
         &self,
         device: &wgpu::Device,
         kind: KernelKind,
-        interface: Option<&wgpu::Buffer>,
+        interface: Interface<'_>,
         inner: Option<&wgpu::Buffer>,
         outputs: &HashMap<&str, wgpu::TextureView>,
         shading_rate: Option<&wgpu::TextureView>,
@@ -886,7 +927,11 @@ impl Shader {
             .map(|b| wgpu::BindGroupEntry {
                 binding: b.binding,
                 resource: match b.slot {
-                    StageSlot::Interface => interface.expect(needed).as_entire_binding(),
+                    StageSlot::Interface => match interface {
+                        Interface::Records(view) => wgpu::BindingResource::TextureView(view),
+                        Interface::Buffer(buffer) => buffer.as_entire_binding(),
+                        Interface::None => panic!("the interface is {needed}"),
+                    },
                     StageSlot::Interface2 => inner.expect(needed).as_entire_binding(),
                     StageSlot::Stats => self.stats.as_entire_binding(),
                     StageSlot::RateImage => wgpu::BindingResource::TextureView(rate_view.as_ref().expect(needed)),
@@ -1132,6 +1177,17 @@ fn gbuffer_layout(device: &wgpu::Device, l: &Layout) -> wgpu::BindGroupLayout {
         .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("mrsl g-buffer"), entries: &entries })
 }
 
+/// What a stage group binds as the interface ([`StageSlot::Interface`]).
+#[derive(Clone, Copy)]
+enum Interface<'a> {
+    /// The block modes' record texture.
+    Records(&'a wgpu::TextureView),
+    /// The rate-image mode's record buffer.
+    Buffer(&'a wgpu::Buffer),
+    /// None: the kernel binds no interface.
+    None,
+}
+
 fn stage_layout(device: &wgpu::Device, l: &Layout, kind: KernelKind) -> wgpu::BindGroupLayout {
     let entries: Vec<wgpu::BindGroupLayoutEntry> = l
         .stage_bindings(kind)
@@ -1154,6 +1210,16 @@ fn stage_layout(device: &wgpu::Device, l: &Layout, kind: KernelKind) -> wgpu::Bi
                     sample_type: wgpu::TextureSampleType::Uint,
                     view_dimension: wgpu::TextureViewDimension::D2,
                     multisampled: false,
+                },
+                StageResource::RecordTexture => wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Uint,
+                    view_dimension: wgpu::TextureViewDimension::D2Array,
+                    multisampled: false,
+                },
+                StageResource::RecordStorageTexture => wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: wgpu::TextureFormat::Rgba32Uint,
+                    view_dimension: wgpu::TextureViewDimension::D2Array,
                 },
             },
             count: None,

@@ -79,6 +79,16 @@ pub fn binding_mismatches_are_typed_errors(gpu: &Gpu) {
         }
         other => panic!("expected a size error, got {other:?}"),
     }
+    // A target whose 2x2 sample grid is wider than a texture side the runtime
+    // relies on (8192): the record texture could not be made.
+    bindings.size = (16384, 8);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    match shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, DispatchOptions::new(Mode::Coarse2x2)) {
+        Err(Error::BadSize { reason, .. }) => {
+            assert!(reason.contains("record texture") && reason.contains("8193x5"), "{reason}")
+        }
+        other => panic!("expected a size error, got {other:?}"),
+    }
     bindings.size = (16, 8);
     // And with everything right, it runs.
     dispatch(gpu, &mut shader, &bindings).unwrap();

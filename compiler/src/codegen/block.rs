@@ -31,6 +31,8 @@ pub(super) struct Level {
 /// pixels their keys are loaded at (in `mrsl_resolve` and `mrsl_corners`).
 const CORNERS: [&str; 4] = ["k00", "k10", "k01", "k11"];
 const CORNER_PIXELS: [&str; 4] = ["p0", "vec2<i32>(p1.x, p0.y)", "vec2<i32>(p0.x, p1.y)", "p1"];
+/// The corners' record texels in `mrsl_corners`, in the same order (`r00_<layer>`, ...).
+const TEXELS: [&str; 4] = ["r00", "r10", "r01", "r11"];
 
 /// The number of coarse samples along each axis of a `block` grid over an
 /// image of `size`, as WGSL: the rule of [`mrsl_abi::geometry::sample_grid`].
@@ -57,18 +59,42 @@ pub(super) fn corners_differ(key: &Key) -> Vec<String> {
 }
 
 impl Writer<'_, '_, '_> {
-    /// The interface buffer of the coarse (written) and fine (read) kernels.
+    /// The interface of the coarse (written) and fine (read) kernels: the
+    /// block modes' record texture, or the rate-image mode's buffer.
     pub(super) fn interface_bindings(&mut self) {
         let l = self.i.layout;
-        let access =
-            if matches!(self.kind, KernelKind::Coarse | KernelKind::RateCoarse) { "read_write" } else { "read" };
-        self.template(
-            0,
-            include_str!("templates/interface.wgsl"),
-            &[("GROUP", &l.interface.group), ("BINDING", &l.interface.binding), ("ACCESS", &access)],
-        );
+        let values: &super::writer::Values = &[("GROUP", &l.interface.group), ("BINDING", &l.interface.binding)];
+        match self.kind {
+            KernelKind::Coarse => self.template(0, include_str!("templates/records_write.wgsl"), values),
+            KernelKind::Fine | KernelKind::DynamicFine => {
+                self.template(0, include_str!("templates/records_read.wgsl"), values)
+            }
+            _ => {
+                let access = if self.kind == KernelKind::RateCoarse { "read_write" } else { "read" };
+                let values: &super::writer::Values =
+                    &[("GROUP", &l.interface.group), ("BINDING", &l.interface.binding), ("ACCESS", &access)];
+                self.template(0, include_str!("templates/interface.wgsl"), values)
+            }
+        }
         if self.kind == KernelKind::DynamicFine {
             self.inner_interface_binding();
+        }
+    }
+
+    /// Whether the kernel writes its records as texels of the record
+    /// texture (the block coarse kernel) rather than as buffer words.
+    fn writes_record_texels(&self) -> bool {
+        self.kind == KernelKind::Coarse
+    }
+
+    /// The statement storing `value` as word `word` of this sample's record:
+    /// into the word's local (flushed to the record texture at the end of
+    /// the kernel) or into the interface buffer.
+    fn record_word_store(&self, word: u32, value: &str) -> String {
+        if self.writes_record_texels() {
+            format!("mrsl_w{word} = {value};")
+        } else {
+            format!("mrsl_interface[mrsl_rec + {word}u] = {value};")
         }
     }
 
@@ -87,11 +113,18 @@ impl Writer<'_, '_, '_> {
             include_str!("templates/coarse_main.wgsl")
         };
         let [head, tail] = cut(main, &["BODY"]);
+        // Where the sample's record starts in a buffer; the record texture is addressed by `mrsl_pos`.
+        let record = if self.writes_record_texels() {
+            String::new()
+        } else {
+            "\n    let mrsl_rec = (mrsl_gid.y * u32(mrsl_n.x) + mrsl_gid.x) * MRSL_STRIDE;".to_string()
+        };
         self.template(
             0,
             head,
             &[
                 ("WORKGROUP", &format!("{x}, {y}, {z}")),
+                ("RECORD", &record),
                 ("ENTRY", &self.kind.main_entry_point()),
                 ("WORK_GROUP", &x),
                 ("MAX_X", &mrsl_abi::geometry::RATE_ARGS_MAX_X),
@@ -99,6 +132,14 @@ impl Writer<'_, '_, '_> {
         );
         if self.kind == KernelKind::DynamicCoarse {
             self.dynamic_coarse_gate();
+        }
+        let stride = iface.stride;
+        if self.writes_record_texels() {
+            // Words are gathered in locals and stored a texel at a time; a word no
+            // effect writes here (a shared slot's other effect) is stored as 0.
+            for w in 0..stride {
+                self.line(1, format!("var mrsl_w{w} = 0u;"));
+            }
         }
         let coarse = self.coarse_live();
         for &e in &coarse {
@@ -111,7 +152,10 @@ impl Writer<'_, '_, '_> {
             for &e in &coarse {
                 self.set_refine_flag(e, 1);
             }
-            self.store_flag_words(iface.flag_words, "mrsl_interface", "mrsl_rec");
+            for w in 0..iface.flag_words {
+                let store = self.record_word_store(w, &format!("mrsl_flags{w}"));
+                self.line(1, store);
+            }
         }
         for (k, slot) in iface.slots.iter().enumerate() {
             let names: Vec<&str> = slot.effects.iter().map(|e| c.effects[e.index()].name.as_str()).collect();
@@ -121,11 +165,8 @@ impl Writer<'_, '_, '_> {
             );
             for &e in &slot.effects {
                 let words = pack_words(&self.effect_name(e), &c.effects[e.index()].ty);
-                let writes: Vec<String> = words
-                    .iter()
-                    .enumerate()
-                    .map(|(j, w)| format!("mrsl_interface[mrsl_rec + {}u] = {w};", slot.offset as usize + j))
-                    .collect();
+                let writes: Vec<String> =
+                    words.iter().enumerate().map(|(j, w)| self.record_word_store(slot.offset + j as u32, w)).collect();
                 if slot.effects.len() > 1 {
                     // A shared slot holds whichever effect this sample's own flags say is passed.
                     let cond = self.store_condition(e, &|bit| test_bit("mrsl_flags", bit));
@@ -139,6 +180,17 @@ impl Writer<'_, '_, '_> {
                         self.line(1, wline);
                     }
                 }
+            }
+        }
+        if self.writes_record_texels() {
+            for layer in 0..stride.div_ceil(4) {
+                let words: Vec<String> = (4 * layer..4 * layer + 4)
+                    .map(|w| if w < stride { format!("mrsl_w{w}") } else { "0u".to_string() })
+                    .collect();
+                self.line(
+                    1,
+                    format!("textureStore(mrsl_interface, mrsl_pos, {layer}, vec4<u32>({}));", words.join(", ")),
+                );
             }
         }
         self.template(0, tail, &[]);
@@ -223,8 +275,11 @@ impl Writer<'_, '_, '_> {
         for w in 0..stride {
             self.line(1, format!("w{w}: vec4<u32>,"));
         }
+        if keys.is_empty() && stride == 0 {
+            self.line(1, "none: u32, // a WGSL structure has at least one member");
+        }
         let geometry = block_geometry(self.block);
-        let values: &super::writer::Values = &[("GEOMETRY", &geometry), ("STRIDE", &stride)];
+        let values: &super::writer::Values = &[("GEOMETRY", &geometry)];
         self.template(0, middle, values);
         for key in &keys {
             let name = key.name;
@@ -232,10 +287,17 @@ impl Writer<'_, '_, '_> {
                 self.line(1, format!("c.{corner}_{name} = mrsl_load_{name}({at});"));
             }
         }
-        for w in 0..stride {
-            let words: Vec<String> =
-                ["x", "y", "z", "w"].iter().map(|l| format!("mrsl_interface[s.{l} + {w}u]")).collect();
-            self.line(1, format!("c.w{w} = vec4<u32>({});", words.join(", ")));
+        // A texel holds four words of a record: one load per corner and texel.
+        let texels = ["i0", "vec2<i32>(i1.x, i0.y)", "vec2<i32>(i0.x, i1.y)", "i1"];
+        for layer in 0..stride.div_ceil(4) {
+            for (corner, at) in TEXELS.iter().zip(texels) {
+                self.line(1, format!("let {corner}_{layer} = textureLoad(mrsl_interface, {at}, {layer}, 0);"));
+            }
+            for w in 4 * layer..(4 * layer + 4).min(stride) {
+                let lane = ["x", "y", "z", "w"][(w % 4) as usize];
+                let words: Vec<String> = TEXELS.iter().map(|corner| format!("{corner}_{layer}.{lane}")).collect();
+                self.line(1, format!("c.w{w} = vec4<u32>({});", words.join(", ")));
+            }
         }
         self.template(0, tail, values);
     }

@@ -58,8 +58,12 @@ impl Writer<'_, '_, '_> {
         let block = DYNAMIC_OUTER_BLOCK;
         let [head, flags, keys] = cut(include_str!("templates/parent_refined.wgsl"), &["FLAGS", "KEYS"]);
         self.template(0, head, &[("GRID", &sample_grid(block)), ("BLOCK", &block)]);
+        for layer in 0..iface.flag_words.div_ceil(4) {
+            self.line(3, format!("let t{layer} = textureLoad(mrsl_parent, corners[j], {layer}, 0);"));
+        }
         for w in 0..iface.flag_words {
-            self.line(3, format!("refined = refined || mrsl_parent[s * {}u + {w}u] != 0u;", iface.stride));
+            let lane = ["x", "y", "z", "w"][(w % 4) as usize];
+            self.line(3, format!("refined = refined || t{}.{lane} != 0u;", w / 4));
         }
         self.template(0, flags, &[]);
         // Conservative: the inner samples are needed where any coarse effect

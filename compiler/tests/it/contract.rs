@@ -48,9 +48,9 @@ fn compiled_programs_read_back_from_their_files_unchanged() {
 fn foreign_or_broken_layouts_are_refused() {
     let program = mrsl::compile(&examples()[0].1, &Options::default()).unwrap();
     let json = program.layout.to_json();
-    let other_version = json.replacen("mrsl-layout/4", "mrsl-layout/2", 1);
+    let other_version = json.replacen(mrsl_abi::LAYOUT_FORMAT, "mrsl-layout/2", 1);
     let message = Layout::from_json(&other_version).unwrap_err();
-    assert!(message.contains("mrsl-layout/2") && message.contains("mrsl-layout/4"), "{message}");
+    assert!(message.contains("mrsl-layout/2") && message.contains(mrsl_abi::LAYOUT_FORMAT), "{message}");
     // A format the runtime could only guess at is an error, not rgba32float.
     let first_format = program.layout.channels[0].format.name();
     let bad_format = json.replacen(&format!("\"format\": \"{first_format}\""), "\"format\": \"bgra8unorm\"", 1);
@@ -97,6 +97,10 @@ fn kernels_declare_the_stage_bindings_of_the_contract() {
                         StageResource::Buffer { read_only: false }
                     } else if decl.contains("texture_2d<u32>") {
                         StageResource::UintTexture
+                    } else if decl.contains("texture_2d_array<u32>") {
+                        StageResource::RecordTexture
+                    } else if decl.contains("texture_storage_2d_array<rgba32uint, write>") {
+                        StageResource::RecordStorageTexture
                     } else {
                         let format = decl.split("texture_storage_2d<").nth(1).unwrap().split(',').next().unwrap();
                         StageResource::StorageTexture(format.parse::<TextureFormat>().unwrap())

@@ -3,15 +3,12 @@
 // of their records (`w<w>`: c00, c10, c01, c11). A lane loads them once for the pixels
 // it shades in the block; the shader compiler drops the loads a caller never reads.
 struct MrslCorners {
-    index: vec4<u32>, // coarse samples c00, c10, c01, c11
 {{#FIELDS}}
 }
 
 fn mrsl_corners(pos: vec2<i32>) -> MrslCorners {
 {{GEOMETRY}}
     var c: MrslCorners;
-    c.index = vec4<u32>(u32(i0.y * n.x + i0.x), u32(i0.y * n.x + i1.x), u32(i1.y * n.x + i0.x), u32(i1.y * n.x + i1.x));
-    let s = c.index * {{STRIDE}}u;
 {{#LOADS}}
     return c;
 }

@@ -8,7 +8,6 @@ fn mrsl_parent_refined(p: vec2<i32>) -> bool {
         let i1 = min(i0 + vec2<i32>(1), n - vec2<i32>(1));
         let corners = array<vec2<i32>, 4>(i0, vec2<i32>(i1.x, i0.y), vec2<i32>(i0.x, i1.y), i1);
         for (var j = 0; j < 4; j++) {
-            let s = u32(corners[j].y * n.x + corners[j].x);
 {{#FLAGS}}
         }
 {{#KEYS}}

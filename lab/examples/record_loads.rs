@@ -1,0 +1,143 @@
+//! Micro-benchmark behind the block modes' record texture: what reading the
+//! four coarse samples' records around a block costs each fine-kernel lane
+//! as storage-buffer words against texels of an `rgba32uint` texture array,
+//! at 1920x1080 with two pixels per lane and six words per record (the
+//! sponza_lights workload's figures).
+//!
+//! `cargo run --release -p mrsl-lab --example record_loads [ROUNDS]`
+//!
+//! The three kernels run interleaved (the order rotates every round), each
+//! timed over 4 dispatches; it prints the median time of each and the
+//! median over rounds of each load kernel's time above the store-only
+//! kernel's, so that a slow moment of a shared machine weighs on all three.
+
+use mrsl_lab::gpu::Gpu;
+use std::time::Instant;
+
+const SIZE: (u32, u32) = (1920, 1080);
+const BLOCK: u32 = 4;
+const STRIDE: u32 = 6;
+const LAYERS: u32 = STRIDE.div_ceil(4);
+const DISPATCHES: u32 = 4;
+
+fn main() {
+    let rounds: usize = std::env::args().nth(1).map_or(9, |a| a.parse().expect("ROUNDS is a number"));
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    println!("adapter: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let grid = (SIZE.0 / BLOCK + 2, SIZE.1 / BLOCK + 2);
+    let texels = (grid.0 * grid.1 * LAYERS) as usize;
+    let words: Vec<u32> = (0..4 * texels as u32).map(|i| i.wrapping_mul(2_654_435_761)).collect();
+    let bytes: &[u8] = bytemuck::cast_slice(&words);
+
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("records as words"),
+        size: bytes.len() as u64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    queue.write_buffer(&buffer, 0, bytes);
+    let extent = wgpu::Extent3d { width: grid.0, height: grid.1, depth_or_array_layers: LAYERS };
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("records as texels"),
+        size: extent,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba32Uint,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let layout =
+        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(grid.0 * 16), rows_per_image: Some(grid.1) };
+    queue.write_texture(texture.as_image_copy(), bytes, layout, extent);
+    let out = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("out"),
+        size: wgpu::Extent3d { width: SIZE.0, height: SIZE.1, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::R32Uint,
+        usage: wgpu::TextureUsages::STORAGE_BINDING,
+        view_formats: &[],
+    });
+
+    let source = include_str!("record_loads.wgsl").replace("{{GRID_X}}", &grid.0.to_string());
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("record_loads"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let records = texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    let out_view = out.create_view(&Default::default());
+    let kernels: Vec<(&str, wgpu::ComputePipeline, wgpu::BindGroup)> = ["none", "buffer", "texture"]
+        .into_iter()
+        .map(|name| {
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(name),
+                layout: None,
+                module: &module,
+                entry_point: Some(&format!("{name}_main")),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            let mut entries =
+                vec![wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&out_view) }];
+            match name {
+                "buffer" => entries.push(wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }),
+                "texture" => entries
+                    .push(wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&records) }),
+                _ => {}
+            }
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(name),
+                layout: &pipeline.get_bind_group_layout(0),
+                entries: &entries,
+            });
+            (name, pipeline, group)
+        })
+        .collect();
+
+    let time = |(_, pipeline, group): &(&str, wgpu::ComputePipeline, wgpu::BindGroup)| {
+        let start = Instant::now();
+        for _ in 0..DISPATCHES {
+            let mut encoder = device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, group, &[]);
+                pass.dispatch_workgroups(SIZE.0 / 8, SIZE.1 / 8, 1);
+            }
+            queue.submit([encoder.finish()]);
+        }
+        device.poll(wgpu::PollType::wait_indefinitely()).expect("the device is alive");
+        start.elapsed().as_secs_f64() * 1000.0 / f64::from(DISPATCHES)
+    };
+    kernels.iter().for_each(|k| {
+        time(k);
+    });
+    let mut times = vec![vec![]; kernels.len()];
+    for round in 0..rounds {
+        for k in 0..kernels.len() {
+            let k = (k + round) % kernels.len();
+            times[k].push(time(&kernels[k]));
+        }
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    for (k, (name, ..)) in kernels.iter().enumerate() {
+        println!("{name:>8}: {:6.1} ms median of {rounds} rounds", median(times[k].clone()));
+    }
+    let extra = |k: usize| median(times[k].iter().zip(&times[0]).map(|(t, none)| t - none).collect());
+    let (buffer_ms, texture_ms) = (extra(1), extra(2));
+    println!(
+        "loads: {:.1} ms as buffer words (24 per lane), {:.1} ms as texels (8 per lane): {:.1}x",
+        buffer_ms,
+        texture_ms,
+        buffer_ms / texture_ms
+    );
+}
