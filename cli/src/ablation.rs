@@ -87,6 +87,18 @@ fn nothing_refined(w: &str) -> Option<String> {
     })
 }
 
+/// No coarse effect is evaluated per pixel, but the evaluation branches stay
+/// in the kernel behind a per-pixel condition only the run time knows to be
+/// false (no pixel has a negative position): what a branch that no lane
+/// takes still costs where a SIMD machine cannot tell it is untaken.
+fn nothing_refined_at_run_time(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        let cond = t.strip_prefix("if (mrsl_is_refined(mrsl_b, ")?.strip_suffix(")) {")?;
+        Some(format!("{}if (mrsl_is_refined(mrsl_b, {cond}) && mrsl_pos.x < 0) {{", indent(l)))
+    })
+}
+
 /// The key loads and comparisons of the resolve (each `disc_<key>` false).
 fn no_key_tests(w: &str) -> Option<String> {
     edit_lines(w, |l| {
@@ -131,7 +143,7 @@ fn no_fine_work(w: &str) -> Option<String> {
 /// The variants. Removing the key tests or the flag reads from the full
 /// kernel would also change what is refined, so those parts are measured
 /// within the fixed cost (nothing refined), where they decide nothing.
-const VARIANTS: [Variant; 6] = [
+const VARIANTS: [Variant; 7] = [
     Variant {
         name: "no instrumentation",
         removes: "the statistics atomics, their barrier and the rate-image store (`DispatchOptions::statistics` off)",
@@ -141,6 +153,11 @@ const VARIANTS: [Variant; 6] = [
         name: "nothing refined (fixed cost)",
         removes: "the per-pixel re-evaluation of refined coarse effects: every pixel resolves and resamples",
         edits: &[nothing_refined],
+    },
+    Variant {
+        name: "nothing refined at run time",
+        removes: "the same re-evaluations, but their branches stay, untaken by a per-pixel test: what a SIMD machine runs of a branch no lane takes",
+        edits: &[nothing_refined_at_run_time],
     },
     Variant {
         name: "fixed cost, no key tests",

@@ -6,16 +6,19 @@ fn mrsl_d{{SITE}}({{PARAMS}}) -> {{TYPE}} {
 // The differences across the pixel's quad pair. The caller passes the operand at
 // `mrsl_pos` itself (`mrsl_here`, the value it already has), so only the pair's other
 // position is evaluated: for an effect, one evaluation at a neighbour instead of two.
+// That position is chosen by `select`, not by a branch: lanes on both sides of their
+// pairs would run both sides of a branch on a SIMD machine, evaluating it twice.
 fn mrsl_ddx_{{SITE}}({{PARAMS}}, mrsl_here: {{TYPE}}) -> {{TYPE}} {
     let mrsl_q = mrsl_pair_x(mrsl_pos);
-    if (all(mrsl_q.xy == mrsl_q.zw)) { return {{TYPE}}(); }
-    if (all(mrsl_q.zw == mrsl_pos)) { return mrsl_here - mrsl_d{{SITE}}(mrsl_q.xy{{ARGS}}); }
-    return mrsl_d{{SITE}}(mrsl_q.zw{{ARGS}}) - mrsl_here;
+    let mrsl_second = all(mrsl_q.zw == mrsl_pos);
+    let mrsl_there = mrsl_d{{SITE}}(select(mrsl_q.zw, mrsl_q.xy, mrsl_second){{ARGS}});
+    let mrsl_difference = select(mrsl_there - mrsl_here, mrsl_here - mrsl_there, mrsl_second);
+    return select(mrsl_difference, {{TYPE}}(), all(mrsl_q.xy == mrsl_q.zw));
 }
 fn mrsl_ddy_{{SITE}}({{PARAMS}}, mrsl_here: {{TYPE}}) -> {{TYPE}} {
     let mrsl_q = mrsl_pair_y(mrsl_pos);
-    if (all(mrsl_q.xy == mrsl_q.zw)) { return {{TYPE}}(); }
-    if (all(mrsl_q.zw == mrsl_pos)) { return mrsl_here - mrsl_d{{SITE}}(mrsl_q.xy{{ARGS}}); }
-    return mrsl_d{{SITE}}(mrsl_q.zw{{ARGS}}) - mrsl_here;
+    let mrsl_second = all(mrsl_q.zw == mrsl_pos);
+    let mrsl_there = mrsl_d{{SITE}}(select(mrsl_q.zw, mrsl_q.xy, mrsl_second){{ARGS}});
+    let mrsl_difference = select(mrsl_there - mrsl_here, mrsl_here - mrsl_there, mrsl_second);
+    return select(mrsl_difference, {{TYPE}}(), all(mrsl_q.xy == mrsl_q.zw));
 }
-
