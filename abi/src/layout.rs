@@ -77,6 +77,8 @@ impl Layout {
             |slot, binding, read_only| StageBinding { binding, slot, resource: StageResource::Buffer { read_only } };
         // The block modes' coarse samples: a texture array of records ([`InterfaceLayout`]).
         let records = |resource| StageBinding { binding: self.interface.binding, slot: S::Interface, resource };
+        let pixel_records =
+            StageBinding { binding: h.values_binding, slot: S::Records, resource: StageResource::PixelRecords };
         let shading_rate = StageBinding {
             binding: self.shading_rate.binding,
             slot: S::ShadingRate,
@@ -96,11 +98,11 @@ impl Layout {
             }
             KernelKind::Reference => vec![],
             KernelKind::Hierarchical => vec![
-                buffer(S::Records, h.values_binding, false),
+                pixel_records,
                 buffer(S::WorkLists, h.work_binding, false),
                 buffer(S::Queues, h.queue_binding, false),
             ],
-            KernelKind::Checkerboard => vec![buffer(S::Records, h.values_binding, false)],
+            KernelKind::Checkerboard => vec![pixel_records],
             KernelKind::RateCoarse => vec![
                 buffer(S::Interface, self.interface.binding, false),
                 buffer(S::WorkLists, h.work_binding, false),
@@ -180,15 +182,25 @@ pub enum StageResource {
     /// The same texture as the coarse kernel writes it: a write-only
     /// `texture_storage_2d_array<rgba32uint, write>`.
     RecordStorageTexture,
+    /// The hierarchical and checkerboard modes' per-pixel records: a
+    /// `texture_storage_2d_array<r32uint, read_write>` of W x H texels and a
+    /// layer per record word ([`HierarchicalLayout`]).
+    PixelRecords,
 }
 
-/// Buffers of the hierarchical and checkerboard modes (group 2): a record per
-/// pixel, and (hierarchical only) the work lists of pixels to shade per level
-/// and per-level counters that double as indirect dispatch arguments.
+/// Resources of the hierarchical and checkerboard modes (group 2): a record
+/// per pixel, and (hierarchical only) the work lists of pixels to shade per
+/// level and per-level counters that double as indirect dispatch arguments.
+/// The records are an `r32uint` texture array, read and written in place:
+/// word k of pixel (x, y)'s record is texel (x, y) of layer k. (A texture
+/// rather than a storage buffer for the reason [`InterfaceLayout`] gives:
+/// llvmpipe reads and writes it for all lanes at once, a buffer word lane
+/// by lane.)
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct HierarchicalLayout {
     /// Per pixel: `flag_words` refine flags, `mask_words` "evaluated here" bits
-    /// (bit k = coarse effect k), then every live coarse effect's value.
+    /// (bit k = coarse effect k), then every live coarse effect's value; one
+    /// layer of the record texture per word.
     pub values_binding: u32,
     pub record_words: u32,
     pub flag_words: u32,

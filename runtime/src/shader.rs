@@ -76,9 +76,10 @@ impl DispatchOptions {
     }
 }
 
-/// Buffers of the hierarchical mode.
+/// Resources of the hierarchical and checkerboard modes.
 struct HierBuffers {
-    values: wgpu::Buffer,
+    /// The per-pixel records (`r32uint`, a layer per record word).
+    values: wgpu::TextureView,
     work: wgpu::Buffer,
     queue: wgpu::Buffer,
     args: wgpu::Buffer,
@@ -380,7 +381,14 @@ impl Shader {
             fits("the 2x2 level", samples(geometry::DYNAMIC_INNER_BLOCK) * words)?;
         }
         if matches!(mode, Mode::Hierarchical | Mode::Checkerboard) {
-            fits("the hierarchical records", pixels * u64::from(self.layout.hierarchical.record_words))?;
+            let layers = self.layout.hierarchical.record_words;
+            if width.max(height) > MAX_TEXTURE_SIDE || layers > MAX_TEXTURE_LAYERS {
+                let reason = format!(
+                    "the per-pixel record texture would need {width}x{height} texels and {layers} layers, more \
+                     than {MAX_TEXTURE_SIDE}x{MAX_TEXTURE_SIDE} texels and {MAX_TEXTURE_LAYERS} layers"
+                );
+                return Err(Error::BadSize { width, height, reason });
+            }
         }
         if mode == Mode::RateImage {
             fits("the rate-image interface", pixels * u64::from(self.layout.interface.stride_words))?;
@@ -754,12 +762,25 @@ impl Shader {
         if self.hier_buffers.as_ref().is_some_and(|(_, s)| *s == size) {
             return;
         }
-        let (w, h) = (size.0 as u64, size.1 as u64);
         let work_words = geometry::work_list_words(size);
         let storage = |label, bytes, extra| storage_buffer(device, label, bytes, extra);
-        let record = self.layout.hierarchical.record_words as u64;
+        let record = self.layout.hierarchical.record_words.max(1);
         let buffers = HierBuffers {
-            values: storage("mrsl hierarchical values", w * h * record * 4, wgpu::BufferUsages::empty()),
+            values: device
+                .create_texture(&wgpu::TextureDescriptor {
+                    label: Some("mrsl per-pixel records"),
+                    size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: record },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: wgpu::TextureFormat::R32Uint,
+                    usage: wgpu::TextureUsages::STORAGE_BINDING,
+                    view_formats: &[],
+                })
+                .create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2Array),
+                    ..Default::default()
+                }),
             work: storage("mrsl hierarchical work lists", work_words * 4, wgpu::BufferUsages::empty()),
             queue: storage(
                 "mrsl hierarchical queues",
@@ -938,7 +959,7 @@ impl Shader {
                     StageSlot::Output(index) => {
                         wgpu::BindingResource::TextureView(&outputs[l.outputs[index].name.as_str()])
                     }
-                    StageSlot::Records => records.expect(needed).values.as_entire_binding(),
+                    StageSlot::Records => wgpu::BindingResource::TextureView(&records.expect(needed).values),
                     StageSlot::WorkLists if rate_kind => rate_buffers.expect(needed).work.as_entire_binding(),
                     StageSlot::Queues if rate_kind => rate_buffers.expect(needed).queue.as_entire_binding(),
                     StageSlot::WorkLists => records.expect(needed).work.as_entire_binding(),
@@ -1219,6 +1240,11 @@ fn stage_layout(device: &wgpu::Device, l: &Layout, kind: KernelKind) -> wgpu::Bi
                 StageResource::RecordStorageTexture => wgpu::BindingType::StorageTexture {
                     access: wgpu::StorageTextureAccess::WriteOnly,
                     format: wgpu::TextureFormat::Rgba32Uint,
+                    view_dimension: wgpu::TextureViewDimension::D2Array,
+                },
+                StageResource::PixelRecords => wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::ReadWrite,
+                    format: wgpu::TextureFormat::R32Uint,
                     view_dimension: wgpu::TextureViewDimension::D2Array,
                 },
             },

@@ -485,13 +485,6 @@ impl<'b> Writer<'_, '_, 'b> {
             self.line(indent, format!("if (mrsl_r_{name} || mrsl_force) {{ mrsl_flags{word} |= {mask}u; }}"));
         }
     }
-
-    /// Stores the refine flag words at `{buffer}[{base} + w]`.
-    pub(super) fn store_flag_words(&mut self, words: u32, buffer: &str, base: &str) {
-        for w in 0..words {
-            self.line(1, format!("{buffer}[{base} + {w}u] = mrsl_flags{w};"));
-        }
-    }
 }
 
 /// Calls `f` on the top-level expressions of `s` and its sub-statements, like

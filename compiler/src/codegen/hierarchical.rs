@@ -139,7 +139,7 @@ impl Writer<'_, '_, '_> {
                 w.template(0, head, &[("FLAG_WORDS", &flag_words), ("STATISTICS_ON", &super::pixel::STATISTICS_ON)]);
                 for k in 0..coarse {
                     let (word, mask) = bit(k as u32);
-                    w.count_refined(k, &format!("(mrsl_values[mrsl_r0 + {}u] & {mask}u) != 0u", flag_words + word));
+                    w.count_refined(k, &format!("(mrsl_word(mrsl_pos, {}u) & {mask}u) != 0u", flag_words + word));
                 }
                 w.template(0, end, &[]);
             },
@@ -193,7 +193,9 @@ impl Writer<'_, '_, '_> {
             self.set_refine_flag(e, 2);
             self.template(1, read, &values);
         }
-        self.store_flag_words(flag_words, "mrsl_values", "mrsl_r0");
+        for w in 0..flag_words {
+            self.line(1, format!("mrsl_set_word(mrsl_pos, {w}u, mrsl_flags{w});"));
+        }
         self.template(0, end, &[]);
     }
 
@@ -215,7 +217,7 @@ impl Writer<'_, '_, '_> {
         for w in 0..h.mask_words {
             let bits = coarse.saturating_sub(w * 32).min(32);
             let mask = if bits == 32 { u32::MAX } else { (1u32 << bits) - 1 };
-            self.line(1, format!("mrsl_values[r + {}u] = {mask}u;", h.flag_words + w));
+            self.line(1, format!("mrsl_set_word(p, {}u, {mask}u);", h.flag_words + w));
         }
         self.template(0, tail, &[]);
     }
@@ -297,10 +299,10 @@ impl Writer<'_, '_, '_> {
             );
         }
         for w in 0..fw {
-            self.line(1, format!("mrsl_values[r + {w}u] = 0u;"));
+            self.line(1, format!("mrsl_set_word(p, {w}u, 0u);"));
         }
         for w in 0..mw {
-            self.line(1, format!("mrsl_values[r + {}u] = mask{w};", fw + w));
+            self.line(1, format!("mrsl_set_word(p, {}u, mask{w});", fw + w));
         }
         let any: Vec<String> = (0..mw).map(|w| format!("mask{w}")).collect();
         self.template(0, end, &[("ANY_MASK", &any.join(" | ")), ("QUEUE_WORDS", &QUEUE_WORDS_PER_LEVEL)]);

@@ -7,7 +7,7 @@
 //! opposite pairs, only complete pairs used) and the final pass.
 
 use super::Writer;
-use super::words::{pack_words, unpack_words};
+use super::words::{pack_words, unpack_with};
 use super::writer::cut;
 use crate::check::EffectId;
 
@@ -28,7 +28,7 @@ pub(super) fn neighbours(offsets: [(i32, i32); 4]) -> String {
 }
 
 impl Writer<'_, '_, '_> {
-    /// The record buffer, after a comment on what the mode keeps in it.
+    /// The record texture, after a comment on what the mode keeps in it.
     pub(super) fn record_binding(&mut self, what: &str) {
         let l = self.i.layout;
         self.template(
@@ -38,24 +38,21 @@ impl Writer<'_, '_, '_> {
         );
     }
 
-    /// `mrsl_rec`, and `mrsl_hget_X` / `mrsl_hput_X` for every live coarse effect.
+    /// `mrsl_word` / `mrsl_set_word`, and `mrsl_hget_X` / `mrsl_hput_X` for every live coarse effect.
     pub(super) fn record_helpers(&mut self) {
         let c = self.checked();
         let h = &self.i.layout.hierarchical;
-        self.template(0, include_str!("templates/records.wgsl"), &[("RECORD", &h.record_words)]);
+        self.template(0, include_str!("templates/records.wgsl"), &[]);
         let [access, end] = cut(include_str!("templates/record_access.wgsl"), &["STORES"]);
         for (k, &e) in self.coarse_live().iter().enumerate() {
             let info = &c.effects[e.index()];
-            let unpack = unpack_words(&info.ty, "mrsl_values");
-            let values = [
-                ("NAME", &info.name as &dyn std::fmt::Display),
-                ("TYPE", &info.ty.wgsl()),
-                ("OFFSET", &h.value_offsets[k]),
-                ("UNPACK", &unpack),
-            ];
+            let offset = h.value_offsets[k];
+            let unpack = unpack_with(&info.ty, |j| format!("mrsl_word(p, {}u)", offset + j));
+            let values =
+                [("NAME", &info.name as &dyn std::fmt::Display), ("TYPE", &info.ty.wgsl()), ("UNPACK", &unpack)];
             self.template(0, access, &values);
             for (j, word) in pack_words("v", &info.ty).iter().enumerate() {
-                self.line(1, format!("mrsl_values[base + {j}u] = {word};"));
+                self.line(1, format!("mrsl_set_word(p, {}u, {word});", offset + j as u32));
             }
             self.template(0, end, &[]);
         }

@@ -101,6 +101,8 @@ fn kernels_declare_the_stage_bindings_of_the_contract() {
                         StageResource::RecordTexture
                     } else if decl.contains("texture_storage_2d_array<rgba32uint, write>") {
                         StageResource::RecordStorageTexture
+                    } else if decl.contains("texture_storage_2d_array<r32uint, read_write>") {
+                        StageResource::PixelRecords
                     } else {
                         let format = decl.split("texture_storage_2d<").nth(1).unwrap().split(',').next().unwrap();
                         StageResource::StorageTexture(format.parse::<TextureFormat>().unwrap())

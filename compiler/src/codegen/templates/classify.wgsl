@@ -17,7 +17,6 @@ fn mrsl_classify(p: vec2<i32>, n: array<vec2<i32>, 4>, level: u32) {
     }
     var disc = mrsl_ctl.force_refine != 0u || total == 0.0;
 {{#KEYS}}
-    let r = mrsl_rec(p);
 {{#EFFECTS}}
     if (({{ANY_MASK}}) != 0u) {
         let slot = atomicAdd(&mrsl_queue[level * {{QUEUE_WORDS}}u], 1u);

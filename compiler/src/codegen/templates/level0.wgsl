@@ -3,7 +3,6 @@
 fn {{ENTRY}}(@builtin(global_invocation_id) gid: vec3<u32>) {
     let p = {{PIXEL}};
     if (any(p >= vec2<i32>(mrsl_ctl.size))) { return; }
-    let r = mrsl_rec(p);
 {{#MASKS}}
     mrsl_shade(p);
 }

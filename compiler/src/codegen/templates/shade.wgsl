@@ -1,7 +1,6 @@
 // Evaluates the coarse effects `mrsl_pos`'s mask names (reading the others) and stores
 // their values and refine flags.
 fn mrsl_shade(mrsl_pos: vec2<i32>) {
-    let mrsl_r0 = mrsl_rec(mrsl_pos);
 {{#FLAG_WORDS}}
     let mrsl_force = mrsl_ctl.force_refine != 0u;
 {{#EFFECTS}}
