@@ -49,12 +49,12 @@ fn block_geometry(block: u32) -> String {
 }
 
 /// Tests of `key` between corner `k00_<key>` and the corners `k10_`, `k01_`,
-/// `k11_`: whether the block's own corners disagree.
-pub(super) fn corners_differ(key: &Key) -> Vec<String> {
+/// `k11_` (each name after `prefix`): whether the block's own corners disagree.
+pub(super) fn corners_differ(key: &Key, prefix: &str) -> Vec<String> {
     let name = key.name;
     ["k10", "k01", "k11"]
         .iter()
-        .map(|corner| key.differs(&format!("k00_{name}"), &format!("{corner}_{name}")))
+        .map(|corner| key.differs(&format!("{prefix}k00_{name}"), &format!("{prefix}{corner}_{name}")))
         .collect()
 }
 
@@ -272,6 +272,9 @@ impl Writer<'_, '_, '_> {
                 self.line(1, format!("{corner}_{}: {},", key.name, key.ty));
             }
         }
+        for key in &keys {
+            self.line(1, format!("split_{}: bool, // the block's own corners disagree on the key", key.name));
+        }
         for w in 0..stride {
             self.line(1, format!("w{w}: vec4<u32>,"));
         }
@@ -286,6 +289,8 @@ impl Writer<'_, '_, '_> {
             for (corner, at) in CORNERS.iter().zip(CORNER_PIXELS) {
                 self.line(1, format!("c.{corner}_{name} = mrsl_load_{name}({at});"));
             }
+            // Tested once per lane, not once per pixel.
+            self.line(1, format!("c.split_{name} = {};", corners_differ(key, "c.").join(" || ")));
         }
         // A texel holds four words of a record: one load per corner and texel.
         let texels = ["i0", "vec2<i32>(i1.x, i0.y)", "vec2<i32>(i0.x, i1.y)", "i1"];
@@ -370,7 +375,11 @@ impl Writer<'_, '_, '_> {
             }
             let mut tests: Vec<String> =
                 CORNERS.iter().map(|corner| key.differs(&format!("k_{name}"), &format!("{corner}_{name}"))).collect();
-            tests.extend(corners_differ(&key));
+            if preloaded {
+                tests.push(format!("c.split_{name}"));
+            } else {
+                tests.extend(corners_differ(&key, ""));
+            }
             let at: Vec<String> = CORNERS
                 .iter()
                 .zip(CORNER_PIXELS)

@@ -72,7 +72,7 @@ impl Writer<'_, '_, '_> {
             self.template(
                 0,
                 include_str!("templates/parent_key.wgsl"),
-                &[("NAME", &key.name), ("BLOCK", &block), ("TESTS", &corners_differ(&key).join(" || "))],
+                &[("NAME", &key.name), ("BLOCK", &block), ("TESTS", &corners_differ(&key, "").join(" || "))],
             );
         }
         self.template(0, keys, &[]);
