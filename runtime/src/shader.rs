@@ -50,8 +50,8 @@ pub struct DispatchOptions {
     /// Count per-pixel re-evaluations ([`Shader::read_stats`]) and write the
     /// per-pixel refine mask ([`Shader::rate_image`]). On by default; turn it
     /// off for frames that are only displayed or timed: the counters are
-    /// workgroup atomics and a barrier per tile, about 7% of a coarse 4x4
-    /// frame on lavapipe (docs/evaluation.md).
+    /// workgroup atomics and a barrier per tile, under 2% of a coarse 4x4
+    /// frame on lavapipe in the ablations of docs/evaluation.md.
     pub statistics: bool,
 }
 
@@ -114,6 +114,9 @@ pub struct Shader {
     stage_layouts: HashMap<KernelKind, wgpu::BindGroupLayout>,
     /// Every entry point of every kernel, by name (see [`mrsl_abi::KernelKind::entry_points`]).
     pipelines: HashMap<PipelineKey, wgpu::ComputePipeline>,
+    /// Kernel kinds whose stage layout or pipelines the device refused, with
+    /// its reason: the modes that need them are refused at `encode`.
+    unavailable: HashMap<KernelKind, String>,
     /// Hierarchical mode buffers (values, work lists, queues) and the size they were made for.
     hier_buffers: Option<(HierBuffers, (u32, u32))>,
     /// Rate-image mode buffers and the size they were made for.
@@ -143,14 +146,28 @@ pub struct Shader {
 impl Shader {
     /// Creates the pipelines of every kernel in `program`: compiled just now
     /// (`&mrsl::compile(..)?` dereferences to one) or read from the files
-    /// `mrslc compile` wrote ([`CompiledProgram::read_dir`]).
+    /// `mrslc compile` wrote ([`CompiledProgram::read_dir`]). A kernel the
+    /// device refuses (a limit exceeded) does not fail this: the modes that
+    /// need it return [`Error::UnsupportedMode`] from [`Shader::encode`].
     pub fn new(device: &wgpu::Device, program: &CompiledProgram) -> Result<Shader, Error> {
         let layout = program.layout.clone();
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let resources_layout = resources_layout(device, &layout);
         let gbuffer_layout = gbuffer_layout(device, &layout);
-        let stage_layouts: HashMap<KernelKind, wgpu::BindGroupLayout> =
-            KernelKind::ALL.into_iter().map(|kind| (kind, stage_layout(device, &layout, kind))).collect();
+        // A kernel kind this device cannot run (its stage group beyond the
+        // device's limits, say the hierarchical kernel's outputs and records
+        // beyond `max_storage_textures_per_shader_stage`) refuses the modes
+        // that need it when they are dispatched, not every mode here: each
+        // kind's layout and pipelines are made under their own error scope.
+        let mut unavailable: HashMap<KernelKind, String> = HashMap::new();
+        let mut stage_layouts: HashMap<KernelKind, wgpu::BindGroupLayout> = HashMap::new();
+        for kind in KernelKind::ALL {
+            let kind_scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+            stage_layouts.insert(kind, stage_layout(device, &layout, kind));
+            if let Some(error) = pollster::block_on(kind_scope.pop()) {
+                unavailable.insert(kind, describe(&error));
+            }
+        }
         let mut pipelines = HashMap::new();
         let args_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("mrsl hierarchical args"),
@@ -166,6 +183,10 @@ impl Shader {
             }],
         });
         for kernel in &program.kernels {
+            if unavailable.contains_key(&kernel.kind) {
+                continue;
+            }
+            let kind_scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some(kernel.kind.name()),
                 source: wgpu::ShaderSource::Wgsl(kernel.wgsl.as_str().into()),
@@ -201,6 +222,9 @@ impl Shader {
                     cache: None,
                 });
                 pipelines.insert((kernel.kind, kernel.block_size, entry), pipeline);
+            }
+            if let Some(error) = pollster::block_on(kind_scope.pop()) {
+                unavailable.insert(kernel.kind, describe(&error));
             }
         }
         let control = device.create_buffer(&wgpu::BufferDescriptor {
@@ -259,6 +283,7 @@ impl Shader {
             gbuffer_layout,
             stage_layouts,
             pipelines,
+            unavailable,
             hier_buffers: None,
             rate_buffers: None,
             forced: false,
@@ -338,6 +363,10 @@ impl Shader {
         let missing = |what: &str| {
             Err(Error::UnsupportedMode(mode.name().into(), format!("the program was compiled without {what}")))
         };
+        if let Some((kind, reason)) = mode.kernels().iter().find_map(|(k, _)| self.unavailable.get_key_value(k)) {
+            let reason = format!("the device cannot run its {kind} kernel: {reason}");
+            return Err(Error::UnsupportedMode(mode.name().into(), reason));
+        }
         if let Some(what) = mode.kernels().iter().find(|(kind, block)| !self.has_kernel(*kind, *block)) {
             return missing(&match what {
                 (kind, Some(b)) if kind.per_block_size() => format!("its {b}x{b} {kind} kernel"),

@@ -150,6 +150,33 @@ pub fn modes_without_kernels_are_unsupported(gpu: &Gpu) {
     run(gpu, &program, &gbuffer, Mode::Coarse4x4, false).unwrap();
 }
 
+/// A kernel the device cannot run refuses only the modes that need it: with
+/// three outputs and a coarse effect, the hierarchical and checkerboard
+/// kernels bind five storage textures (outputs, rate image, per-pixel
+/// records), one more than WebGPU's default limit, while the block modes
+/// bind four and render.
+pub fn modes_beyond_the_device_limits_are_unsupported(gpu: &Gpu) {
+    let source = "in float3 normal;\ncoarse effect float d = saturate(normal.y);\n\
+                  fine out float4 a = float4(d);\nfine out float4 b = float4(d * 0.5);\n\
+                  fine out float4 c = float4(normal, 1.0);\n";
+    let program = mrsl::compile(source, &Default::default()).unwrap();
+    let gbuffer = Scene::Gradient.render(8, 8);
+    assert_eq!(gpu.device.limits().max_storage_textures_per_shader_stage, 4, "the test assumes the default limit");
+    for mode in [Mode::Hierarchical, Mode::Checkerboard] {
+        match run(gpu, &program, &gbuffer, mode, false) {
+            Err(Error::UnsupportedMode(m, reason)) => {
+                assert_eq!(m, mode.name());
+                assert!(reason.contains("cannot run") && reason.contains("StorageTextures"), "{reason}");
+            }
+            Err(other) => panic!("{mode}: expected UnsupportedMode, got {other:?}"),
+            Ok(_) => panic!("{mode}: expected UnsupportedMode, and it rendered"),
+        }
+    }
+    for mode in [Mode::Reference, Mode::Coarse4x4, Mode::Dynamic, Mode::RateImage] {
+        run(gpu, &program, &gbuffer, mode, false).unwrap_or_else(|e| panic!("{mode}: {e}"));
+    }
+}
+
 /// `mrsl_runtime::compile_modes` generates exactly the kernels its modes
 /// dispatch (the union of their `Mode::kernels`), for every set of modes;
 /// `compile` those of all seven.

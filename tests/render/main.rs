@@ -40,6 +40,7 @@ const GPU_TESTS: &[GpuTest] = &[
     ),
     ("errors::extra_channels_are_ignored", errors::extra_channels_are_ignored),
     ("errors::modes_without_kernels_are_unsupported", errors::modes_without_kernels_are_unsupported),
+    ("errors::modes_beyond_the_device_limits_are_unsupported", errors::modes_beyond_the_device_limits_are_unsupported),
     ("errors::precompiled_and_load_time_kernels_render_alike", errors::precompiled_and_load_time_kernels_render_alike),
     (
         "modes::forced_refinement_equals_reference_for_every_example",
