@@ -8,6 +8,9 @@ use serde::{Deserialize, Serialize};
 /// up by these names; the compiler writes them and keeps user names clear of them.
 pub mod entry {
     pub const COARSE: &str = "coarse_main";
+    /// The block coarse kernel's first entry point: the neighbour values
+    /// (`Layout::neighbours`), dispatched over the samples before `coarse_main`.
+    pub const COARSE_NEIGHBOURS: &str = "coarse_neighbours";
     pub const FINE: &str = "fine_main";
     pub const REFERENCE: &str = "reference_main";
     pub const DYNAMIC_COARSE: &str = "dynamic_coarse_main";
@@ -131,7 +134,7 @@ impl KernelKind {
     /// Every entry point of the kernel, in dispatch order.
     pub fn entry_points(self) -> &'static [&'static str] {
         match self {
-            KernelKind::Coarse => &[entry::COARSE],
+            KernelKind::Coarse => &[entry::COARSE_NEIGHBOURS, entry::COARSE],
             KernelKind::Fine => &[entry::FINE],
             KernelKind::Reference => &[entry::REFERENCE],
             KernelKind::DynamicCoarse => &[entry::DYNAMIC_COARSE],

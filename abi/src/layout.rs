@@ -37,6 +37,9 @@ pub struct Layout {
     /// Its coarse kernel's work list and counter are bound at the hierarchical
     /// mode's `work_binding` and `queue_binding`, and its arguments like theirs.
     pub shading_rate: ResourceBinding,
+    /// The block coarse kernel's neighbour values (its `coarse_neighbours`
+    /// entry point writes them, `coarse_main` reads them).
+    pub neighbours: NeighbourLayout,
     pub effects: Vec<EffectLayout>,
 }
 
@@ -78,13 +81,21 @@ impl Layout {
         // The block modes' coarse samples: a texture array of records ([`InterfaceLayout`]).
         let records = |resource| StageBinding { binding: self.interface.binding, slot: S::Interface, resource };
         let pixel_records =
-            StageBinding { binding: h.values_binding, slot: S::Records, resource: StageResource::PixelRecords };
+            StageBinding { binding: h.values_binding, slot: S::Records, resource: StageResource::WordTexture };
         let shading_rate = StageBinding {
             binding: self.shading_rate.binding,
             slot: S::ShadingRate,
             resource: StageResource::UintTexture,
         };
         let mut bindings = match kind {
+            KernelKind::Coarse if self.neighbours.words > 0 => vec![
+                records(StageResource::RecordStorageTexture),
+                StageBinding {
+                    binding: self.neighbours.binding,
+                    slot: S::Neighbours,
+                    resource: StageResource::WordTexture,
+                },
+            ],
             KernelKind::Coarse => vec![records(StageResource::RecordStorageTexture)],
             KernelKind::Fine => vec![records(StageResource::RecordTexture)],
             // Reads the 4x4 level, writes the 2x2 level and counts its samples.
@@ -164,6 +175,8 @@ pub enum StageSlot {
     Queues,
     /// The rate-image mode's shading-rate image.
     ShadingRate,
+    /// The coarse kernel's neighbour values ([`NeighbourLayout`]).
+    Neighbours,
 }
 
 /// What a stage-group binding holds.
@@ -182,10 +195,11 @@ pub enum StageResource {
     /// The same texture as the coarse kernel writes it: a write-only
     /// `texture_storage_2d_array<rgba32uint, write>`.
     RecordStorageTexture,
-    /// The hierarchical and checkerboard modes' per-pixel records: a
-    /// `texture_storage_2d_array<r32uint, read_write>` of W x H texels and a
-    /// layer per record word ([`HierarchicalLayout`]).
-    PixelRecords,
+    /// A `texture_storage_2d_array<r32uint, read_write>` with a layer per
+    /// word: the hierarchical and checkerboard modes' per-pixel records (W x
+    /// H texels, [`HierarchicalLayout`]) and the coarse kernel's neighbour
+    /// values (a texel per coarse sample, [`NeighbourLayout`]).
+    WordTexture,
 }
 
 /// Resources of the hierarchical and checkerboard modes (group 2): a record
@@ -215,6 +229,30 @@ pub struct HierarchicalLayout {
     /// the `hier_args_*` entry points only: bind group `args_group`, binding 0. It is
     /// a separate group because a buffer cannot be indirect and writable in one dispatch.
     pub args_group: u32,
+}
+
+/// The coarse effects that the block coarse kernel's derivatives read at
+/// neighbouring samples, stored once per sample by a first entry point,
+/// `coarse_neighbours`, so that `coarse_main` reads a neighbour's value
+/// instead of evaluating the effect there again (at each of the two
+/// neighbours of every derivative). An `r32uint` texture array of `nx` x
+/// `ny` texels (the sample grid) and `words` layers, bound at `binding` of
+/// the stage group; effect `name`'s value starts at layer `offset`. `words`
+/// is 0 (no binding, and no dispatch of `coarse_neighbours`) when no
+/// derivative reads an effect, or when evaluating those effects would
+/// itself read effects at neighbours.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NeighbourLayout {
+    pub binding: u32,
+    pub words: u32,
+    pub effects: Vec<NeighbourValue>,
+}
+
+/// Where one effect's value sits in the neighbour values ([`NeighbourLayout`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NeighbourValue {
+    pub name: String,
+    pub offset: u32,
 }
 
 /// Counters the fine kernels accumulate (when the program has live coarse effects).

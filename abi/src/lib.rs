@@ -32,8 +32,8 @@ pub use control::{CONTROL_FIELDS, Control, ControlField};
 pub use kernel::{KernelKind, entry};
 pub use layout::{
     Channel, ControlBlock, EffectLayout, Field, HierarchicalLayout, InterfaceLayout, KeyCompare, LAYOUT_FORMAT, Layout,
-    Output, Rate, Resample, ResourceBinding, ResourceKind, SlotLayout, StageBinding, StageResource, StageSlot,
-    StatsLayout, UniformBlock,
+    NeighbourLayout, NeighbourValue, Output, Rate, Resample, ResourceBinding, ResourceKind, SlotLayout, StageBinding,
+    StageResource, StageSlot, StatsLayout, UniformBlock,
 };
 pub use program::{CompiledProgram, Kernel, ReadError};
 pub use shading_rate::ShadingRate;

@@ -4,17 +4,18 @@
 
 use crate::budget::Costs;
 use crate::check::{Checked, EffectId, UniformKind};
+use crate::deriv::DerivInfo;
 use crate::graph::EffectGraph;
 use crate::interface::Interface;
 use crate::syntax::ast::Rate;
 use crate::types::{Scalar, Type, round_up};
 use mrsl_abi::{
     BINDING_CONTROL, BINDING_UNIFORMS, CONTROL_FIELDS, Channel, Control, ControlBlock, EffectLayout, Field, GROUP_ARGS,
-    GROUP_GBUFFER, GROUP_RESOURCES, GROUP_STAGE, HierarchicalLayout, InterfaceLayout, LAYOUT_FORMAT, Layout, Output,
-    Resample, ResourceBinding, ResourceKind, SampleType, SlotLayout, StatsLayout, TextureFormat, UniformBlock,
-    ValueType,
+    GROUP_GBUFFER, GROUP_RESOURCES, GROUP_STAGE, HierarchicalLayout, InterfaceLayout, LAYOUT_FORMAT, Layout,
+    NeighbourLayout, NeighbourValue, Output, Resample, ResourceBinding, ResourceKind, SampleType, SlotLayout,
+    StatsLayout, TextureFormat, UniformBlock, ValueType,
 };
-use std::collections::HashMap;
+use std::collections::{BTreeSet, HashMap};
 
 /// The layout's type of a checked value type (checked programs only declare value types where the layout has them).
 fn value_type(ty: &Type) -> ValueType {
@@ -38,7 +39,13 @@ pub fn channel_format(ty: &Type) -> (TextureFormat, SampleType) {
     (format, SampleType::of(format.scalar()))
 }
 
-pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface, costs: &Costs) -> Layout {
+pub fn build(
+    checked: &Checked,
+    graph: &EffectGraph,
+    deriv: &DerivInfo,
+    interface: &Interface,
+    costs: &Costs,
+) -> Layout {
     let operations: HashMap<EffectId, u64> = costs.effects.iter().copied().collect();
     let value_operations: HashMap<EffectId, u64> = costs.values.iter().copied().collect();
     let control = ControlBlock {
@@ -221,6 +228,12 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface, cost
             binding: 6 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
             kind: ResourceKind::ShadingRate,
         },
+        neighbours: neighbours(
+            checked,
+            graph,
+            deriv,
+            7 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
+        ),
         hierarchical: {
             let outputs = checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32;
             let coarse: Vec<&crate::check::EffectInfo> =
@@ -249,6 +262,34 @@ pub fn build(checked: &Checked, graph: &EffectGraph, interface: &Interface, cost
         outputs,
         effects,
     }
+}
+
+/// The coarse effects the block coarse kernel's derivatives read at
+/// neighbouring samples (the operands of derivative sites in live coarse
+/// effects), with their word offsets, when evaluating them reads no effect
+/// at a neighbour in turn: then a first entry point can store them at every
+/// sample and the derivatives read them ([`NeighbourLayout`]). Otherwise none.
+fn neighbours(checked: &Checked, graph: &EffectGraph, deriv: &DerivInfo, binding: u32) -> NeighbourLayout {
+    let coarse_live = |e: EffectId| graph.live[e.index()] && checked.effects[e.index()].rate == Rate::Coarse;
+    let needed: BTreeSet<EffectId> = deriv
+        .sites
+        .iter()
+        .filter(|site| coarse_live(site.effect))
+        .flat_map(|site| site.effects.iter().copied())
+        .filter(|e| graph.live[e.index()])
+        .collect();
+    let evaluated: BTreeSet<EffectId> = needed.iter().flat_map(|&e| graph.closure(e, checked)).collect();
+    let nested = deriv.sites.iter().any(|site| evaluated.contains(&site.effect) && !site.effects.is_empty());
+    let mut words = 0;
+    let mut effects = vec![];
+    if !nested {
+        for e in graph.order.iter().filter(|e| needed.contains(e)) {
+            let info = &checked.effects[e.index()];
+            effects.push(NeighbourValue { name: info.name.clone(), offset: words });
+            words += info.ty.components();
+        }
+    }
+    NeighbourLayout { binding, words, effects }
 }
 
 /// Whether a coarse effect is resampled by the nearest corner: `@nearest`, or

@@ -265,7 +265,7 @@ fn generate(
 ) -> Result<Program, Vec<Diagnostic>> {
     let interface = interface::allocate(checked, graph);
     let costs = budget::evaluation_costs(checked, graph, deriv);
-    let layout = layout::build(checked, graph, &interface, &costs);
+    let layout = layout::build(checked, graph, deriv, &interface, &costs);
     let inputs = codegen::Inputs {
         checked,
         graph,

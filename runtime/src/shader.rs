@@ -133,6 +133,8 @@ pub struct Shader {
     interfaces: HashMap<(u32, bool), (wgpu::Buffer, (u32, u32))>,
     /// The block modes' record textures by block size, with the size they were made for.
     record_textures: HashMap<u32, (wgpu::TextureView, (u32, u32))>,
+    /// The block coarse kernel's neighbour values by block size, with the size they were made for.
+    neighbour_textures: HashMap<u32, (wgpu::TextureView, (u32, u32))>,
     /// Dispatch counter, written to the control block (validity tags of the dynamic mode).
     frame: u32,
     /// The fine kernel's per-pixel refine mask, with the size it was made for.
@@ -299,6 +301,7 @@ impl Shader {
             uniform_values: HashMap::new(),
             interfaces: HashMap::new(),
             record_textures: HashMap::new(),
+            neighbour_textures: HashMap::new(),
             frame: 0,
             rate: None,
             stats,
@@ -396,7 +399,7 @@ impl Shader {
         let pixels = u64::from(width) * u64::from(height);
         if let Some(block) = mode.block_size() {
             let (nx, ny) = geometry::sample_grid(bindings.size, block);
-            let layers = self.layout.interface.layers();
+            let layers = self.layout.interface.layers().max(self.layout.neighbours.words);
             if nx.max(ny) > MAX_TEXTURE_SIDE || layers > MAX_TEXTURE_LAYERS {
                 let reason = format!(
                     "the record texture would need {nx}x{ny} texels and {layers} layers, more than \
@@ -553,6 +556,9 @@ impl Shader {
                 }
                 Some(block) => {
                     let records = self.record_texture(device, block, bindings.size).clone();
+                    let stores_neighbours = self.layout.neighbours.words > 0;
+                    let neighbours =
+                        stores_neighbours.then(|| self.neighbour_texture(device, block, bindings.size).clone());
                     self.ensure_rate_image(device, bindings.size);
                     let dynamic = mode == Mode::Dynamic;
                     let inner = if dynamic {
@@ -560,18 +566,25 @@ impl Shader {
                     } else {
                         None
                     };
-                    let interface = Interface::Records(&records);
+                    let interface = Interface::Records(&records, neighbours.as_ref());
                     let coarse_stage = self.stage_group(device, KernelKind::Coarse, interface, None, &views, None);
                     let fine_kind = if dynamic { KernelKind::DynamicFine } else { KernelKind::Fine };
                     let fine_stage = self.stage_group(device, fine_kind, interface, inner.as_ref(), &views, None);
-                    self.pass(
-                        encoder,
-                        "mrsl coarse",
-                        1,
-                        (KernelKind::Coarse, Some(block), entry::COARSE),
-                        &[&resources, &gbuffer, &coarse_stage],
-                        geometry::coarse_workgroups(bindings.size, block),
-                    );
+                    {
+                        // The neighbour values first, then the samples, which read them.
+                        let groups = [&resources, &gbuffer, &coarse_stage];
+                        let mut pass = self.begin_pass(encoder, "mrsl coarse", 1, &groups);
+                        let (gx, gy) = geometry::coarse_workgroups(bindings.size, block);
+                        let entries: &[&str] = if stores_neighbours {
+                            &[entry::COARSE_NEIGHBOURS, entry::COARSE]
+                        } else {
+                            &[entry::COARSE]
+                        };
+                        for &name in entries {
+                            pass.set_pipeline(&self.pipelines[&(KernelKind::Coarse, Some(block), name)]);
+                            pass.dispatch_workgroups(gx, gy, 1);
+                        }
+                    }
                     if dynamic {
                         let stage = self.stage_group(
                             device,
@@ -906,6 +919,31 @@ impl Shader {
         &self.record_textures[&block].0
     }
 
+    /// The coarse kernel's neighbour values for `block`, (re)created when the
+    /// size changes: the sample grid in texels, a layer per word
+    /// ([`mrsl_abi::NeighbourLayout`]).
+    fn neighbour_texture(&mut self, device: &wgpu::Device, block: u32, size: (u32, u32)) -> &wgpu::TextureView {
+        if self.neighbour_textures.get(&block).is_none_or(|(_, s)| *s != size) {
+            let (nx, ny) = geometry::sample_grid(size, block);
+            let texture = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("mrsl neighbour values"),
+                size: wgpu::Extent3d { width: nx, height: ny, depth_or_array_layers: self.layout.neighbours.words },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::R32Uint,
+                usage: wgpu::TextureUsages::STORAGE_BINDING,
+                view_formats: &[],
+            });
+            let view = texture.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            });
+            self.neighbour_textures.insert(block, (view, size));
+        }
+        &self.neighbour_textures[&block].0
+    }
+
     fn resources_group(&self, device: &wgpu::Device, bindings: &Bindings) -> wgpu::BindGroup {
         let l = &self.layout;
         let mut entries =
@@ -978,7 +1016,7 @@ impl Shader {
                 binding: b.binding,
                 resource: match b.slot {
                     StageSlot::Interface => match interface {
-                        Interface::Records(view) => wgpu::BindingResource::TextureView(view),
+                        Interface::Records(view, _) => wgpu::BindingResource::TextureView(view),
                         Interface::Buffer(buffer) => buffer.as_entire_binding(),
                         Interface::None => panic!("the interface is {needed}"),
                     },
@@ -994,6 +1032,10 @@ impl Shader {
                     StageSlot::WorkLists => records.expect(needed).work.as_entire_binding(),
                     StageSlot::Queues => records.expect(needed).queue.as_entire_binding(),
                     StageSlot::ShadingRate => wgpu::BindingResource::TextureView(shading_rate.expect(needed)),
+                    StageSlot::Neighbours => match interface {
+                        Interface::Records(_, Some(view)) => wgpu::BindingResource::TextureView(view),
+                        _ => panic!("the neighbour values are {needed}"),
+                    },
                 },
             })
             .collect();
@@ -1230,8 +1272,8 @@ fn gbuffer_layout(device: &wgpu::Device, l: &Layout) -> wgpu::BindGroupLayout {
 /// What a stage group binds as the interface ([`StageSlot::Interface`]).
 #[derive(Clone, Copy)]
 enum Interface<'a> {
-    /// The block modes' record texture.
-    Records(&'a wgpu::TextureView),
+    /// The block modes' record texture, and the coarse kernel's neighbour values if it has them.
+    Records(&'a wgpu::TextureView, Option<&'a wgpu::TextureView>),
     /// The rate-image mode's record buffer.
     Buffer(&'a wgpu::Buffer),
     /// None: the kernel binds no interface.
@@ -1271,7 +1313,7 @@ fn stage_layout(device: &wgpu::Device, l: &Layout, kind: KernelKind) -> wgpu::Bi
                     format: wgpu::TextureFormat::Rgba32Uint,
                     view_dimension: wgpu::TextureViewDimension::D2Array,
                 },
-                StageResource::PixelRecords => wgpu::BindingType::StorageTexture {
+                StageResource::WordTexture => wgpu::BindingType::StorageTexture {
                     access: wgpu::StorageTextureAccess::ReadWrite,
                     format: wgpu::TextureFormat::R32Uint,
                     view_dimension: wgpu::TextureViewDimension::D2Array,

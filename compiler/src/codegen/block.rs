@@ -76,6 +76,14 @@ impl Writer<'_, '_, '_> {
                 self.template(0, include_str!("templates/interface.wgsl"), values)
             }
         }
+        if self.stores_neighbours() {
+            let l = self.i.layout;
+            self.template(
+                0,
+                include_str!("templates/neighbours_binding.wgsl"),
+                &[("GROUP", &l.interface.group), ("BINDING", &l.neighbours.binding)],
+            );
+        }
         if self.kind == KernelKind::DynamicFine {
             self.inner_interface_binding();
         }
@@ -100,9 +108,70 @@ impl Writer<'_, '_, '_> {
 
     // ---- Coarse kernel ----------------------------------------------------------
 
+    /// Whether this is the block coarse kernel with neighbour values
+    /// (layout `neighbours`): `coarse_neighbours` stores them at every
+    /// sample, and `mrsl_at_<effect>` reads them.
+    pub(super) fn stores_neighbours(&self) -> bool {
+        self.kind == KernelKind::Coarse && self.i.layout.neighbours.words > 0
+    }
+
+    /// The effects of the neighbour values, in layout order, with their word offsets.
+    pub(super) fn neighbour_values(&self) -> Vec<(EffectId, u32)> {
+        let c = self.checked();
+        let id = |name: &str| {
+            let k = c.effects.iter().position(|e| e.name == name).expect("the layout names effects of the program");
+            EffectId(k as u32)
+        };
+        self.i.layout.neighbours.effects.iter().map(|v| (id(&v.name), v.offset)).collect()
+    }
+
+    /// `coarse_neighbours`, the block coarse kernel's first entry point:
+    /// each neighbour value evaluated at the sample (for its value alone,
+    /// as a neighbour evaluation computes it) and stored. Empty without them.
+    fn neighbours_entry(&mut self) {
+        let [x, y, z] = self.kind.workgroup_size();
+        if !self.stores_neighbours() {
+            self.line(0, "// No neighbour values (layout `neighbours`): the runtime does not dispatch this.");
+            self.line(0, format!("@compute @workgroup_size({x}, {y}, {z})"));
+            self.line(0, format!("fn {}() {{}}", mrsl_abi::entry::COARSE_NEIGHBOURS));
+            self.line(0, "");
+            return;
+        }
+        let [head, tail] = cut(include_str!("templates/coarse_main.wgsl"), &["BODY"]);
+        let values: &super::writer::Values = &[
+            ("WORKGROUP", &format!("{x}, {y}, {z}")),
+            ("RECORD", &""),
+            ("ENTRY", &mrsl_abi::entry::COARSE_NEIGHBOURS),
+        ];
+        self.template(0, head, values);
+        let c = self.checked();
+        let stored = self.neighbour_values();
+        // The stored effects and what they read, each evaluated once, in dependency order.
+        let needed: BTreeSet<EffectId> = stored.iter().flat_map(|&(e, _)| self.i.graph.closure(e, c)).collect();
+        let chain: Vec<EffectId> = self.i.graph.order.iter().copied().filter(|e| needed.contains(e)).collect();
+        self.value_only = true;
+        self.effect_chain(&chain, 1);
+        self.value_only = false;
+        for (e, offset) in stored {
+            let info = &c.effects[e.index()];
+            for (j, word) in pack_words(&self.effect_name(e), &info.ty).iter().enumerate() {
+                let layer = offset + j as u32;
+                self.line(
+                    1,
+                    format!("textureStore(mrsl_neighbours, mrsl_pos, {layer}, vec4<u32>({word}, 0u, 0u, 0u));"),
+                );
+            }
+        }
+        self.template(0, tail, &[]);
+        self.line(0, "");
+    }
+
     pub(super) fn coarse_entry(&mut self) {
         if self.kind == KernelKind::DynamicCoarse {
             self.parent_refined();
+        }
+        if self.kind == KernelKind::Coarse {
+            self.neighbours_entry();
         }
         let c = self.checked();
         let iface = self.i.interface;
@@ -142,9 +211,21 @@ impl Writer<'_, '_, '_> {
             }
         }
         let coarse = self.coarse_live();
+        let stored: Vec<EffectId> = if self.stores_neighbours() {
+            self.neighbour_values().into_iter().map(|(e, _)| e).collect()
+        } else {
+            vec![]
+        };
         for &e in &coarse {
-            self.line(1, format!("// coarse effect `{}`", c.effects[e.index()].name));
-            self.effect_chain(&[e], 1);
+            let info = &c.effects[e.index()];
+            self.line(1, format!("// coarse effect `{}`", info.name));
+            if stored.contains(&e) && !info.has_refine {
+                // Its value here is what `coarse_neighbours` stored here: the same evaluation.
+                let name = self.effect_name(e);
+                self.line(1, format!("let {name} = mrsl_at_{}(mrsl_pos);", info.name));
+            } else {
+                self.effect_chain(&[e], 1);
+            }
         }
         if iface.flag_words > 0 {
             self.template(0, include_str!("templates/refine_flags.wgsl"), &[]);

@@ -6,7 +6,7 @@
 //! entry points of every family use.
 
 use super::body::{Mode, float_literal, local_name, wgsl_ident};
-use super::words::bit;
+use super::words::{bit, unpack_with};
 use super::writer::cut;
 use super::{Derivatives, Writer};
 use crate::check::{EffectId, InputId, KeyCompare, Symbol};
@@ -397,6 +397,19 @@ impl<'b> Writer<'_, '_, 'b> {
     /// are evaluated for their value alone.
     pub(super) fn neighbour_functions(&mut self) {
         let c = self.checked();
+        if self.stores_neighbours() {
+            for (e, offset) in self.neighbour_values() {
+                let info = &c.effects[e.index()];
+                self.line(0, format!("// `{}` at another sample, as `coarse_neighbours` stored it there.", info.name));
+                self.line(0, format!("fn mrsl_at_{}(mrsl_pos: vec2<i32>) -> {} {{", info.name, info.ty.wgsl()));
+                let value =
+                    unpack_with(&info.ty, |j| format!("textureLoad(mrsl_neighbours, mrsl_pos, {}).x", offset + j));
+                self.line(1, format!("return {value};"));
+                self.line(0, "}");
+                self.line(0, "");
+            }
+            return;
+        }
         let mut resolvers = HashMap::new();
         for e in self.effects_at_neighbours() {
             let info = &c.effects[e.index()];

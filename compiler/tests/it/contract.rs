@@ -102,7 +102,7 @@ fn kernels_declare_the_stage_bindings_of_the_contract() {
                     } else if decl.contains("texture_storage_2d_array<rgba32uint, write>") {
                         StageResource::RecordStorageTexture
                     } else if decl.contains("texture_storage_2d_array<r32uint, read_write>") {
-                        StageResource::PixelRecords
+                        StageResource::WordTexture
                     } else {
                         let format = decl.split("texture_storage_2d<").nth(1).unwrap().split(',').next().unwrap();
                         StageResource::StorageTexture(format.parse::<TextureFormat>().unwrap())
