@@ -806,23 +806,9 @@ impl Shader {
         }
         let work_words = geometry::work_list_words(size);
         let storage = |label, bytes, extra| storage_buffer(device, label, bytes, extra);
-        let record = self.layout.hierarchical.record_words.max(1);
+        let record = self.layout.hierarchical.record_words;
         let buffers = HierBuffers {
-            values: device
-                .create_texture(&wgpu::TextureDescriptor {
-                    label: Some("mrsl per-pixel records"),
-                    size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: record },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format: wgpu::TextureFormat::R32Uint,
-                    usage: wgpu::TextureUsages::STORAGE_BINDING,
-                    view_formats: &[],
-                })
-                .create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2Array),
-                    ..Default::default()
-                }),
+            values: word_texture_array(device, "mrsl per-pixel records", size, record, RECORD_WORDS),
             work: storage("mrsl hierarchical work lists", work_words * 4, wgpu::BufferUsages::empty()),
             queue: storage(
                 "mrsl hierarchical queues",
@@ -897,23 +883,10 @@ impl Shader {
     /// the size changes: the sample grid in texels, a layer per four words
     /// of a record ([`mrsl_abi::InterfaceLayout`]).
     fn record_texture(&mut self, device: &wgpu::Device, block: u32, size: (u32, u32)) -> &wgpu::TextureView {
-        let fresh = self.record_textures.get(&block).is_none_or(|(_, s)| *s != size);
-        if fresh {
-            let (nx, ny) = geometry::sample_grid(size, block);
-            let texture = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("mrsl records"),
-                size: wgpu::Extent3d { width: nx, height: ny, depth_or_array_layers: self.layout.interface.layers() },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba32Uint,
-                usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            });
-            let view = texture.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            });
+        if self.record_textures.get(&block).is_none_or(|(_, s)| *s != size) {
+            let grid = geometry::sample_grid(size, block);
+            let layers = self.layout.interface.layers();
+            let view = word_texture_array(device, "mrsl records", grid, layers, RECORD_TEXELS);
             self.record_textures.insert(block, (view, size));
         }
         &self.record_textures[&block].0
@@ -924,21 +897,9 @@ impl Shader {
     /// ([`mrsl_abi::NeighbourLayout`]).
     fn neighbour_texture(&mut self, device: &wgpu::Device, block: u32, size: (u32, u32)) -> &wgpu::TextureView {
         if self.neighbour_textures.get(&block).is_none_or(|(_, s)| *s != size) {
-            let (nx, ny) = geometry::sample_grid(size, block);
-            let texture = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("mrsl neighbour values"),
-                size: wgpu::Extent3d { width: nx, height: ny, depth_or_array_layers: self.layout.neighbours.words },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::R32Uint,
-                usage: wgpu::TextureUsages::STORAGE_BINDING,
-                view_formats: &[],
-            });
-            let view = texture.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            });
+            let grid = geometry::sample_grid(size, block);
+            let layers = self.layout.neighbours.words;
+            let view = word_texture_array(device, "mrsl neighbour values", grid, layers, RECORD_WORDS);
             self.neighbour_textures.insert(block, (view, size));
         }
         &self.neighbour_textures[&block].0
@@ -1124,6 +1085,39 @@ impl Shader {
     fn has_kernel(&self, kind: KernelKind, block: Option<u32>) -> bool {
         kind.entry_points().iter().all(|e| self.pipelines.contains_key(&(kind, block, *e)))
     }
+}
+
+/// The block modes' records: four words a texel, read by the fine kernels as a sampled texture.
+const RECORD_TEXELS: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
+/// The per-pixel records and the neighbour values: a word a texel, read and written in place.
+const RECORD_WORDS: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+
+/// A 2D texture array of `size` texels and `layers` layers (at least one) of
+/// `format`, as the array view the kernels bind: a storage texture, which the
+/// block records (`RECORD_TEXELS`) also are as a sampled one.
+fn word_texture_array(
+    device: &wgpu::Device,
+    label: &str,
+    size: (u32, u32),
+    layers: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::TextureView {
+    let sampled =
+        if format == RECORD_TEXELS { wgpu::TextureUsages::TEXTURE_BINDING } else { wgpu::TextureUsages::empty() };
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: layers.max(1) },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::STORAGE_BINDING | sampled,
+        view_formats: &[],
+    });
+    texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    })
 }
 
 /// A storage buffer of `bytes` (at least 4) with `extra` usages besides `STORAGE`.
