@@ -51,16 +51,7 @@ fn main() {
     let layout =
         wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(grid.0 * 16), rows_per_image: Some(grid.1) };
     queue.write_texture(texture.as_image_copy(), bytes, layout, extent);
-    let out = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("out"),
-        size: wgpu::Extent3d { width: SIZE.0, height: SIZE.1, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::R32Uint,
-        usage: wgpu::TextureUsages::STORAGE_BINDING,
-        view_formats: &[],
-    });
+    let out = gpu.output_texture("out", SIZE, wgpu::TextureFormat::R32Uint);
 
     let source = include_str!("record_loads.wgsl").replace("{{GRID_X}}", &grid.0.to_string());
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

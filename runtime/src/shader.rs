@@ -131,10 +131,9 @@ pub struct Shader {
     /// Interface buffers by (block size, tagged), with the size they were made
     /// for: the dynamic mode's 2x2 level and the rate-image mode's records.
     interfaces: HashMap<(u32, bool), (wgpu::Buffer, (u32, u32))>,
-    /// The block modes' record textures by block size, with the size they were made for.
-    record_textures: HashMap<u32, (wgpu::TextureView, (u32, u32))>,
-    /// The block coarse kernel's neighbour values by block size, with the size they were made for.
-    neighbour_textures: HashMap<u32, (wgpu::TextureView, (u32, u32))>,
+    /// The block modes' textures over a sample grid (records, neighbour
+    /// values) by block size, with the image size they were made for.
+    sample_textures: HashMap<(SampleTexture, u32), (wgpu::TextureView, (u32, u32))>,
     /// Dispatch counter, written to the control block (validity tags of the dynamic mode).
     frame: u32,
     /// The fine kernel's per-pixel refine mask, with the size it was made for.
@@ -300,8 +299,7 @@ impl Shader {
             uniforms,
             uniform_values: HashMap::new(),
             interfaces: HashMap::new(),
-            record_textures: HashMap::new(),
-            neighbour_textures: HashMap::new(),
+            sample_textures: HashMap::new(),
             frame: 0,
             rate: None,
             stats,
@@ -392,35 +390,33 @@ impl Shader {
             }
             Ok(())
         };
+        // Every texture array of records must fit WebGPU's default texture limits.
+        let fits_texture = |what: &str, (w, h): (u32, u32), layers: u32| {
+            if w.max(h) > MAX_TEXTURE_SIDE || layers > MAX_TEXTURE_LAYERS {
+                let reason = format!(
+                    "{what} would need {w}x{h} texels and {layers} layers, more than \
+                     {MAX_TEXTURE_SIDE}x{MAX_TEXTURE_SIDE} texels and {MAX_TEXTURE_LAYERS} layers"
+                );
+                return Err(Error::BadSize { width, height, reason });
+            }
+            Ok(())
+        };
         let samples = |block| {
             let (nx, ny) = geometry::sample_grid(bindings.size, block);
             u64::from(nx) * u64::from(ny)
         };
         let pixels = u64::from(width) * u64::from(height);
         if let Some(block) = mode.block_size() {
-            let (nx, ny) = geometry::sample_grid(bindings.size, block);
-            let layers = self.layout.interface.layers().max(self.layout.neighbours.words);
-            if nx.max(ny) > MAX_TEXTURE_SIDE || layers > MAX_TEXTURE_LAYERS {
-                let reason = format!(
-                    "the record texture would need {nx}x{ny} texels and {layers} layers, more than \
-                     {MAX_TEXTURE_SIDE}x{MAX_TEXTURE_SIDE} texels and {MAX_TEXTURE_LAYERS} layers"
-                );
-                return Err(Error::BadSize { width, height, reason });
-            }
+            let grid = geometry::sample_grid(bindings.size, block);
+            fits_texture("the record texture", grid, self.layout.interface.layers())?;
+            fits_texture("the neighbour values", grid, self.layout.neighbours.words)?;
         }
         if mode == Mode::Dynamic {
             let words = u64::from(self.layout.interface.stride_words + geometry::DYNAMIC_TAG_WORDS);
             fits("the 2x2 level", samples(geometry::DYNAMIC_INNER_BLOCK) * words)?;
         }
         if matches!(mode, Mode::Hierarchical | Mode::Checkerboard) {
-            let layers = self.layout.hierarchical.record_words;
-            if width.max(height) > MAX_TEXTURE_SIDE || layers > MAX_TEXTURE_LAYERS {
-                let reason = format!(
-                    "the per-pixel record texture would need {width}x{height} texels and {layers} layers, more \
-                     than {MAX_TEXTURE_SIDE}x{MAX_TEXTURE_SIDE} texels and {MAX_TEXTURE_LAYERS} layers"
-                );
-                return Err(Error::BadSize { width, height, reason });
-            }
+            fits_texture("the per-pixel record texture", bindings.size, self.layout.hierarchical.record_words)?;
         }
         if mode == Mode::RateImage {
             fits("the rate-image interface", pixels * u64::from(self.layout.interface.stride_words))?;
@@ -555,10 +551,10 @@ impl Shader {
                     );
                 }
                 Some(block) => {
-                    let records = self.record_texture(device, block, bindings.size).clone();
+                    let records = self.sample_texture(device, SampleTexture::Records, block, bindings.size).clone();
                     let stores_neighbours = self.layout.neighbours.words > 0;
-                    let neighbours =
-                        stores_neighbours.then(|| self.neighbour_texture(device, block, bindings.size).clone());
+                    let neighbours = stores_neighbours
+                        .then(|| self.sample_texture(device, SampleTexture::Neighbours, block, bindings.size).clone());
                     self.ensure_rate_image(device, bindings.size);
                     let dynamic = mode == Mode::Dynamic;
                     let inner = if dynamic {
@@ -879,30 +875,30 @@ impl Shader {
         &self.interfaces[&(block, tagged)].0
     }
 
-    /// The record texture of the block modes for `block`, (re)created when
-    /// the size changes: the sample grid in texels, a layer per four words
-    /// of a record ([`mrsl_abi::InterfaceLayout`]).
-    fn record_texture(&mut self, device: &wgpu::Device, block: u32, size: (u32, u32)) -> &wgpu::TextureView {
-        if self.record_textures.get(&block).is_none_or(|(_, s)| *s != size) {
+    /// The block modes' texture `what` for `block`, (re)created when the
+    /// size changes: the sample grid in texels, with the layers of its
+    /// layout ([`mrsl_abi::InterfaceLayout`], [`mrsl_abi::NeighbourLayout`]).
+    fn sample_texture(
+        &mut self,
+        device: &wgpu::Device,
+        what: SampleTexture,
+        block: u32,
+        size: (u32, u32),
+    ) -> &wgpu::TextureView {
+        if self.sample_textures.get(&(what, block)).is_none_or(|(_, s)| *s != size) {
             let grid = geometry::sample_grid(size, block);
-            let layers = self.layout.interface.layers();
-            let view = word_texture_array(device, "mrsl records", grid, layers, RECORD_TEXELS);
-            self.record_textures.insert(block, (view, size));
+            let view = match what {
+                SampleTexture::Records => {
+                    word_texture_array(device, "mrsl records", grid, self.layout.interface.layers(), RECORD_TEXELS)
+                }
+                SampleTexture::Neighbours => {
+                    let words = self.layout.neighbours.words;
+                    word_texture_array(device, "mrsl neighbour values", grid, words, RECORD_WORDS)
+                }
+            };
+            self.sample_textures.insert((what, block), (view, size));
         }
-        &self.record_textures[&block].0
-    }
-
-    /// The coarse kernel's neighbour values for `block`, (re)created when the
-    /// size changes: the sample grid in texels, a layer per word
-    /// ([`mrsl_abi::NeighbourLayout`]).
-    fn neighbour_texture(&mut self, device: &wgpu::Device, block: u32, size: (u32, u32)) -> &wgpu::TextureView {
-        if self.neighbour_textures.get(&block).is_none_or(|(_, s)| *s != size) {
-            let grid = geometry::sample_grid(size, block);
-            let layers = self.layout.neighbours.words;
-            let view = word_texture_array(device, "mrsl neighbour values", grid, layers, RECORD_WORDS);
-            self.neighbour_textures.insert(block, (view, size));
-        }
-        &self.neighbour_textures[&block].0
+        &self.sample_textures[&(what, block)].0
     }
 
     fn resources_group(&self, device: &wgpu::Device, bindings: &Bindings) -> wgpu::BindGroup {
@@ -1261,6 +1257,15 @@ fn gbuffer_layout(device: &wgpu::Device, l: &Layout) -> wgpu::BindGroupLayout {
         .collect();
     device
         .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("mrsl g-buffer"), entries: &entries })
+}
+
+/// The block modes' textures over a sample grid.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+enum SampleTexture {
+    /// The coarse-to-fine records.
+    Records,
+    /// The coarse kernel's neighbour values.
+    Neighbours,
 }
 
 /// What a stage group binds as the interface ([`StageSlot::Interface`]).
