@@ -82,6 +82,10 @@ fn nothing_refined(w: &str) -> Option<String> {
         if t.starts_with("if (mrsl_is_refined(mrsl_b, ") && t.contains("mrsl_cq[") {
             return Some(String::new());
         }
+        if let Some((todo, _)) = t.strip_prefix("var mrsl_todo_").and_then(|r| r.split_once(" = ")) {
+            // The block fine kernel's loops over a lane's refined pixels.
+            return Some(format!("{}var mrsl_todo_{todo} = 0u;", indent(l)));
+        }
         (t.starts_with("if (mrsl_is_refined(mrsl_b, ") && t.ends_with(")) {"))
             .then(|| format!("{}if (false) {{", indent(l)))
     })
@@ -94,15 +98,24 @@ fn nothing_refined(w: &str) -> Option<String> {
 fn nothing_refined_at_run_time(w: &str) -> Option<String> {
     edit_lines(w, |l| {
         let t = l.trim_start();
+        if let Some((todo, pixels)) = t.strip_prefix("var mrsl_todo_").and_then(|r| r.split_once(" = ")) {
+            let pixels = pixels.strip_suffix(';')?;
+            return Some(format!("{}var mrsl_todo_{todo} = ({pixels}) & select(0u, 3u, mrsl_first.x < 0);", indent(l)));
+        }
         let cond = t.strip_prefix("if (mrsl_is_refined(mrsl_b, ")?.strip_suffix(")) {")?;
         Some(format!("{}if (mrsl_is_refined(mrsl_b, {cond}) && mrsl_pos.x < 0) {{", indent(l)))
     })
 }
 
-/// The key loads and comparisons of the resolve (each `disc_<key>` false).
+/// The key loads and comparisons of the resolve: every corner on each
+/// pixel's side of every key (`side_<key>` all true), or
+/// in the kernels that refine a whole block at an edge, `disc_<key>` false.
 fn no_key_tests(w: &str) -> Option<String> {
     edit_lines(w, |l| {
         let t = l.trim_start();
+        if let Some(name) = t.strip_prefix("let side_").and_then(|r| r.split(' ').next()) {
+            return Some(format!("{}let side_{name} = vec4<bool>(true);", indent(l)));
+        }
         let name = t.strip_prefix("let disc_")?.split(' ').next()?;
         Some(format!("{}let disc_{name} = false;", indent(l)))
     })
@@ -119,10 +132,22 @@ fn no_flag_reads(w: &str) -> Option<String> {
     })
 }
 
-/// The resampling of the coarse effects (they read zero).
+/// The resampling of the coarse effects (they read zero): each resampling
+/// function of the preloaded corners returns its type's zero value, and
+/// elsewhere the calls are dropped.
 fn no_resampling(w: &str) -> Option<String> {
+    let returned = std::cell::RefCell::new(None::<String>);
     edit_lines(w, |l| {
         let t = l.trim_start();
+        if t.starts_with("fn mrsl_resample_") && t.contains("c: MrslCorners") {
+            *returned.borrow_mut() = t.rsplit_once("-> ").map(|(_, ty)| ty.trim_end_matches(" {").to_string());
+            return None;
+        }
+        if t.starts_with("return ")
+            && let Some(ty) = returned.borrow_mut().take()
+        {
+            return Some(format!("{}return {ty}();", indent(l)));
+        }
         let resamples = t.ends_with("(mrsl_b);") || t.ends_with("(mrsl_b, mrsl_c);");
         (t.contains(" = mrsl_resample_") && resamples && !t.starts_with("let ")).then(String::new)
     })
@@ -136,6 +161,12 @@ fn no_fine_work(w: &str) -> Option<String> {
             Some(format!("{}if (false && {}", indent(l), &t["if (".len()..]))
         }
         "let mrsl_in = all(mrsl_pos < mrsl_grid());" => Some(format!("{}let mrsl_in = false;", indent(l))),
+        // The block fine kernel's pixels (`mrsl_in<k>`): nothing is stored,
+        // so nothing is computed.
+        t if t.starts_with("let mrsl_in") && t.ends_with(" < mrsl_grid());") => {
+            let name = t["let ".len()..].split(' ').next()?;
+            Some(format!("{}let {name} = false;", indent(l)))
+        }
         _ => None,
     })
 }

@@ -75,8 +75,10 @@ fine out float4 color = float4(shade, shade, shade, 1.0);
 ";
 
 /// Step functions with the step on the discontinuity key (the normal, which
-/// `shade` reads, with a threshold far below a step's turn): blocks that
-/// straddle a step are shaded per pixel, the others are constant, so no
+/// `shade` reads, with a threshold far below a step's turn): in blocks that
+/// straddle a step, the block modes resample each pixel from the corners on
+/// its side of the step and shade per pixel only where none is (the
+/// hierarchical and checkerboard modes shade the edge per pixel), so no
 /// pixel may blend two steps. A blended pixel would be off by at least a
 /// step height (> 0.05); interpolating equal corners is exact up to the
 /// rounding of weights that sum to one (2e-7).
@@ -92,7 +94,8 @@ pub fn steps_keep_their_edges(gpu: &Gpu) {
             let shade = &out.stats.effects[0];
             // Checkerboard shades half the quads by construction (plus border pixels).
             let limit = if mode == Mode::Checkerboard { (w * h) as u64 * 3 / 4 } else { (w * h) as u64 / 2 };
-            assert!(shade.pixel_evaluations > 0 && shade.pixel_evaluations < limit, "{mode}: {shade:?}");
+            assert!(shade.pixel_evaluations < limit, "{mode}: {shade:?}");
+            assert!(shade.resampled > 0, "{mode}: {shade:?}");
         }
     }
 }
@@ -106,9 +109,12 @@ fine out float4 color = float4(light, tint, 0.0, 1.0);
 ";
 
 /// A 64x48 G-buffer whose material changes at column 29 (`material_edge`) or
-/// whose normal turns by about 50 degrees there (otherwise), over a normal
-/// that tilts smoothly with x elsewhere: 0.6 across the image, so 0.04
-/// between corners 4 pixels apart, far below the normal key's 0.1.
+/// whose normal turns by about 50 degrees there (otherwise), and again on
+/// the one-pixel ridge of column 45, over a normal that tilts smoothly with
+/// x elsewhere: 0.6 across the image, so 0.04 between corners 4 pixels
+/// apart, far below the normal key's 0.1. Column 45 lies between corner
+/// columns in every block size (44 and 46, 44 and 48), so no corner is on
+/// its side of the ridge.
 fn edge_gbuffer(material_edge: bool) -> GBuffer {
     let (w, h) = (64u32, 48u32);
     let mut normal = vec![];
@@ -116,10 +122,11 @@ fn edge_gbuffer(material_edge: bool) -> GBuffer {
     for _y in 0..h {
         for x in 0..w {
             let tilt = (x as f32 / w as f32 - 0.5) * 0.6;
-            let n = if !material_edge && x >= 29 { [tilt + 0.9, 0.3, 0.4] } else { [tilt, 0.3, 1.0] };
+            let edged = x >= 29 && x != 45;
+            let n = if !material_edge && edged { [tilt + 0.9, 0.3, 0.4] } else { [tilt, 0.3, 1.0] };
             let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
             normal.extend(n.map(|v| v / len));
-            material.push(if material_edge && x >= 29 { 2 } else { 1 });
+            material.push(if material_edge && edged { 2 } else { 1 });
         }
     }
     GBuffer {
@@ -135,12 +142,17 @@ fn edge_gbuffer(material_edge: bool) -> GBuffer {
 /// A discontinuity key refines the coarse effects that read it, directly or
 /// through other effects, and no other: a material-only edge leaves the
 /// lighting (which never reads `material`) interpolated, and a geometric
-/// edge (the normal key) within one material refines the lighting but not
-/// the material tint. Where an effect is refined, no pixel blends across the
-/// edge: a blend is off by at least 0.05 (a tint step is 0.25, the lighting
-/// step about 0.3), while interpolating the smooth parts is off by the
-/// curvature of a gently tilting Lambert term (3.6e-5 measured), so 1e-3
-/// separates the two. The block modes count evaluations
+/// edge (the normal key) within one material refines the lighting (on the
+/// ridge, where no corner is on the pixel's side; at the step the pixels
+/// resample the corners on their side) but not the material tint. For the
+/// effect that reads the key, no pixel blends across the edge: a blend
+/// gives the far side at least a quarter of the weight (a pixel one column
+/// from its corners in a 4x4 block), so it is off by at least 0.06 (a tint
+/// step is 0.25, the lighting step about 0.3). Resampling the corners on
+/// one side instead extrapolates the smooth tilt over at most 3 pixels:
+/// 0.0094 of normal per pixel, measured at most 0.0030 (2x2) and 0.0090
+/// (4x4); interpolating elsewhere is off by the curvature of the Lambert
+/// term (3.6e-5). So 0.02 separates a blend from the rest. The block modes count evaluations
 /// exactly (they refine only by flags and keys, and these effects have no
 /// `refine`); the hierarchical mode also refines by its variance test, so
 /// only its image is checked.
@@ -158,7 +170,8 @@ pub fn keys_refine_only_the_effects_that_read_them(gpu: &Gpu) {
             let err =
                 out.pixels.iter().zip(&reference.pixels).map(|(a, b)| (a[edged] - b[edged]).abs()).fold(0.0, f32::max);
             let what = if material_edge { "material edge" } else { "geometric edge" };
-            assert!(err <= 1e-3, "{what}, {mode}: channel {edged} blends across the edge (error {err})");
+            eprintln!("{what}, {mode}: channel {edged} off by at most {err}");
+            assert!(err <= 0.02, "{what}, {mode}: channel {edged} blends across the edge (error {err})");
             if mode == Mode::Hierarchical {
                 continue;
             }

@@ -42,11 +42,12 @@ fn shade(
 }
 
 /// The demo program over Sponza at 192x108, from the scene's camera.
-/// Measured on lavapipe (llvmpipe, Mesa 22.3): coarse2x2 57.2 dB and
-/// coarse4x4 60.5 dB against the reference, at shaded fractions 0.885 and
-/// 0.906. (4x4 scores higher: at this size most of Sponza's 4x4 blocks
-/// straddle a silhouette or a crease, which the program's position and
-/// normal keys refine.) The bars are 3 dB below the measurements: the refine
+/// Measured on lavapipe (llvmpipe, Mesa 22.3): coarse2x2 56.4 dB and
+/// coarse4x4 56.4 dB against the reference, at shaded fractions 0.819 and
+/// 0.814. (At this size most of Sponza's blocks straddle a silhouette or a
+/// crease. Before the fine kernel resampled the corners on a pixel's side
+/// of an edge, it refined every such block: 57.2 and 60.5 dB at 0.885 and
+/// 0.906.) The bars are 3 dB below the measurements: the refine
 /// decisions compare derivatives and keys with thresholds, so another
 /// driver's rounding can flip a few blocks; the 3 dB leave room for that.
 /// Blending across silhouettes costs far more: the same program without the
@@ -75,7 +76,7 @@ pub fn sponza_coarse_modes_stay_close_to_the_reference(gpu: &Gpu) {
     assert!(again.pixels == reference.pixels, "the uploaded readback shades differently");
 
     let mut fractions = vec![reference.stats.shaded_fraction];
-    for (mode, bar) in [(Mode::Coarse2x2, 54.2), (Mode::Coarse4x4, 57.5)] {
+    for (mode, bar) in [(Mode::Coarse2x2, 53.3), (Mode::Coarse4x4, 53.3)] {
         let out = shade(gpu, &program, &channels, mode, Some(eye));
         let db = psnr(&out.pixels, &reference.pixels);
         eprintln!(
@@ -636,13 +637,16 @@ pub fn sponza_lights_workload_matches_its_reference(gpu: &Gpu) {
         assert!(forced.pixels == reference.pixels, "{mode}: forced refinement differs from the reference");
     }
     // Adaptive quality at the program's defaults, measured on lavapipe
-    // (Mesa 22.3) at 192x108: coarse4x4 52.7 dB at shaded fraction 0.967,
-    // hierarchical 56.0 dB at 0.751 (at this size almost every 4x4 block
-    // holds a silhouette or a crease, which the position and normal keys
-    // refine). The bars are 3 dB below, as in the test above: threshold
+    // (Mesa 22.3) at 192x108: coarse4x4 36.6 dB at shaded fraction 0.611,
+    // hierarchical 56.0 dB at 0.751. At this size almost every 4x4 block
+    // holds a silhouette or a crease, and a block spans metres of wall: a
+    // pixel resampled from the corners on its side of an edge extrapolates
+    // the 32 lights' falloff across it (52.7 dB at 0.967 when every such
+    // block was refined; at 1920x1080 the same program is at MSSIM 0.99,
+    // docs/evaluation.md). The bars are 3 dB below, as in the test above: threshold
     // comparisons may flip a few blocks on another driver.
     // (20,427 of 20,504 visible points agreed with the shadow map.)
-    for (mode, bar) in [(Mode::Coarse4x4, 49.7), (Mode::Hierarchical, 53.0)] {
+    for (mode, bar) in [(Mode::Coarse4x4, 33.5), (Mode::Hierarchical, 53.0)] {
         let out = run(mode, false);
         let db = psnr(&out.pixels, &reference.pixels);
         eprintln!("sponza_lights 192x108 {mode}: PSNR {db:.2} dB, shaded fraction {:.4}", out.stats.shaded_fraction);

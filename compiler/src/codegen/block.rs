@@ -6,10 +6,11 @@
 //! blocks; what only they add is in [`super::dynamic`].
 
 use super::Writer;
+use super::body::float_literal;
 use super::effects::Key;
 use super::words::{bit, pack_words, test_bit, unpack_with, unpack_words};
 use super::writer::{cut, fill};
-use crate::check::EffectId;
+use crate::check::{EffectId, InputId, KeyCompare};
 use crate::layout;
 use crate::syntax::ast::Rate;
 use mrsl_abi::KernelKind;
@@ -314,6 +315,15 @@ impl Writer<'_, '_, '_> {
         self.template(0, head, &[]);
         // Separate words, not an array: llvmpipe spills dynamically indexed
         // arrays in structs to memory, which made every lookup a memory access.
+        if !rate {
+            for (s, keys) in self.edge_sets().iter().enumerate() {
+                let names: Vec<&str> = keys.iter().map(|k| self.checked().inputs[k.index()].name.as_str()).collect();
+                self.line(
+                    1,
+                    format!("weights{s}: vec4<f32>, // the corners on the pixel's side of {}", names.join(", ")),
+                );
+            }
+        }
         for w in 0..mask_words {
             self.line(1, format!("refined{w}: u32, // bit k: coarse effect 32 * {w} + k is evaluated per pixel"));
         }
@@ -353,9 +363,6 @@ impl Writer<'_, '_, '_> {
                 self.line(1, format!("{corner}_{}: {},", key.name, key.ty));
             }
         }
-        for key in &keys {
-            self.line(1, format!("split_{}: bool, // the block's own corners disagree on the key", key.name));
-        }
         for w in 0..stride {
             self.line(1, format!("w{w}: vec4<u32>,"));
         }
@@ -370,8 +377,6 @@ impl Writer<'_, '_, '_> {
             for (corner, at) in CORNERS.iter().zip(CORNER_PIXELS) {
                 self.line(1, format!("c.{corner}_{name} = mrsl_load_{name}({at});"));
             }
-            // Tested once per lane, not once per pixel.
-            self.line(1, format!("c.split_{name} = {};", corners_differ(key, "c.").join(" || ")));
         }
         // A texel holds four words of a record: one load per corner and texel.
         let texels = ["i0", "vec2<i32>(i1.x, i0.y)", "vec2<i32>(i0.x, i1.y)", "i1"];
@@ -386,6 +391,65 @@ impl Writer<'_, '_, '_> {
             }
         }
         self.template(0, tail, values);
+    }
+
+    /// The distinct sets of discontinuity keys that the live coarse effects
+    /// read (`EffectGraph::keys`), each non-empty: `MrslBlock::weights<s>`
+    /// holds the resampling weights of the effects that read set `s`.
+    pub(super) fn edge_sets(&self) -> Vec<Vec<InputId>> {
+        let sets: BTreeSet<Vec<InputId>> = self
+            .coarse_live()
+            .into_iter()
+            .map(|e| self.i.graph.keys[e.index()].clone())
+            .filter(|keys| !keys.is_empty())
+            .collect();
+        sets.into_iter().collect()
+    }
+
+    /// The index in [`Self::edge_sets`] of the keys coarse effect `e` reads, if it reads any.
+    fn edge_set_of(&self, e: EffectId) -> Option<usize> {
+        let keys = &self.i.graph.keys[e.index()];
+        self.edge_sets().iter().position(|set| set == keys)
+    }
+
+    /// In `mrsl_resolve`, after the keys' `side_<key>`: for each key set the
+    /// `coarse` effects read, the corners on the pixel's side of all of them
+    /// (`side<s>`) and their bilinear weights renormalised (`b.weights<s>`,
+    /// exactly `b.weights` where every corner is on the pixel's side, so
+    /// that a block without an edge blends as before). `sum<s>` is zero
+    /// where no corner with a weight is on the pixel's side: the effects are
+    /// then evaluated per pixel ([`Self::edge_discontinuity`]).
+    fn edge_weights(&mut self, coarse: &[EffectId]) {
+        let c = self.checked();
+        let used: BTreeSet<usize> = coarse.iter().filter_map(|&e| self.edge_set_of(e)).collect();
+        for (s, keys) in self.edge_sets().iter().enumerate() {
+            if !used.contains(&s) {
+                continue;
+            }
+            let sides: Vec<String> = keys.iter().map(|k| format!("side_{}", c.inputs[k.index()].name)).collect();
+            let names: Vec<&str> = keys.iter().map(|k| c.inputs[k.index()].name.as_str()).collect();
+            self.template(
+                0,
+                include_str!("templates/edge_weights.wgsl"),
+                &[("SET", &s), ("KEYS", &names.join(", ")), ("SIDES", &sides.join(" & "))],
+            );
+        }
+    }
+
+    /// `disc || ...`: true where the fine kernel evaluates coarse effect `e`
+    /// per pixel because of a discontinuity: forced refinement, or an edge of
+    /// a key `e` reads with no corner on the pixel's side to resample from
+    /// (any corner across it for an effect resampled from the nearest corner,
+    /// which cannot be renormalised, or whose value reads a derivative, which
+    /// at a corner may have been taken across the edge).
+    fn edge_discontinuity(&self, e: EffectId) -> String {
+        match self.edge_set_of(e) {
+            None => "disc".to_string(),
+            Some(s) if layout::uses_nearest(self.checked(), e) || self.value_reads_derivatives(e) => {
+                format!("disc || !all(side{s})")
+            }
+            Some(s) => format!("disc || torn{s}"),
+        }
     }
 
     /// `mrsl_resolve{suffix}`: where a pixel takes its coarse values from at
@@ -454,13 +518,25 @@ impl Writer<'_, '_, '_> {
                 );
                 continue;
             }
-            let mut tests: Vec<String> =
-                CORNERS.iter().map(|corner| key.differs(&format!("k_{name}"), &format!("{corner}_{name}"))).collect();
-            if preloaded {
-                tests.push(format!("c.split_{name}"));
-            } else {
-                tests.extend(corners_differ(&key, ""));
-            }
+            // Which corners are on the pixel's side of the key.
+            let side = match key.compare {
+                KeyCompare::Exact => {
+                    let matches: Vec<String> = CORNERS
+                        .iter()
+                        .map(|corner| key.matches(&format!("k_{name}"), &format!("{corner}_{name}")))
+                        .collect();
+                    format!("vec4<bool>({})", matches.join(", "))
+                }
+                KeyCompare::Threshold { threshold } => format!("d_{name} <= vec4<f32>({})", float_literal(threshold)),
+            };
+            let distances = match key.compare {
+                KeyCompare::Exact => String::new(),
+                KeyCompare::Threshold { .. } => {
+                    let d: Vec<String> =
+                        CORNERS.iter().map(|corner| format!("distance(k_{name}, {corner}_{name})")).collect();
+                    format!("    let d_{name} = vec4<f32>({});\n", d.join(", "))
+                }
+            };
             let at: Vec<String> = CORNERS
                 .iter()
                 .zip(CORNER_PIXELS)
@@ -479,9 +555,13 @@ impl Writer<'_, '_, '_> {
                     ("K10", &at[1]),
                     ("K01", &at[2]),
                     ("K11", &at[3]),
-                    ("TESTS", &tests.join(" || ")),
+                    ("DISTANCES", &distances),
+                    ("SIDE", &side),
                 ],
             );
+        }
+        if !rate {
+            self.edge_weights(&coarse);
         }
         let words: Vec<u32> = match only {
             None => (0..iface.flag_words).collect(),
@@ -516,7 +596,7 @@ impl Writer<'_, '_, '_> {
         for &e in coarse.iter().rev() {
             let info = &c.effects[e.index()];
             let k = self.coarse_index[&e];
-            let mut terms = vec![self.discontinuity(e)];
+            let mut terms = vec![if rate { self.discontinuity(e) } else { self.edge_discontinuity(e) }];
             if let Some(b) = iface.refine_bit[e.index()] {
                 let (word, mask) = bit(b);
                 let words: Vec<String> = (0..samples.len()).map(|ci| format!("f{ci}_{word}")).collect();
@@ -654,7 +734,11 @@ impl Writer<'_, '_, '_> {
                     ),
                 )
             } else {
-                ("bilinear", "v0 * b.weights.x + v1 * b.weights.y + v2 * b.weights.z + v3 * b.weights.w".to_string())
+                let weights = match self.edge_set_of(e) {
+                    Some(s) if self.kind != KernelKind::RateFine => format!("b.weights{s}"),
+                    _ => "b.weights".to_string(),
+                };
+                ("bilinear", format!("v0 * {weights}.x + v1 * {weights}.y + v2 * {weights}.z + v3 * {weights}.w"))
             };
             let values: &super::writer::Values = &[
                 ("SUFFIX", &sfx),
@@ -711,6 +795,9 @@ impl Writer<'_, '_, '_> {
     /// `mrsl_pos` in the fine kernels; nothing elsewhere. `name` is the suffix
     /// of a neighbour function's own resolvers (`mrsl_resolve_<effect>`), or empty.
     pub(super) fn resolve_preamble(&mut self, indent: usize, name: &str) {
+        if self.pixels_resolved {
+            return;
+        }
         if self.preloads_corners() {
             // The entry point loads its lane's corners once; elsewhere each position loads its own.
             if !self.corners_loaded {

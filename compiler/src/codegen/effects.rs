@@ -21,7 +21,7 @@ pub(super) struct Key<'c> {
     pub(super) name: &'c str,
     /// The channel's WGSL type.
     pub(super) ty: String,
-    compare: KeyCompare,
+    pub(super) compare: KeyCompare,
     scalar: bool,
 }
 
@@ -183,7 +183,7 @@ impl<'b> Writer<'_, '_, 'b> {
         }
     }
 
-    fn deps_params(&self, e: EffectId) -> Vec<EffectId> {
+    pub(super) fn deps_params(&self, e: EffectId) -> Vec<EffectId> {
         self.checked().effects[e.index()].deps.iter().map(|(d, _)| *d).collect()
     }
 
@@ -223,6 +223,36 @@ impl<'b> Writer<'_, '_, 'b> {
             },
         }
         read
+    }
+
+    /// Whether coarse effect `e`'s value, not only its refine decision,
+    /// reads a derivative (or a `sample`, whose gradients are derivatives),
+    /// directly or through the coarse effects it reads. Its value at a
+    /// coarse sample then depends on the sample's quad neighbour, which may
+    /// lie across an edge, so the fine kernel never resamples it from the
+    /// corners on one side of an edge ([`Writer::edge_discontinuity`]).
+    pub(super) fn value_reads_derivatives(&self, e: EffectId) -> bool {
+        let c = self.checked();
+        let own: Vec<NodeId> = c.derivative_calls.iter().filter(|(x, _)| *x == e).map(|(_, n)| *n).collect();
+        if !own.is_empty() {
+            let mut kept = HashSet::new();
+            let mut collect = |x: &Expr| visit_expr(x, &mut |y| _ = kept.insert(y.id));
+            match &c.effect_decl(e).body {
+                EffectBody::Expr(x) => collect(x),
+                EffectBody::Block(b) => {
+                    let none = HashSet::new();
+                    let skipped = self.i.deriv.value_skips.get(&e).unwrap_or(&none);
+                    b.stmts.iter().for_each(|s| visit_kept_exprs(s, skipped, &mut collect));
+                }
+            }
+            if own.iter().any(|n| kept.contains(n)) {
+                return true;
+            }
+        }
+        c.effects[e.index()]
+            .deps
+            .iter()
+            .any(|(d, _)| c.effects[d.index()].rate == Rate::Coarse && self.value_reads_derivatives(*d))
     }
 
     /// `mrsl_eval_<effect>`: the effect's body at `mrsl_pos`, given its
@@ -463,8 +493,15 @@ impl<'b> Writer<'_, '_, 'b> {
     /// refine flags, an effect that can refine is evaluated by
     /// `mrsl_val_<effect>`, with no flag.
     pub(super) fn evaluate(&mut self, e: EffectId, indent: usize, declare: &str) {
+        self.evaluate_at(e, indent, declare, "mrsl_pos", "");
+    }
+
+    /// [`Self::evaluate`] at position `pos`, with the values of `e` and of
+    /// its dependencies named `{prefix}{name}` (the block fine kernel's
+    /// per-pixel values, `mrsl_v<k>_<effect>`).
+    pub(super) fn evaluate_at(&mut self, e: EffectId, indent: usize, declare: &str, pos: &str, prefix: &str) {
         let info = &self.checked().effects[e.index()];
-        let mut args = vec!["mrsl_pos".to_string()];
+        let mut args = vec![pos.to_string()];
         let function = if info.has_refine && (self.value_only || !self.keeps_refine_flags()) {
             "val"
         } else {
@@ -474,10 +511,10 @@ impl<'b> Writer<'_, '_, 'b> {
             }
             "eval"
         };
-        args.extend(self.deps_params(e).into_iter().map(|d| self.effect_name(d)));
+        args.extend(self.deps_params(e).into_iter().map(|d| format!("{prefix}{}", self.effect_name(d))));
         self.line(
             indent,
-            format!("{declare}{} = mrsl_{function}_{}({});", self.effect_name(e), info.name, args.join(", ")),
+            format!("{declare}{prefix}{} = mrsl_{function}_{}({});", self.effect_name(e), info.name, args.join(", ")),
         );
     }
 

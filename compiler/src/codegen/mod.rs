@@ -155,6 +155,9 @@ struct Writer<'i, 'a, 'b> {
     /// While writing the block fine kernel's entry point: `mrsl_c`, the
     /// corners of the lane's block (`mrsl_corners`), is in scope.
     corners_loaded: bool,
+    /// While writing the block fine kernel's statistics for one of its
+    /// pixels: `mrsl_b`, the pixel's resolved block, is in scope.
+    pixels_resolved: bool,
 }
 
 impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
@@ -176,6 +179,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             skipped: None,
             value_only: false,
             corners_loaded: false,
+            pixels_resolved: false,
         }
     }
 

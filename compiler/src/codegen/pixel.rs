@@ -115,7 +115,9 @@ impl Writer<'_, '_, '_> {
             ],
         );
         let counted = self.counts_stats();
-        if pairs {
+        if self.kind == KernelKind::Fine && !self.coarse_live().is_empty() {
+            self.effect_major_pixels(&mut prologue);
+        } else if pairs {
             if !self.coarse_live().is_empty() {
                 // A lane past the image's edge still loads (clamped) corners: it skips its pixels below.
                 self.line(1, "let mrsl_c = mrsl_corners(min(mrsl_first, mrsl_grid() - vec2<i32>(1)));");
@@ -187,15 +189,115 @@ impl Writer<'_, '_, '_> {
     }
 
     pub(super) fn output_stores(&mut self, order: &[EffectId], indent: usize) {
+        self.output_stores_at(order, indent, "mrsl_pos", "");
+    }
+
+    /// [`Self::output_stores`] at `pos`, of the values named `{prefix}{output}`.
+    fn output_stores_at(&mut self, order: &[EffectId], indent: usize, pos: &str, prefix: &str) {
         let c = self.checked();
         for e in order {
             let info = &c.effects[e.index()];
             if info.rate != Rate::Out {
                 continue;
             }
-            let value = to_vec4(&self.effect_name(*e), &info.ty);
-            self.line(indent, format!("textureStore(mrsl_out_{}, mrsl_pos, {value});", info.name));
+            let value = to_vec4(&format!("{prefix}{}", self.effect_name(*e)), &info.ty);
+            self.line(indent, format!("textureStore(mrsl_out_{}, {pos}, {value});", info.name));
         }
+    }
+
+    /// The block fine kernel's pixels, effect by effect: a lane resolves
+    /// its [`FINE_PIXELS_PER_LANE`] pixels of one block (`mrsl_pos<k>`,
+    /// `mrsl_b<k>`, the values `mrsl_v<k>_<effect>`), then evaluates each
+    /// effect for all of them. A coarse effect is resampled at each pixel and
+    /// re-evaluated, in a loop, at the pixels that refine it.
+    ///
+    /// Why a loop and not a branch per pixel: llvmpipe runs the body of an
+    /// `if` that no lane of a SIMD group takes (masked), and leaves a loop
+    /// only after its first iteration, once no lane is left in it. A branch
+    /// per pixel therefore costs a masked evaluation per pixel where nothing
+    /// is refined; the loop costs one per lane, and where a lane refines one
+    /// pixel of its two it runs the evaluation once, not twice (ablation
+    /// "nothing refined at run time", docs/evaluation.md).
+    fn effect_major_pixels(&mut self, prologue: &mut impl FnMut(&mut Self)) {
+        let per_lane = FINE_PIXELS_PER_LANE;
+        let pixels: Vec<u32> = (0..per_lane).collect();
+        // A lane past the image's edge still loads (clamped) corners and
+        // resolves; its pixels' statistics and stores are skipped below.
+        self.line(1, "let mrsl_c = mrsl_corners(min(mrsl_first, mrsl_grid() - vec2<i32>(1)));");
+        self.corners_loaded = true;
+        for &k in &pixels {
+            let at = match k * self.block / per_lane {
+                0 => "mrsl_first".to_string(),
+                dy => format!("mrsl_first + vec2<i32>(0, {dy})"),
+            };
+            self.line(1, format!("let mrsl_pos{k} = {at};"));
+            self.line(1, format!("let mrsl_in{k} = all(mrsl_pos{k} < mrsl_grid());"));
+            self.line(1, format!("let mrsl_b{k} = mrsl_resolve(mrsl_pos{k}, mrsl_c);"));
+        }
+        self.pixels_resolved = true;
+        for &k in &pixels {
+            self.line(1, format!("if (mrsl_in{k}) {{"));
+            self.line(2, format!("let mrsl_pos = mrsl_pos{k};"));
+            self.line(2, format!("let mrsl_b = mrsl_b{k};"));
+            prologue(self);
+            self.line(1, "}");
+        }
+        self.pixels_resolved = false;
+        let c = self.checked();
+        let order = self.i.graph.order.clone();
+        for &e in &order {
+            let info = &c.effects[e.index()];
+            let name = self.effect_name(e);
+            if info.rate != Rate::Coarse {
+                for &k in &pixels {
+                    self.evaluate_at(e, 1, "let ", &format!("mrsl_pos{k}"), &format!("mrsl_v{k}_"));
+                }
+                continue;
+            }
+            let index = self.coarse_index[&e];
+            for &k in &pixels {
+                if self.i.interface.is_passed(e) {
+                    self.line(1, format!("var mrsl_v{k}_{name} = mrsl_resample_{}(mrsl_b{k}, mrsl_c);", info.name));
+                } else {
+                    self.line(1, format!("var mrsl_v{k}_{name}: {};", info.ty.wgsl()));
+                }
+            }
+            let todo: Vec<String> = pixels
+                .iter()
+                .map(|k| format!("select(0u, {}u, mrsl_in{k} && mrsl_is_refined(mrsl_b{k}, {index}u))", 1u32 << k))
+                .collect();
+            self.line(1, format!("// `{}`, re-evaluated at the lane's pixels that refine it", info.name));
+            self.line(1, format!("var mrsl_todo_{name} = {};", todo.join(" | ")));
+            self.line(1, "loop {");
+            self.line(2, format!("if (mrsl_todo_{name} == 0u) {{ break; }}"));
+            self.line(2, format!("let mrsl_k = countTrailingZeros(mrsl_todo_{name});"));
+            self.line(2, format!("mrsl_todo_{name} &= mrsl_todo_{name} - 1u;"));
+            let mut locals = vec![("mrsl_pos".to_string(), "mrsl_pos".to_string())];
+            locals.extend(self.deps_params(e).into_iter().map(|d| {
+                let dep = self.effect_name(d);
+                (dep.clone(), format!("mrsl_v{{k}}_{dep}"))
+            }));
+            for (local, per_pixel) in &locals {
+                let at = |k: u32| per_pixel.replace("{k}", &k.to_string());
+                let first = if local == "mrsl_pos" { "mrsl_pos0".to_string() } else { at(0) };
+                self.line(2, format!("var {local} = {first};"));
+                for &k in &pixels[1..] {
+                    let value = if local == "mrsl_pos" { format!("mrsl_pos{k}") } else { at(k) };
+                    self.line(2, format!("if (mrsl_k == {k}u) {{ {local} = {value}; }}"));
+                }
+            }
+            self.evaluate(e, 2, "let ");
+            for &k in &pixels {
+                self.line(2, format!("if (mrsl_k == {k}u) {{ mrsl_v{k}_{name} = {name}; }}"));
+            }
+            self.line(1, "}");
+        }
+        for &k in &pixels {
+            self.line(1, format!("if (mrsl_in{k}) {{"));
+            self.output_stores_at(&order, 2, &format!("mrsl_pos{k}"), &format!("mrsl_v{k}_"));
+            self.line(1, "}");
+        }
+        self.corners_loaded = false;
     }
 }
 
