@@ -92,12 +92,13 @@ impl Writer<'_, '_, '_> {
     /// statistics: then every lane must reach the barrier before the
     /// workgroup's counters are added up, so they skip the work instead.
     ///
-    /// In the block modes' fine kernels a lane shades
-    /// [`FINE_PIXELS_PER_LANE`] pixels of one block, one after the other,
-    /// with the block's corners loaded once (`mrsl_c`). The pixels are
-    /// written out one after the other, not as a loop: llvmpipe ran the
-    /// re-evaluations inside a loop at about the one-pixel kernel's time,
-    /// written out at 0.75 of it (paired, 1920x1080, docs/evaluation.md).
+    /// In the block modes' and the dynamic mode's fine kernels a lane shades
+    /// [`FINE_PIXELS_PER_LANE`] pixels of one block with the block's corners
+    /// loaded once (`mrsl_c`), effect by effect when the program has coarse
+    /// effects ([`Self::effect_major_pixels`]). (A loop over the pixels, the
+    /// whole work in its body, ran at about the one-pixel kernel's time on
+    /// llvmpipe; the pixels written out one after the other at 0.75 of it;
+    /// docs/evaluation.md.)
     pub(super) fn pixel_main(
         &mut self,
         mut prologue: impl FnMut(&mut Self),
@@ -115,14 +116,10 @@ impl Writer<'_, '_, '_> {
             ],
         );
         let counted = self.counts_stats();
-        if self.kind == KernelKind::Fine && !self.coarse_live().is_empty() {
+        if pairs && !self.coarse_live().is_empty() {
             self.effect_major_pixels(&mut prologue);
         } else if pairs {
-            if !self.coarse_live().is_empty() {
-                // A lane past the image's edge still loads (clamped) corners: it skips its pixels below.
-                self.line(1, "let mrsl_c = mrsl_corners(min(mrsl_first, mrsl_grid() - vec2<i32>(1)));");
-                self.corners_loaded = true;
-            }
+            // No coarse effects: the pixels' work, one after the other.
             for k in 0..FINE_PIXELS_PER_LANE {
                 let at = match k * self.block / FINE_PIXELS_PER_LANE {
                     0 => "mrsl_first".to_string(),
@@ -133,7 +130,6 @@ impl Writer<'_, '_, '_> {
                 self.pixel_body(2, &mut prologue, &mut coarse);
                 self.line(1, "}");
             }
-            self.corners_loaded = false;
         } else {
             // The record modes' final passes keep one shape, counting or not.
             let returns = !counted && !matches!(self.kind, KernelKind::Hierarchical | KernelKind::Checkerboard);
@@ -205,11 +201,14 @@ impl Writer<'_, '_, '_> {
         }
     }
 
-    /// The block fine kernel's pixels, effect by effect: a lane resolves
-    /// its [`FINE_PIXELS_PER_LANE`] pixels of one block (`mrsl_pos<k>`,
-    /// `mrsl_b<k>`, the values `mrsl_v<k>_<effect>`), then evaluates each
-    /// effect for all of them. A coarse effect is resampled at each pixel and
-    /// re-evaluated, in a loop, at the pixels that refine it.
+    /// The block and dynamic fine kernels' pixels, effect by effect: a lane
+    /// resolves its [`FINE_PIXELS_PER_LANE`] pixels of one block
+    /// (`mrsl_pos<k>`, `mrsl_b<k>`, in the dynamic mode also the inner level
+    /// `mrsl_inner<k>`; the values `mrsl_v<k>_<effect>`), then evaluates
+    /// each effect for all of them. A coarse effect is resampled at each
+    /// pixel (in the dynamic mode from the inner level where the outer one
+    /// refined it) and re-evaluated, in a loop, at the pixels that refine it
+    /// at their innermost level.
     ///
     /// Why a loop and not a branch per pixel: llvmpipe runs the body of an
     /// `if` that no lane of a SIMD group takes (masked), and leaves a loop
@@ -221,6 +220,10 @@ impl Writer<'_, '_, '_> {
     fn effect_major_pixels(&mut self, prologue: &mut impl FnMut(&mut Self)) {
         let per_lane = FINE_PIXELS_PER_LANE;
         let pixels: Vec<u32> = (0..per_lane).collect();
+        // The dynamic mode: the innermost level a pixel refined to
+        // (`mrsl_inner<k>`), whose refined effects it evaluates.
+        let dynamic = self.kind == KernelKind::DynamicFine;
+        let last = if dynamic { "mrsl_inner" } else { "mrsl_b" };
         // A lane past the image's edge still loads (clamped) corners and
         // resolves; its pixels' statistics and stores are skipped below.
         self.line(1, "let mrsl_c = mrsl_corners(min(mrsl_first, mrsl_grid() - vec2<i32>(1)));");
@@ -233,12 +236,25 @@ impl Writer<'_, '_, '_> {
             self.line(1, format!("let mrsl_pos{k} = {at};"));
             self.line(1, format!("let mrsl_in{k} = all(mrsl_pos{k} < mrsl_grid());"));
             self.line(1, format!("let mrsl_b{k} = mrsl_resolve(mrsl_pos{k}, mrsl_c);"));
+            if dynamic {
+                // The inner level, resolved only where the outer one refined.
+                self.line(1, format!("var mrsl_inner{k} = mrsl_b{k};"));
+                self.line(
+                    1,
+                    format!(
+                        "if (mrsl_any_refined(mrsl_b{k})) {{ mrsl_inner{k} = mrsl_resolve2(mrsl_pos{k}, mrsl_b{k}); }}"
+                    ),
+                );
+            }
         }
         self.pixels_resolved = true;
         for &k in &pixels {
             self.line(1, format!("if (mrsl_in{k}) {{"));
             self.line(2, format!("let mrsl_pos = mrsl_pos{k};"));
             self.line(2, format!("let mrsl_b = mrsl_b{k};"));
+            if dynamic {
+                self.line(2, format!("let mrsl_b2 = mrsl_inner{k};"));
+            }
             prologue(self);
             self.line(1, "}");
         }
@@ -258,13 +274,22 @@ impl Writer<'_, '_, '_> {
             for &k in &pixels {
                 if self.i.interface.is_passed(e) {
                     self.line(1, format!("var mrsl_v{k}_{name} = mrsl_resample_{}(mrsl_b{k}, mrsl_c);", info.name));
+                    if dynamic {
+                        self.line(
+                            1,
+                            format!(
+                                "if (mrsl_is_refined(mrsl_b{k}, {index}u) && !mrsl_is_refined(mrsl_inner{k}, {index}u)) {{ mrsl_v{k}_{name} = mrsl_resample2_{}(mrsl_inner{k}); }}",
+                                info.name
+                            ),
+                        );
+                    }
                 } else {
                     self.line(1, format!("var mrsl_v{k}_{name}: {};", info.ty.wgsl()));
                 }
             }
             let todo: Vec<String> = pixels
                 .iter()
-                .map(|k| format!("select(0u, {}u, mrsl_in{k} && mrsl_is_refined(mrsl_b{k}, {index}u))", 1u32 << k))
+                .map(|k| format!("select(0u, {}u, mrsl_in{k} && mrsl_is_refined({last}{k}, {index}u))", 1u32 << k))
                 .collect();
             self.line(1, format!("// `{}`, re-evaluated at the lane's pixels that refine it", info.name));
             self.line(1, format!("var mrsl_todo_{name} = {};", todo.join(" | ")));
