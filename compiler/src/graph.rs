@@ -21,9 +21,10 @@ pub struct EffectGraph {
     pub live: Vec<bool>,
     /// For each live effect, the discontinuity keys it reads, directly or
     /// through the effects it reads (ascending; empty for dead effects). A
-    /// discontinuity in one of these keys refines the effect, and only these
-    /// do: an effect that never reads `material` is continuous across a
-    /// material edge, so interpolating it there is exact to first order.
+    /// discontinuity in one of these keys concerns the effect (it is
+    /// resampled from the corners on a pixel's side, or refined), and only
+    /// these do: an effect that never reads `material` is continuous across
+    /// a material edge, so interpolating it there is exact to first order.
     pub keys: Vec<Vec<InputId>>,
 }
 

@@ -52,7 +52,7 @@ impl Key<'_> {
 }
 
 impl<'b> Writer<'_, '_, 'b> {
-    /// The discontinuity keys that refine any of `effects` (those they read,
+    /// The discontinuity keys that concern any of `effects` (those they read,
     /// directly or through other effects: `EffectGraph::keys`), in
     /// declaration order. A key no coarse effect reads is never loaded.
     pub(super) fn keys_of(&self, effects: &[EffectId]) -> Vec<Key<'b>> {
