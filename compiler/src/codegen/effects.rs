@@ -232,27 +232,44 @@ impl<'b> Writer<'_, '_, 'b> {
     /// lie across an edge, so the fine kernel never resamples it from the
     /// corners on one side of an edge ([`Writer::edge_discontinuity`]).
     pub(super) fn value_reads_derivatives(&self, e: EffectId) -> bool {
+        // In dependency order, each effect once: a recursion over the
+        // dependencies would revisit shared ones (exponentially many times
+        // in a lattice of diamonds).
         let c = self.checked();
-        let own: Vec<NodeId> = c.derivative_calls.iter().filter(|(x, _)| *x == e).map(|(_, n)| *n).collect();
-        if !own.is_empty() {
-            let mut kept = HashSet::new();
-            let mut collect = |x: &Expr| visit_expr(x, &mut |y| _ = kept.insert(y.id));
-            match &c.effect_decl(e).body {
-                EffectBody::Expr(x) => collect(x),
-                EffectBody::Block(b) => {
-                    let none = HashSet::new();
-                    let skipped = self.i.deriv.value_skips.get(&e).unwrap_or(&none);
-                    b.stmts.iter().for_each(|s| visit_kept_exprs(s, skipped, &mut collect));
-                }
+        let mut reads = vec![false; c.effects.len()];
+        for &x in &self.i.graph.order {
+            if c.effects[x.index()].rate != Rate::Coarse {
+                continue;
             }
-            if own.iter().any(|n| kept.contains(n)) {
-                return true;
+            reads[x.index()] =
+                self.own_value_reads_derivatives(x) || c.effects[x.index()].deps.iter().any(|(d, _)| reads[d.index()]);
+            if x == e {
+                break;
             }
         }
-        c.effects[e.index()]
-            .deps
-            .iter()
-            .any(|(d, _)| c.effects[d.index()].rate == Rate::Coarse && self.value_reads_derivatives(*d))
+        reads[e.index()]
+    }
+
+    /// [`Self::value_reads_derivatives`] for `e`'s own body alone: a
+    /// derivative call outside the statements that only decide its refine
+    /// flag (`DerivInfo::value_skips`).
+    fn own_value_reads_derivatives(&self, e: EffectId) -> bool {
+        let c = self.checked();
+        let own: Vec<NodeId> = c.derivative_calls.iter().filter(|(x, _)| *x == e).map(|(_, n)| *n).collect();
+        if own.is_empty() {
+            return false;
+        }
+        let mut kept = HashSet::new();
+        let mut collect = |x: &Expr| visit_expr(x, &mut |y| _ = kept.insert(y.id));
+        match &c.effect_decl(e).body {
+            EffectBody::Expr(x) => collect(x),
+            EffectBody::Block(b) => {
+                let none = HashSet::new();
+                let skipped = self.i.deriv.value_skips.get(&e).unwrap_or(&none);
+                b.stmts.iter().for_each(|s| visit_kept_exprs(s, skipped, &mut collect));
+            }
+        }
+        own.iter().any(|n| kept.contains(n))
     }
 
     /// `mrsl_eval_<effect>`: the effect's body at `mrsl_pos`, given its

@@ -173,6 +173,26 @@ fn long_chains_of_definitions() {
     assert_rejected("a cycle of 2,000 effects", &format!("{HEADER}{effects}fine out float o = e0;\n"), &["E0311"]);
 }
 
+/// A lattice of 40 diamonds of coarse effects behind a discontinuity key,
+/// none of whose values reads a derivative: whether one does through the
+/// effects it reads (edge-aware resampling, docs/language.md section 8.3)
+/// is decided once per effect. A recursion over the dependencies, which
+/// stops only at a derivative, revisited the shared ones 2^40 times and
+/// never finished.
+#[test]
+fn a_lattice_of_diamonds_compiles() {
+    let mut source = String::from("@key(0.3) in float3 normal;\ncoarse effect float a0 = normal.y;\n");
+    for k in 1..=40 {
+        let prev = k - 1;
+        source.push_str(&format!(
+            "coarse effect float b{k} = a{prev} + normal.x;\ncoarse effect float c{k} = a{prev} * 0.5;\n\
+             coarse effect float a{k} = b{k} + c{k};\n"
+        ));
+    }
+    source.push_str("fine out float4 color = float4(a40, 0.0, 0.0, 1.0);\n");
+    assert_compiles("40 diamonds of coarse effects", &source);
+}
+
 /// One level (or brace, or operation) less than each case above compiles;
 /// the limit itself is E0602/E0603/E0604.
 #[test]
