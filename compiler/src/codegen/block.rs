@@ -6,11 +6,10 @@
 //! blocks; what only they add is in [`super::dynamic`].
 
 use super::Writer;
-use super::body::float_literal;
 use super::effects::Key;
 use super::words::{bit, pack_words, test_bit, unpack_with, unpack_words};
 use super::writer::{cut, fill};
-use crate::check::{EffectId, InputId, KeyCompare};
+use crate::check::{EffectId, InputId};
 use crate::layout;
 use crate::syntax::ast::Rate;
 use mrsl_abi::KernelKind;
@@ -519,24 +518,8 @@ impl Writer<'_, '_, '_> {
                 continue;
             }
             // Which corners are on the pixel's side of the key.
-            let side = match key.compare {
-                KeyCompare::Exact => {
-                    let matches: Vec<String> = CORNERS
-                        .iter()
-                        .map(|corner| key.matches(&format!("k_{name}"), &format!("{corner}_{name}")))
-                        .collect();
-                    format!("vec4<bool>({})", matches.join(", "))
-                }
-                KeyCompare::Threshold { threshold } => format!("d_{name} <= vec4<f32>({})", float_literal(threshold)),
-            };
-            let distances = match key.compare {
-                KeyCompare::Exact => String::new(),
-                KeyCompare::Threshold { .. } => {
-                    let d: Vec<String> =
-                        CORNERS.iter().map(|corner| format!("distance(k_{name}, {corner}_{name})")).collect();
-                    format!("    let d_{name} = vec4<f32>({});\n", d.join(", "))
-                }
-            };
+            let side: Vec<String> =
+                CORNERS.iter().map(|corner| key.matches(&format!("k_{name}"), &format!("{corner}_{name}"))).collect();
             let at: Vec<String> = CORNERS
                 .iter()
                 .zip(CORNER_PIXELS)
@@ -555,8 +538,7 @@ impl Writer<'_, '_, '_> {
                     ("K10", &at[1]),
                     ("K01", &at[2]),
                     ("K11", &at[3]),
-                    ("DISTANCES", &distances),
-                    ("SIDE", &side),
+                    ("SIDE", &side.join(", ")),
                 ],
             );
         }
@@ -808,7 +790,7 @@ impl Writer<'_, '_, '_> {
             self.line(indent, format!("let mrsl_b = mrsl_resolve{name}(mrsl_pos);"));
         }
         if self.kind == KernelKind::DynamicFine {
-            self.resolve_inner(indent, name);
+            self.resolve_inner(indent, name, ["mrsl_pos", "mrsl_b", "mrsl_b2"]);
         }
     }
 

@@ -116,10 +116,15 @@ impl Writer<'_, '_, '_> {
         self.line(1, format!("disc = disc || {};", tags.join(" || ")));
     }
 
-    /// After `mrsl_b`: `mrsl_b2`, the inner level, resolved only where the outer one refined.
-    /// `name` is the suffix of a neighbour function's own resolver, or empty.
-    pub(super) fn resolve_inner(&mut self, indent: usize, name: &str) {
-        self.template(indent, include_str!("templates/resolve_inner.wgsl"), &[("NAME", &name)]);
+    /// After `outer` (`mrsl_b`, the 4x4 level at `pos`): `inner` (`mrsl_b2`),
+    /// the inner level, resolved only where the outer one refined. `name` is
+    /// the suffix of a neighbour function's own resolver, or empty.
+    pub(super) fn resolve_inner(&mut self, indent: usize, name: &str, [pos, outer, inner]: [&str; 3]) {
+        self.template(
+            indent,
+            include_str!("templates/resolve_inner.wgsl"),
+            &[("NAME", &name), ("POS", &pos), ("OUTER", &outer), ("INNER", &inner)],
+        );
     }
 
     /// A coarse effect in `dynamic_fine_main`, into its declared variable:

@@ -21,7 +21,7 @@ pub(super) struct Key<'c> {
     pub(super) name: &'c str,
     /// The channel's WGSL type.
     pub(super) ty: String,
-    pub(super) compare: KeyCompare,
+    compare: KeyCompare,
     scalar: bool,
 }
 

@@ -121,10 +121,7 @@ impl Writer<'_, '_, '_> {
         } else if pairs {
             // No coarse effects: the pixels' work, one after the other.
             for k in 0..FINE_PIXELS_PER_LANE {
-                let at = match k * self.block / FINE_PIXELS_PER_LANE {
-                    0 => "mrsl_first".to_string(),
-                    dy => format!("(mrsl_first + vec2<i32>(0, {dy}))"),
-                };
+                let at = self.lane_pixel(k);
                 self.line(1, format!("if (all({at} < mrsl_grid())) {{"));
                 self.line(2, format!("let mrsl_pos = {at};"));
                 self.pixel_body(2, &mut prologue, &mut coarse);
@@ -201,6 +198,15 @@ impl Writer<'_, '_, '_> {
         }
     }
 
+    /// The `k`-th pixel of a block fine kernel's lane: the first
+    /// (`mrsl_first`), or `B / FINE_PIXELS_PER_LANE` rows per step below it.
+    fn lane_pixel(&self, k: u32) -> String {
+        match k * self.block / FINE_PIXELS_PER_LANE {
+            0 => "mrsl_first".to_string(),
+            dy => format!("mrsl_first + vec2<i32>(0, {dy})"),
+        }
+    }
+
     /// The block and dynamic fine kernels' pixels, effect by effect: a lane
     /// resolves its [`FINE_PIXELS_PER_LANE`] pixels of one block
     /// (`mrsl_pos<k>`, `mrsl_b<k>`, in the dynamic mode also the inner level
@@ -218,8 +224,7 @@ impl Writer<'_, '_, '_> {
     /// pixel of its two it runs the evaluation once, not twice (ablation
     /// "nothing refined at run time", docs/evaluation.md).
     fn effect_major_pixels(&mut self, prologue: &mut impl FnMut(&mut Self)) {
-        let per_lane = FINE_PIXELS_PER_LANE;
-        let pixels: Vec<u32> = (0..per_lane).collect();
+        let pixels: Vec<u32> = (0..FINE_PIXELS_PER_LANE).collect();
         // The dynamic mode: the innermost level a pixel refined to
         // (`mrsl_inner<k>`), whose refined effects it evaluates.
         let dynamic = self.kind == KernelKind::DynamicFine;
@@ -229,22 +234,12 @@ impl Writer<'_, '_, '_> {
         self.line(1, "let mrsl_c = mrsl_corners(min(mrsl_first, mrsl_grid() - vec2<i32>(1)));");
         self.corners_loaded = true;
         for &k in &pixels {
-            let at = match k * self.block / per_lane {
-                0 => "mrsl_first".to_string(),
-                dy => format!("mrsl_first + vec2<i32>(0, {dy})"),
-            };
-            self.line(1, format!("let mrsl_pos{k} = {at};"));
+            self.line(1, format!("let mrsl_pos{k} = {};", self.lane_pixel(k)));
             self.line(1, format!("let mrsl_in{k} = all(mrsl_pos{k} < mrsl_grid());"));
             self.line(1, format!("let mrsl_b{k} = mrsl_resolve(mrsl_pos{k}, mrsl_c);"));
             if dynamic {
-                // The inner level, resolved only where the outer one refined.
-                self.line(1, format!("var mrsl_inner{k} = mrsl_b{k};"));
-                self.line(
-                    1,
-                    format!(
-                        "if (mrsl_any_refined(mrsl_b{k})) {{ mrsl_inner{k} = mrsl_resolve2(mrsl_pos{k}, mrsl_b{k}); }}"
-                    ),
-                );
+                let names = [format!("mrsl_pos{k}"), format!("mrsl_b{k}"), format!("mrsl_inner{k}")];
+                self.resolve_inner(1, "", names.each_ref().map(String::as_str));
             }
         }
         self.pixels_resolved = true;
@@ -297,18 +292,16 @@ impl Writer<'_, '_, '_> {
             self.line(2, format!("if (mrsl_todo_{name} == 0u) {{ break; }}"));
             self.line(2, format!("let mrsl_k = countTrailingZeros(mrsl_todo_{name});"));
             self.line(2, format!("mrsl_todo_{name} &= mrsl_todo_{name} - 1u;"));
+            // The position and the dependencies of pixel `mrsl_k`, under the
+            // names `evaluate` uses: `mrsl_pos` from `mrsl_pos<k>`, each
+            // dependency from `mrsl_v<k>_<dependency>`.
             let mut locals = vec![("mrsl_pos".to_string(), "mrsl_pos".to_string())];
-            locals.extend(self.deps_params(e).into_iter().map(|d| {
-                let dep = self.effect_name(d);
-                (dep.clone(), format!("mrsl_v{{k}}_{dep}"))
-            }));
-            for (local, per_pixel) in &locals {
-                let at = |k: u32| per_pixel.replace("{k}", &k.to_string());
-                let first = if local == "mrsl_pos" { "mrsl_pos0".to_string() } else { at(0) };
-                self.line(2, format!("var {local} = {first};"));
+            locals.extend(self.deps_params(e).into_iter().map(|d| (self.effect_name(d), "mrsl_v".to_string())));
+            for (local, stem) in &locals {
+                let at = |k: u32| if stem == local { format!("{stem}{k}") } else { format!("{stem}{k}_{local}") };
+                self.line(2, format!("var {local} = {};", at(0)));
                 for &k in &pixels[1..] {
-                    let value = if local == "mrsl_pos" { format!("mrsl_pos{k}") } else { at(k) };
-                    self.line(2, format!("if (mrsl_k == {k}u) {{ {local} = {value}; }}"));
+                    self.line(2, format!("if (mrsl_k == {k}u) {{ {local} = {}; }}", at(k)));
                 }
             }
             self.evaluate(e, 2, "let ");

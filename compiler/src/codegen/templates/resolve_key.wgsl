@@ -4,4 +4,4 @@
     let k10_{{NAME}} = {{K10}};
     let k01_{{NAME}} = {{K01}};
     let k11_{{NAME}} = {{K11}};
-{{DISTANCES}}    let side_{{NAME}} = {{SIDE}}; // the corners on the pixel's side of the key
+    let side_{{NAME}} = vec4<bool>({{SIDE}}); // the corners on the pixel's side of the key
