@@ -21,7 +21,7 @@ pub struct Control {
     /// Rate-image mode: pixels per side of one shading-rate tile (8 or 16).
     pub rate_tile: u32,
     /// Nonzero: the per-pixel kernels count their re-evaluations (layout
-    /// `stats`) and write the rate image. Zero leaves both out, so timed
+    /// `stats`) and write the refine mask. Zero leaves both out, so timed
     /// runs carry no instrumentation.
     pub statistics: u32,
     /// Padding to a multiple of 16 bytes.
@@ -84,7 +84,7 @@ pub static CONTROL_FIELDS: [ControlField; 6] = [
         offset: 24,
         size: 4,
         default: Some(1.0),
-        comment: Some("nonzero: count per-pixel re-evaluations and write the rate image"),
+        comment: Some("nonzero: count per-pixel re-evaluations and write the refine mask"),
     },
 ];
 

@@ -42,11 +42,6 @@ pub mod entry {
 
     /// Prefixes of generated entry points; user identifiers with them are renamed.
     pub const RESERVED_PREFIXES: [&str; 3] = ["hier_", "cb_", "rate_"];
-
-    /// Whether `name` is an entry point that binds the indirect-argument group.
-    pub fn binds_args_group(name: &str) -> bool {
-        HIER_ARGS.contains(&name) || name == RATE_ARGS
-    }
 }
 
 /// The hierarchical kernel's entry points in dispatch order: level 0, then per

@@ -5,12 +5,12 @@
 //! to be guessed. It is written as JSON (`STEM.layout.json`) and read back
 //! into the same value ([`Layout::from_json`]).
 
-use crate::KernelKind;
+use crate::Plan;
 use crate::types::{SampleType, TextureFormat, ValueType};
 use serde::{Deserialize, Serialize};
 
 /// The layout format this crate reads and writes (the `format` field).
-pub const LAYOUT_FORMAT: &str = "mrsl-layout/5";
+pub const LAYOUT_FORMAT: &str = "mrsl-layout/6";
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Layout {
@@ -24,9 +24,9 @@ pub struct Layout {
     pub interface: InterfaceLayout,
     pub outputs: Vec<Output>,
     pub stats: StatsLayout,
-    /// The fine kernels' per-pixel refine mask (`rg32uint`: x bit k = coarse effect k
+    /// The per-pixel kernels' refine mask (`rg32uint`: x bit k = coarse effect k
     /// (stats counter k) evaluated per pixel; y bit k = taken from the dynamic mode's 2x2 level).
-    pub rate_image: ResourceBinding,
+    pub refine_mask: ResourceBinding,
     /// The dynamic mode's second (2x2) level of coarse samples: records of
     /// `interface.stride_words + 1` words, the last being a validity tag.
     pub interface2: ResourceBinding,
@@ -34,13 +34,16 @@ pub struct Layout {
     pub hierarchical: HierarchicalLayout,
     /// The rate-image mode's shading-rate image (`texture_2d<u32>`, one texel
     /// per tile, codes of [`crate::ShadingRate`]), read by both its kernels.
-    /// Its coarse kernel's work list and counter are bound at the hierarchical
-    /// mode's `work_binding` and `queue_binding`, and its arguments like theirs.
+    /// Its coarse kernel's sample list and count take the binding numbers of
+    /// the hierarchical mode's `work_binding` and `queue_binding` (the plan
+    /// says which resource each binds).
     pub shading_rate: ResourceBinding,
     /// The block coarse kernel's neighbour values (its `coarse_neighbours`
     /// entry point writes them, `coarse_main` reads them).
     pub neighbours: NeighbourLayout,
     pub effects: Vec<EffectLayout>,
+    /// What every mode the program was compiled for runs ([`Plan`]).
+    pub plan: Plan,
 }
 
 impl Layout {
@@ -69,137 +72,6 @@ impl Layout {
     pub fn stats_counters(&self) -> usize {
         self.stats.counters.len() + 1
     }
-
-    /// The bindings of the stage group ([`crate::GROUP_STAGE`]) that the
-    /// kernel of `kind` declares, in binding order: what the code generator
-    /// writes and what the runtime binds.
-    pub fn stage_bindings(&self, kind: KernelKind) -> Vec<StageBinding> {
-        use StageSlot as S;
-        let h = &self.hierarchical;
-        let buffer =
-            |slot, binding, read_only| StageBinding { binding, slot, resource: StageResource::Buffer { read_only } };
-        // The block modes' coarse samples: a texture array of records ([`InterfaceLayout`]).
-        let records = |resource| StageBinding { binding: self.interface.binding, slot: S::Interface, resource };
-        let pixel_records =
-            StageBinding { binding: h.values_binding, slot: S::Records, resource: StageResource::WordTexture };
-        let shading_rate = StageBinding {
-            binding: self.shading_rate.binding,
-            slot: S::ShadingRate,
-            resource: StageResource::UintTexture,
-        };
-        let mut bindings = match kind {
-            KernelKind::Coarse if self.neighbours.words > 0 => vec![
-                records(StageResource::RecordStorageTexture),
-                StageBinding {
-                    binding: self.neighbours.binding,
-                    slot: S::Neighbours,
-                    resource: StageResource::WordTexture,
-                },
-            ],
-            KernelKind::Coarse => vec![records(StageResource::RecordStorageTexture)],
-            KernelKind::Fine => vec![records(StageResource::RecordTexture)],
-            // Reads the 4x4 level, writes the 2x2 level and counts its samples.
-            KernelKind::DynamicCoarse => vec![
-                records(StageResource::RecordTexture),
-                buffer(S::Interface2, self.interface2.binding, false),
-                buffer(S::Stats, self.stats.binding, false),
-            ],
-            KernelKind::DynamicFine => {
-                vec![records(StageResource::RecordTexture), buffer(S::Interface2, self.interface2.binding, true)]
-            }
-            KernelKind::Reference => vec![],
-            KernelKind::Hierarchical => vec![
-                pixel_records,
-                buffer(S::WorkLists, h.work_binding, false),
-                buffer(S::Queues, h.queue_binding, false),
-            ],
-            KernelKind::Checkerboard => vec![pixel_records],
-            KernelKind::RateCoarse => vec![
-                buffer(S::Interface, self.interface.binding, false),
-                buffer(S::WorkLists, h.work_binding, false),
-                buffer(S::Queues, h.queue_binding, false),
-                shading_rate,
-            ],
-            KernelKind::RateFine => vec![buffer(S::Interface, self.interface.binding, true), shading_rate],
-        };
-        if !kind.is_coarse() {
-            bindings.extend(self.outputs.iter().enumerate().map(|(index, o)| StageBinding {
-                binding: o.binding,
-                slot: S::Output(index),
-                resource: StageResource::StorageTexture(o.format),
-            }));
-        }
-        let counts = kind.is_fine() || matches!(kind, KernelKind::Hierarchical | KernelKind::Checkerboard);
-        if counts && !self.stats.counters.is_empty() {
-            bindings.push(buffer(S::Stats, self.stats.binding, false));
-            bindings.push(StageBinding {
-                binding: self.rate_image.binding,
-                slot: S::RateImage,
-                resource: StageResource::StorageTexture(TextureFormat::Rg32Uint),
-            });
-        }
-        bindings.sort_by_key(|b| b.binding);
-        bindings
-    }
-}
-
-/// One binding of the stage group.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct StageBinding {
-    pub binding: u32,
-    /// What the runtime binds there.
-    pub slot: StageSlot,
-    pub resource: StageResource,
-}
-
-/// The runtime-owned (or engine-owned, for outputs) resource a stage binding takes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StageSlot {
-    /// The coarse samples of the mode's block size (the dynamic mode's 4x4
-    /// level): the record texture of [`InterfaceLayout`]; in the rate-image
-    /// mode a buffer of one record per pixel.
-    Interface,
-    /// The dynamic mode's 2x2 level (tagged records).
-    Interface2,
-    /// The statistics counters.
-    Stats,
-    /// The per-pixel refine mask.
-    RateImage,
-    /// Output `index` of [`Layout::outputs`].
-    Output(usize),
-    /// The hierarchical and checkerboard modes' per-pixel records.
-    Records,
-    /// The hierarchical work lists (the rate-image mode's sample list).
-    WorkLists,
-    /// The hierarchical queue counters (the rate-image mode's sample count).
-    Queues,
-    /// The rate-image mode's shading-rate image.
-    ShadingRate,
-    /// The coarse kernel's neighbour values ([`NeighbourLayout`]).
-    Neighbours,
-}
-
-/// What a stage-group binding holds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StageResource {
-    /// A storage buffer of `u32` words (atomic for the statistics and queues).
-    Buffer { read_only: bool },
-    /// A write-only storage texture (an output, or the rate image).
-    StorageTexture(TextureFormat),
-    /// A sampled `texture_2d<u32>` read with `textureLoad` (the shading-rate image).
-    UintTexture,
-    /// The block modes' records, as the fine kernels read them: a sampled
-    /// `texture_2d_array<u32>` of format `rgba32uint` ([`InterfaceLayout`]),
-    /// read with `textureLoad`.
-    RecordTexture,
-    /// The same texture as the coarse kernel writes it: a write-only
-    /// `texture_storage_2d_array<rgba32uint, write>`.
-    RecordStorageTexture,
-    /// A `texture_storage_2d_array<r32uint, read_write>` with a layer per
-    /// word: the hierarchical and checkerboard modes' per-pixel records (W x
-    /// H texels, [`HierarchicalLayout`]) and the coarse kernel's neighbour
-    /// values (a texel per coarse sample, [`NeighbourLayout`]).
-    WordTexture,
 }
 
 /// Resources of the hierarchical and checkerboard modes (group 2): a record
@@ -308,9 +180,9 @@ pub enum ResourceKind {
     /// A filtering sampler.
     #[serde(rename = "filtering")]
     Sampler,
-    /// An `rg32uint` write-only storage texture (the rate image).
+    /// An `rg32uint` write-only storage texture (the refine mask).
     #[serde(rename = "rg32uint")]
-    RateImage,
+    RefineMask,
     /// A read-write storage buffer.
     #[serde(rename = "storage")]
     Storage,

@@ -13,6 +13,11 @@
 //!   `#[repr(C)]` type.
 //! - [`geometry`]: the dispatch geometry: coarse sample lattices, the
 //!   hierarchical mode's levels and work lists, tiles and quads per workgroup.
+//! - [`Mode`]: the modes a program is dispatched in, and the kernels each
+//!   needs ([`Mode::kernels`], the one table of mode → kernels).
+//! - [`Plan`]: what every mode runs (passes, dispatches, the resources each
+//!   binding takes and how they are sized), as data the runtimes interpret;
+//!   part of the layout.
 //! - [`CompiledProgram`]: kernels plus layout, read from and written to the
 //!   files `mrslc compile -o DIR` produces.
 //!
@@ -24,6 +29,8 @@ mod control;
 pub mod geometry;
 mod kernel;
 mod layout;
+mod mode;
+pub mod plan;
 mod program;
 pub mod shading_rate;
 mod types;
@@ -32,9 +39,11 @@ pub use control::{CONTROL_FIELDS, Control, ControlField};
 pub use kernel::{KernelKind, entry};
 pub use layout::{
     Channel, ControlBlock, EffectLayout, Field, HierarchicalLayout, InterfaceLayout, KeyCompare, LAYOUT_FORMAT, Layout,
-    NeighbourLayout, NeighbourValue, Output, Rate, Resample, ResourceBinding, ResourceKind, SlotLayout, StageBinding,
-    StageResource, StageSlot, StatsLayout, UniformBlock,
+    NeighbourLayout, NeighbourValue, Output, Rate, Resample, ResourceBinding, ResourceKind, SlotLayout, StatsLayout,
+    UniformBlock,
 };
+pub use mode::{KernelRef, Mode, UnknownMode};
+pub use plan::{BindingType, Plan, ResourceId};
 pub use program::{CompiledProgram, Kernel, ReadError};
 pub use shading_rate::ShadingRate;
 pub use types::{SampleType, Scalar, TextureFormat, ValueType};

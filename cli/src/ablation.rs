@@ -243,7 +243,7 @@ pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>, String> {
         Some(path) => crate::read_source(path)?,
         None => WORKLOAD_PROGRAM.to_string(),
     };
-    let options = mrsl::Options { compact: true, file_name: name.clone(), ..mrsl_runtime::compile_options(&modes) };
+    let options = mrsl::Options { compact: true, file_name: name.clone(), ..mrsl::Options::for_modes(&modes) };
     let compacted = mrsl::compile(&source, &options).map_err(|d| mrsl::render_all(&d, &name, &source))?;
     programs.push((
         "compacted (added)",

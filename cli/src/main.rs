@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 use codespan_reporting::term::termcolor::{ColorChoice, StandardStream};
-use mrsl::{Diagnostic, KernelKind, Options};
+use mrsl::{Diagnostic, KernelKind, KernelRef, Options};
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -41,10 +41,10 @@ enum Command {
     },
     /// Compile a program to WGSL kernels and a layout description.
     ///
-    /// Writes <name>.coarse.bB.wgsl, <name>.fine.bB.wgsl (B = each block size),
-    /// <name>.reference.wgsl, the dynamic, hierarchical and checkerboard kernels
-    /// (<name>.dynamic_coarse.b2.wgsl, <name>.dynamic_fine.b4.wgsl, <name>.hierarchical.wgsl,
-    /// <name>.checkerboard.wgsl) and <name>.layout.json into the output directory.
+    /// Writes the kernels of the modes asked for (all by default), named
+    /// <name>.KIND.bB.wgsl for the kinds that exist per block size and
+    /// <name>.KIND.wgsl for the others, and <name>.layout.json, which holds
+    /// every binding and the plan of each mode, into the output directory.
     Compile {
         /// The .mrsl program.
         file: PathBuf,
@@ -54,9 +54,13 @@ enum Command {
         /// Print one artifact to standard output instead of writing files.
         #[arg(long, value_enum)]
         emit: Option<Emit>,
-        /// Coarse block size(s) to generate kernels for.
-        #[arg(short, long = "block", value_parser = ["2", "4"], default_values = ["2", "4"])]
-        blocks: Vec<String>,
+        /// Modes to compile for, comma-separated (reference, coarse2x2, coarse4x4, dynamic,
+        /// hierarchical, checkerboard, rate-image), or all.
+        #[arg(long, alias = "modes", value_parser = render::parse_modes, default_value = "all")]
+        mode: render::ModeList,
+        /// With --emit coarse or fine: the block size of the kernel printed.
+        #[arg(short, long = "block", value_parser = ["2", "4"], default_value = "4")]
+        block: String,
     },
     /// Render a program over a scene with the wgpu runtime (lavapipe works).
     ///
@@ -343,10 +347,9 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
             };
             Ok(written(bench::bench(&args)))
         }
-        Command::Compile { file, out_dir, emit, blocks } => {
+        Command::Compile { file, out_dir, emit, mode, block } => {
             let (name, source) = read(file)?;
-            let block_sizes: Vec<u32> = blocks.iter().map(|b| b.parse().expect("clap restricts block sizes")).collect();
-            let options = Options { block_sizes: block_sizes.clone(), file_name: name.clone(), ..Options::default() };
+            let options = Options { file_name: name.clone(), ..Options::for_modes(&mode.0) };
             let program = match mrsl::compile(&source, &options) {
                 Ok(p) => p,
                 Err(diagnostics) => {
@@ -355,18 +358,19 @@ fn run(cli: &Cli) -> Result<ExitCode, String> {
                 }
             };
             report(cli.color, &program.warnings, &name, &source);
-            let layout = program.layout.to_json();
             if let Some(emit) = emit {
-                let block = *block_sizes.last().unwrap_or(&4);
+                let block: u32 = block.parse().expect("clap restricts block sizes");
+                let kernel = |kind: KernelKind| {
+                    program.kernel(kind, block).map(|k| k.wgsl.clone()).ok_or_else(|| {
+                        let what = KernelRef::new(kind, kind.per_block_size().then_some(block));
+                        format!("{name} was compiled without its {what} kernel: add a mode that runs it with --mode")
+                    })
+                };
                 let text = match emit {
-                    Emit::Layout => layout,
-                    Emit::Coarse => {
-                        program.kernel(KernelKind::Coarse, block).map(|k| k.wgsl.clone()).unwrap_or_default()
-                    }
-                    Emit::Fine => program.kernel(KernelKind::Fine, block).map(|k| k.wgsl.clone()).unwrap_or_default(),
-                    Emit::Reference => {
-                        program.kernel(KernelKind::Reference, block).map(|k| k.wgsl.clone()).unwrap_or_default()
-                    }
+                    Emit::Layout => program.layout.to_json(),
+                    Emit::Coarse => kernel(KernelKind::Coarse)?,
+                    Emit::Fine => kernel(KernelKind::Fine)?,
+                    Emit::Reference => kernel(KernelKind::Reference)?,
                 };
                 std::io::stdout().write_all(text.as_bytes()).map_err(|e| e.to_string())?;
                 return Ok(ExitCode::SUCCESS);
@@ -502,6 +506,37 @@ mod tests {
         assert_eq!(read_source(&bom).unwrap(), "\u{FEFF}in float3 n;\n");
         std::fs::remove_dir_all(&dir).unwrap();
     }
+
+    /// `mrslc compile -o DIR` writes the plan of every mode into the layout,
+    /// and it reads back as the compiler's; `--mode` narrows it (and the
+    /// kernels) to the modes named, and `--emit` of a kernel not compiled
+    /// says so instead of printing nothing.
+    #[test]
+    fn compile_writes_the_plan_of_the_modes_asked_for() {
+        let demo = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/demo.mrsl");
+        let dir = std::env::temp_dir().join(format!("mrslc-compile-{}", std::process::id()));
+        let compile = |extra: &[&str]| {
+            let _ = std::fs::remove_dir_all(&dir);
+            let argv = ["mrslc", "compile", demo, "-o", dir.to_str().unwrap()];
+            let cli = Cli::try_parse_from(argv.iter().chain(extra)).unwrap();
+            assert_eq!(run(&cli).unwrap(), ExitCode::SUCCESS);
+            mrsl_runtime::CompiledProgram::read_dir(&dir, None).unwrap()
+        };
+        let source = std::fs::read_to_string(demo).unwrap();
+        let all = compile(&[]);
+        let expected = mrsl::compile(&source, &Options { file_name: demo.into(), ..Options::default() }).unwrap();
+        assert_eq!(all.layout.plan, expected.layout.plan);
+        assert_eq!(all.layout.plan.modes.len(), mrsl::Mode::ALL.len());
+        let two = compile(&["--mode", "coarse4x4,hierarchical"]);
+        let modes: Vec<mrsl::Mode> = two.layout.plan.modes.iter().map(|m| m.mode).collect();
+        assert_eq!(modes, [mrsl::Mode::Coarse4x4, mrsl::Mode::Hierarchical]);
+        assert_eq!(two.kernels.len(), 3, "coarse b4, fine b4, hierarchical");
+        std::fs::remove_dir_all(&dir).unwrap();
+        let argv = ["mrslc", "compile", demo, "--mode", "coarse4x4", "--emit", "fine", "-b", "2"];
+        let message = run(&Cli::try_parse_from(argv).unwrap()).unwrap_err();
+        assert!(message.contains("without its 2x2 fine kernel"), "{message}");
+    }
+
     #[test]
     fn rate_options_parse_or_say_what_is_expected() {
         assert_eq!(parse_rate("2x4"), Ok(mrsl_abi::ShadingRate::R2x4));

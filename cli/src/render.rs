@@ -104,7 +104,7 @@ pub fn compile_program(
         Some(path) => (path.display().to_string(), crate::read_source(path)?),
         None => (format!("{} (built in)", builtin.0), builtin.1.to_string()),
     };
-    let options = Options { file_name: name.clone(), ..mrsl_runtime::compile_options(modes) };
+    let options = Options { file_name: name.clone(), ..Options::for_modes(modes) };
     let program = mrsl::compile(&source, &options).map_err(|d| mrsl::render_all(&d, &name, &source))?;
     Ok((name, program))
 }
@@ -304,7 +304,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>, String> {
                 Some(p) => with_suffix(p, if args.modes.len() > 1 { &suffix } else { "" }),
                 None => in_out(format!("{stem}.{mode}.heatmap.png")),
             };
-            if let Some(rate) = shader.rate_image() {
+            if let Some(rate) = shader.refine_mask() {
                 let counters = shader.layout().stats.counters.clone();
                 save_heatmap(&gpu, rate, counters.len(), None, &path)?;
                 written.push(path.clone());

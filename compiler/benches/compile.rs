@@ -194,12 +194,12 @@ fn balanced_sum(terms: &[String]) -> String {
 
 /// One mode's kernels: the reference mode.
 fn options_reference() -> mrsl::Options {
-    mrsl::Options { reference: true, ..mrsl::Options::none() }
+    mrsl::Options::for_modes(&[mrsl::Mode::Reference])
 }
 
 /// One mode's kernels: the coarse 4x4 mode (coarse and fine kernels for 4x4 blocks).
 fn options_coarse4x4() -> mrsl::Options {
-    mrsl::Options { block_sizes: vec![4], coarse: true, fine: true, ..mrsl::Options::none() }
+    mrsl::Options::for_modes(&[mrsl::Mode::Coarse4x4])
 }
 
 /// Panics with the rendered diagnostics if `source` does not compile.

@@ -12,7 +12,7 @@ use crate::types::{Scalar, Type, round_up};
 use mrsl_abi::{
     BINDING_CONTROL, BINDING_UNIFORMS, CONTROL_FIELDS, Channel, Control, ControlBlock, EffectLayout, Field, GROUP_ARGS,
     GROUP_GBUFFER, GROUP_RESOURCES, GROUP_STAGE, HierarchicalLayout, InterfaceLayout, LAYOUT_FORMAT, Layout,
-    NeighbourLayout, NeighbourValue, Output, Resample, ResourceBinding, ResourceKind, SampleType, SlotLayout,
+    NeighbourLayout, NeighbourValue, Output, Plan, Resample, ResourceBinding, ResourceKind, SampleType, SlotLayout,
     StatsLayout, TextureFormat, UniformBlock, ValueType,
 };
 use std::collections::{BTreeSet, HashMap};
@@ -210,11 +210,11 @@ pub fn build(
                 .map(|e| checked.effects[e.index()].name.clone())
                 .collect(),
         },
-        rate_image: ResourceBinding {
+        refine_mask: ResourceBinding {
             name: "mrsl_rate".into(),
             group: GROUP_STAGE,
             binding: 2 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
-            kind: ResourceKind::RateImage,
+            kind: ResourceKind::RefineMask,
         },
         interface2: ResourceBinding {
             name: "mrsl_interface2".into(),
@@ -261,6 +261,8 @@ pub fn build(
         },
         outputs,
         effects,
+        // Filled in from the modes by `plan::build`.
+        plan: Plan { modes: vec![], resources: vec![] },
     }
 }
 

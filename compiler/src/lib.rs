@@ -36,12 +36,13 @@ mod graph;
 mod interface;
 mod layout;
 mod limits;
+mod plan;
 mod syntax;
 mod types;
 mod validate;
 
 pub use diagnostic::{Diagnostic, Label, Severity, emit_colored, render_all};
-pub use mrsl_abi::{CompiledProgram, Kernel, KernelKind, Layout};
+pub use mrsl_abi::{CompiledProgram, Kernel, KernelKind, KernelRef, Layout, Mode, Plan};
 use validate::{NagaFailure, generated_context, join_validation, naga_validate, spawn_validation, with_stack};
 
 /// The stages behind [`compile`], for the compiler's own benchmarks and tests
@@ -90,32 +91,17 @@ pub mod internals {
     }
 }
 
-/// Which kernels to generate, and for which block sizes.
+/// Which modes to compile for, and how.
 ///
-/// [`compile`] generates and validates only the kernels these options ask
-/// for ([`Options::kernels`]). The default asks for all eleven: coarse and
-/// fine for blocks 2 and 4, the reference, the dynamic mode's coarse (2x2)
-/// and fine (4x4) kernels, the hierarchical and the checkerboard kernel,
-/// and the rate-image mode's coarse and fine kernels.
-/// A caller that runs fewer modes asks for their kernels alone, which takes
-/// a fraction of the time: `Options { block_sizes: vec![4], coarse: true,
-/// fine: true, ..Options::none() }` for the coarse 4x4 mode (the runtime's
-/// `compile_modes` does this from its modes).
+/// [`compile`] generates and validates only the kernels these modes
+/// dispatch ([`Options::kernels`], from the one table [`Mode::kernels`]),
+/// and writes their passes into the layout's plan. The default is every
+/// mode: eleven kernels. A caller that runs fewer modes asks for them alone,
+/// which takes a fraction of the time: `Options::for_modes(&[Mode::Coarse4x4])`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Options {
-    /// Coarse block sizes to generate coarse and fine kernels for (2 and/or 4).
-    pub block_sizes: Vec<u32>,
-    pub coarse: bool,
-    pub fine: bool,
-    pub reference: bool,
-    /// The dynamic mode's kernels (4x4, refined to 2x2, then per pixel).
-    pub dynamic: bool,
-    /// The hierarchical (DACS) mode's kernel.
-    pub hierarchical: bool,
-    /// The checkerboard baseline's kernel.
-    pub checkerboard: bool,
-    /// The rate-image mode's two kernels (coarse samples at each tile's rate, then per pixel).
-    pub rate_image: bool,
+    /// The modes to compile for; the order does not matter.
+    pub modes: Vec<Mode>,
     /// Name written in the header comment of every generated kernel.
     pub file_name: String,
     /// Compact the block modes' fine pass: the pixels of a workgroup that
@@ -131,75 +117,21 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Self {
-        Options {
-            block_sizes: vec![2, 4],
-            coarse: true,
-            fine: true,
-            reference: true,
-            dynamic: true,
-            hierarchical: true,
-            checkerboard: true,
-            rate_image: true,
-            file_name: "program.mrsl".into(),
-            compact: false,
-        }
+        Options::for_modes(&Mode::ALL)
     }
 }
 
 impl Options {
-    /// The kernels [`compile`] generates with these options, in generation
-    /// order: per block size the coarse and fine kernels, then the
-    /// reference, the dynamic mode's (its 4x4 level is the ordinary 4x4
-    /// coarse kernel, added if not asked for already), the hierarchical and
-    /// the checkerboard kernel. The block size is `None` for the kinds that
-    /// exist once per program.
-    pub fn kernels(&self) -> Vec<(KernelKind, Option<u32>)> {
-        let mut wanted = vec![];
-        for &b in &self.block_sizes {
-            if self.coarse {
-                wanted.push((KernelKind::Coarse, Some(b)));
-            }
-            if self.fine {
-                wanted.push((KernelKind::Fine, Some(b)));
-            }
-        }
-        if self.reference {
-            wanted.push((KernelKind::Reference, None));
-        }
-        if self.dynamic {
-            let (outer, inner) = (mrsl_abi::geometry::DYNAMIC_OUTER_BLOCK, mrsl_abi::geometry::DYNAMIC_INNER_BLOCK);
-            if !wanted.contains(&(KernelKind::Coarse, Some(outer))) {
-                wanted.push((KernelKind::Coarse, Some(outer)));
-            }
-            wanted.push((KernelKind::DynamicCoarse, Some(inner)));
-            wanted.push((KernelKind::DynamicFine, Some(outer)));
-        }
-        if self.hierarchical {
-            wanted.push((KernelKind::Hierarchical, None));
-        }
-        if self.checkerboard {
-            wanted.push((KernelKind::Checkerboard, None));
-        }
-        if self.rate_image {
-            wanted.push((KernelKind::RateCoarse, None));
-            wanted.push((KernelKind::RateFine, None));
-        }
-        wanted
+    /// Options that compile for `modes` alone.
+    pub fn for_modes(modes: &[Mode]) -> Options {
+        Options { modes: modes.to_vec(), file_name: "program.mrsl".into(), compact: false }
     }
 
-    /// Options that ask for no kernel at all; set the flags of the kernels wanted.
-    pub fn none() -> Options {
-        Options {
-            block_sizes: vec![],
-            coarse: false,
-            fine: false,
-            reference: false,
-            dynamic: false,
-            hierarchical: false,
-            checkerboard: false,
-            rate_image: false,
-            ..Options::default()
-        }
+    /// The kernels [`compile`] generates with these options: those of the
+    /// modes, each once, by kind and then block size. The block size is
+    /// `None` for the kinds that exist once per program.
+    pub fn kernels(&self) -> Vec<KernelRef> {
+        Mode::kernels_of(&self.modes)
     }
 }
 
@@ -232,12 +164,6 @@ pub fn check(source: &str) -> Vec<Diagnostic> {
 /// Compiles a program to kernels and a layout, or returns its diagnostics
 /// (errors, and warnings found alongside them).
 pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnostic>> {
-    if let Some(bad) = options.block_sizes.iter().find(|b| !BLOCK_SIZES.contains(b)) {
-        return Err(vec![
-            Diagnostic::error("E0900", format!("unsupported block size {bad}"))
-                .with_note("supported block sizes: 2, 4"),
-        ]);
-    }
     with_stack(|| {
         front_end(source, |checked, graph, deriv, diagnostics| {
             generate(source, options, checked, graph, deriv, diagnostics)
@@ -251,9 +177,6 @@ pub fn validate_wgsl(wgsl: &str) -> Result<(), String> {
     with_stack(|| naga_validate(wgsl)).map_err(|f| f.report)
 }
 
-/// Block sizes the generated kernels support.
-const BLOCK_SIZES: [u32; 2] = [2, 4];
-
 /// Everything after the checks: interface, layout, kernels and their validation.
 fn generate(
     source: &str,
@@ -265,7 +188,8 @@ fn generate(
 ) -> Result<Program, Vec<Diagnostic>> {
     let interface = interface::allocate(checked, graph);
     let costs = budget::evaluation_costs(checked, graph, deriv);
-    let layout = layout::build(checked, graph, deriv, &interface, &costs);
+    let mut layout = layout::build(checked, graph, deriv, &interface, &costs);
+    layout.plan = plan::build(&layout, &options.modes);
     let inputs = codegen::Inputs {
         checked,
         graph,
@@ -281,7 +205,7 @@ fn generate(
     let wanted = options.kernels();
     let texts: Vec<(KernelKind, Option<u32>, String)> = wanted
         .into_iter()
-        .map(|(kind, block)| (kind, block, codegen::write_string(&inputs, kind, block.unwrap_or(1))))
+        .map(|k| (k.kind, k.block, codegen::write_string(&inputs, k.kind, k.block.unwrap_or(1))))
         .collect();
     // naga validation dominates compile time; the kernels are independent, so
     // they are validated on as many threads as there are kernels.

@@ -218,7 +218,7 @@ mod tests {
             "in float2 uv;\n{uniforms}\nuniform texture2d albedo_map;\nuniform sampler linear;\n\
              fine out float4 color = sample(albedo_map, linear, uv);\n"
         );
-        match mrsl::compile(&source, &mrsl::Options::none()) {
+        match mrsl::compile(&source, &mrsl::Options::for_modes(&[])) {
             Ok(program) => program.compiled.layout,
             Err(d) => panic!("{}", mrsl::render_all(&d, "test.mrsl", &source)),
         }

@@ -32,10 +32,8 @@ pub enum Error {
     BadSize { width: u32, height: u32, reason: String },
     #[error("mode `{0}` is not supported by this program: {1}")]
     UnsupportedMode(String, String),
-    #[error(
-        "unknown mode `{0}` (expected reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard, rate-image)"
-    )]
-    UnknownMode(String),
+    #[error("{0}")]
+    UnknownMode(#[from] mrsl_abi::UnknownMode),
     #[error("the rate-image mode needs a shading-rate image (`Bindings::shading_rate`), and none is bound")]
     MissingShadingRate,
     #[error("the device rejected a pipeline: {0}")]

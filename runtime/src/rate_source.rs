@@ -29,7 +29,7 @@
 
 use crate::Error;
 use crate::controller::{Target, ThresholdController};
-use crate::shader::describe;
+use crate::gpu::describe;
 use mrsl_abi::shading_rate::{DEFAULT_RATE_TILE, RATE_TILE_SIZES, ShadingRate, rate_image_size};
 use wgpu::util::DeviceExt;
 

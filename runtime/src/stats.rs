@@ -3,6 +3,7 @@
 
 use crate::shader::DispatchOptions;
 use mrsl_abi::geometry::sample_grid;
+use mrsl_abi::plan::{Counts, Evaluations, SampleCount};
 use mrsl_abi::{Layout, Rate};
 
 /// GPU time of the passes, from timestamp queries.
@@ -60,6 +61,7 @@ pub struct Stats {
 impl Stats {
     pub(crate) fn new(
         layout: &Layout,
+        counts: &Counts,
         options: DispatchOptions,
         size: (u32, u32),
         counters: &[u32],
@@ -67,30 +69,23 @@ impl Stats {
         listed_samples: u64,
     ) -> Stats {
         let pixels = size.0 as u64 * size.1 as u64;
-        let samples_of = |block| {
-            let (nx, ny) = sample_grid(size, block);
-            nx as u64 * ny as u64
+        let counter = |k: usize| counters.get(k).copied().unwrap_or(0) as u64;
+        let samples = match counts.samples {
+            SampleCount::None => 0,
+            SampleCount::Grid { block, counter: extra } => {
+                let (nx, ny) = sample_grid(size, block);
+                // The dynamic mode adds the 2x2 samples its second level shaded, counted by its kernel.
+                nx as u64 * ny as u64 + extra.map(counter).unwrap_or(0)
+            }
+            // The rate-image mode shades the samples its tiles listed (read back from its counter).
+            SampleCount::Listed { .. } => listed_samples,
         };
-        let rate_image = options.mode == crate::Mode::RateImage;
-        // The rate-image mode shades the samples its tiles listed (read back from its counter).
-        let mut samples =
-            if rate_image { listed_samples } else { options.mode.block_size().map(samples_of).unwrap_or(0) };
-        if options.mode == crate::Mode::Dynamic {
-            // The 2x2 samples the second level shaded, counted by its kernel.
-            samples += counters.get(layout.stats.counters.len()).copied().unwrap_or(0) as u64;
-        }
         let mut effects = vec![];
         for e in layout.effects.iter().filter(|e| e.live) {
-            let hierarchical = matches!(options.mode, crate::Mode::Hierarchical | crate::Mode::Checkerboard);
-            let (coarse_evaluations, pixel_evaluations) = match (options.mode.block_size(), e.rate) {
-                (_, Rate::Coarse) if hierarchical => {
-                    let k = layout.stats.counters.iter().position(|c| *c == e.name);
-                    (0, k.map(|k| counters.get(k).copied().unwrap_or(0) as u64).unwrap_or(0))
-                }
-                (_, Rate::Coarse) if rate_image || options.mode.block_size().is_some() => {
-                    let k = layout.stats.counters.iter().position(|c| *c == e.name);
-                    (samples, k.map(|k| counters.get(k).copied().unwrap_or(0) as u64).unwrap_or(0))
-                }
+            let counted = || layout.stats.counters.iter().position(|c| *c == e.name).map(counter).unwrap_or(0);
+            let (coarse_evaluations, pixel_evaluations) = match (counts.evaluations, e.rate) {
+                (Evaluations::Counted, Rate::Coarse) => (0, counted()),
+                (Evaluations::SamplesAndCounted, Rate::Coarse) => (samples, counted()),
                 _ => (0, pixels),
             };
             effects.push(EffectStats {

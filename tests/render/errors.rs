@@ -95,7 +95,10 @@ pub fn binding_mismatches_are_typed_errors(gpu: &Gpu) {
 }
 
 pub fn unknown_modes_are_named() {
-    assert_eq!("coarse8x8".parse::<Mode>(), Err(Error::UnknownMode("coarse8x8".into())));
+    assert_eq!("coarse8x8".parse::<Mode>(), Err(mrsl_abi::UnknownMode("coarse8x8".into())));
+    let error = Error::from("coarse8x8".parse::<Mode>().unwrap_err());
+    assert_eq!(error, Error::UnknownMode(mrsl_abi::UnknownMode("coarse8x8".into())));
+    assert!(error.to_string().contains("expected reference, coarse2x2"), "{error}");
     assert_eq!("coarse4x4".parse::<Mode>(), Ok(Mode::Coarse4x4));
 }
 
@@ -138,7 +141,7 @@ pub fn precompiled_and_load_time_kernels_render_alike(gpu: &Gpu) {
 /// A mode whose kernels were not compiled is a typed error, not a panic.
 pub fn modes_without_kernels_are_unsupported(gpu: &Gpu) {
     let source = "in float depth;\ncoarse effect float d = depth * 2.0;\nfine out float4 color = float4(d);";
-    let options = mrsl::Options { hierarchical: false, dynamic: false, block_sizes: vec![4], ..Default::default() };
+    let options = mrsl::Options::for_modes(&[Mode::Reference, Mode::Coarse4x4, Mode::Checkerboard, Mode::RateImage]);
     let program = mrsl::compile(source, &options).unwrap();
     let gbuffer = Scene::Gradient.render(8, 8);
     for mode in [Mode::Hierarchical, Mode::Dynamic, Mode::Coarse2x2] {
@@ -192,7 +195,7 @@ pub fn compiled_kernels_are_those_of_the_modes() {
         let modes: Vec<Mode> =
             Mode::ALL.iter().enumerate().filter(|(k, _)| subset >> k & 1 == 1).map(|(_, m)| *m).collect();
         let mut wanted: Vec<(mrsl::KernelKind, Option<u32>)> =
-            modes.iter().flat_map(|m| m.kernels().iter().copied()).collect();
+            modes.iter().flat_map(|m| m.kernels().iter().map(|k| (k.kind, k.block))).collect();
         wanted.sort();
         wanted.dedup();
         let program = mrsl_runtime::compile_modes(source, "modes.mrsl", &modes).unwrap();

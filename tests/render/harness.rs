@@ -164,7 +164,7 @@ pub fn dispatch_in_turn<const N: usize>(
         gpu.queue.submit([encoder.finish()]);
         let stats = shader.read_stats(&gpu.device);
         let pixels = gpu.read_rgba32f(&outputs[0].1).map_err(|e| Error::Readback(e.to_string()))?;
-        let refine_masks = match shader.rate_image() {
+        let refine_masks = match shader.refine_mask() {
             Some(t) => {
                 let texels = gpu.read_texture(t).map_err(|e| Error::Readback(e.to_string()))?;
                 // rg32uint: the mask is the first word of each 8-byte texel.

@@ -417,7 +417,7 @@ pub fn compacted_fine_pass_equals_the_plain_one(gpu: &Gpu) {
     let gbuffer = Scene::Demo.render(75, 43);
     for (name, source) in examples() {
         // The block modes' kernels alone: pipeline creation dominates on lavapipe.
-        let options = mrsl::Options { coarse: true, fine: true, block_sizes: vec![2, 4], ..mrsl::Options::none() };
+        let options = mrsl::Options::for_modes(&[Mode::Coarse2x2, Mode::Coarse4x4]);
         let plain = mrsl::compile(&source, &options).unwrap();
         let compacted = mrsl::compile(&source, &mrsl::Options { compact: true, ..options }).unwrap();
         for block in [2, 4] {

@@ -36,8 +36,8 @@ impl Writer<'_, '_, '_> {
             tail,
             &[
                 ("COUNTERS", &self.coarse_live().len()),
-                ("RATE_GROUP", &l.rate_image.group),
-                ("RATE_BINDING", &l.rate_image.binding),
+                ("RATE_GROUP", &l.refine_mask.group),
+                ("RATE_BINDING", &l.refine_mask.binding),
             ],
         );
     }

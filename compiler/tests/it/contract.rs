@@ -74,13 +74,14 @@ fn foreign_or_broken_layouts_are_refused() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// The stage group (group 2) each kernel declares is exactly the one the
-/// contract lists for its kind (`Layout::stage_bindings`), which is what the
+/// The stage group (group 2) each kernel declares is exactly the one every
+/// pass of the plan that runs it lists (`Pass::bindings`), which is what the
 /// runtime builds its bind group layouts from: same binding numbers, same
-/// storage access, same storage-texture formats.
+/// storage access, same storage-texture formats. Every compiled kernel runs
+/// in some pass.
 #[test]
 fn kernels_declare_the_stage_bindings_of_the_contract() {
-    use mrsl_abi::{GROUP_STAGE, StageResource, TextureFormat};
+    use mrsl_abi::{BindingType as StageResource, GROUP_STAGE, KernelRef, TextureFormat};
     let prefix = format!("@group({GROUP_STAGE}) @binding(");
     for (stem, source) in examples() {
         let program = mrsl::compile(&source, &Options::default()).unwrap();
@@ -105,15 +106,20 @@ fn kernels_declare_the_stage_bindings_of_the_contract() {
                         StageResource::WordTexture
                     } else {
                         let format = decl.split("texture_storage_2d<").nth(1).unwrap().split(',').next().unwrap();
-                        StageResource::StorageTexture(format.parse::<TextureFormat>().unwrap())
+                        StageResource::StorageTexture { format: format.parse::<TextureFormat>().unwrap() }
                     };
                     (binding.parse().unwrap(), resource)
                 })
                 .collect();
             declared.sort_by_key(|(binding, _)| *binding);
-            let contract: Vec<(u32, StageResource)> =
-                program.layout.stage_bindings(kernel.kind).iter().map(|b| (b.binding, b.resource)).collect();
-            assert_eq!(declared, contract, "{stem}: {} kernel ({:?})", kernel.kind, kernel.block_size);
+            let kernel_ref = KernelRef::new(kernel.kind, kernel.block_size);
+            let passes: Vec<_> =
+                program.layout.plan.modes.iter().flat_map(|m| m.passes()).filter(|p| p.kernel == kernel_ref).collect();
+            assert!(!passes.is_empty(), "{stem}: no pass runs the {kernel_ref} kernel");
+            for pass in passes {
+                let contract: Vec<(u32, StageResource)> = pass.bindings.iter().map(|b| (b.binding, b.ty)).collect();
+                assert_eq!(declared, contract, "{stem}: {kernel_ref} kernel in `{}`", pass.label);
+            }
         }
     }
 }

@@ -2,8 +2,10 @@
 //! under `ok/` must compile, with exactly the warnings its `// expect-warning:`
 //! header names (none without one), to the full default kernel table. Every
 //! program under `err/` must fail with exactly the diagnostic codes its
-//! `// expect:` header names. Snapshots hold the source together with the
-//! result: the layout and every kernel, or the rendered diagnostics.
+//! `// expect:` header names. An ok/ case has a folder of snapshots
+//! (`snapshots/ok/CASE/`): the source with its layout, its plan, and one file
+//! per kernel; an err/ case one snapshot of the source and its rendered
+//! diagnostics.
 
 use mrsl::{Diagnostic, Options, Severity};
 use std::fmt::Write;
@@ -47,20 +49,71 @@ fn ok_programs() {
             ),
         }
         crate::assert_kernel_table(&name, &program);
-        let mut snapshot = String::new();
-        writeln!(snapshot, "----- SOURCE\n{}", source.trim_end()).unwrap();
-        if !program.warnings.is_empty() {
-            writeln!(snapshot, "----- WARNINGS\n{}", mrsl::render_all(&program.warnings, &name, &source).trim_end())
-                .unwrap();
-        }
-        writeln!(snapshot, "----- LAYOUT\n{}", serde_json::to_string_pretty(&program.layout).unwrap()).unwrap();
-        for kernel in &program.kernels {
-            let block = kernel.block_size.map(|b| format!(" b{b}")).unwrap_or_default();
-            writeln!(snapshot, "----- {}{block} KERNEL\n{}", kernel.kind.name().to_uppercase(), kernel.wgsl.trim_end())
-                .unwrap();
-        }
-        insta::assert_snapshot!(snapshot);
+        // One golden file per output, in a folder per case: the layout (with
+        // the source and warnings), the plan, and each kernel on its own, so
+        // a change to one kernel family rewrites only that family's files.
+        let mut settings = insta::Settings::clone_current();
+        settings.set_snapshot_path(format!("snapshots/ok/{}", name.trim_end_matches(".mrsl")));
+        settings.set_prepend_module_to_snapshot(false);
+        settings.remove_snapshot_suffix();
+        settings.set_omit_expression(true);
+        settings.bind(|| {
+            insta::assert_snapshot!("layout", layout_snapshot(&source, &name, &program));
+            insta::assert_snapshot!("plan", plan_snapshot(&program.layout.plan));
+            for kernel in &program.kernels {
+                let file = kernel.file_name("");
+                insta::assert_snapshot!(file.trim_start_matches('.').trim_end_matches(".wgsl"), kernel.wgsl.trim_end());
+            }
+        });
     });
+}
+
+/// The source, the warnings if any, and the layout without its plan.
+fn layout_snapshot(source: &str, name: &str, program: &mrsl::Program) -> String {
+    let mut snapshot = String::new();
+    writeln!(snapshot, "----- SOURCE\n{}", source.trim_end()).unwrap();
+    if !program.warnings.is_empty() {
+        writeln!(snapshot, "----- WARNINGS\n{}", mrsl::render_all(&program.warnings, name, source).trim_end()).unwrap();
+    }
+    let mut layout = serde_json::to_value(&program.layout).unwrap();
+    layout.as_object_mut().unwrap().remove("plan");
+    writeln!(snapshot, "----- LAYOUT\n{}", serde_json::to_string_pretty(&layout).unwrap()).unwrap();
+    snapshot
+}
+
+/// The plan as a reviewer reads it: per mode its kernels, counts and steps
+/// (a pass with a line per binding and per dispatch); then one resource per
+/// line. Each item is its JSON, as the layout holds it.
+fn plan_snapshot(plan: &mrsl::Plan) -> String {
+    let mut snapshot = String::new();
+    for mode in &plan.modes {
+        writeln!(snapshot, "----- MODE {}", mode.mode).unwrap();
+        writeln!(snapshot, "kernels: {}", json(&mode.kernels)).unwrap();
+        writeln!(snapshot, "counts: {}", json(&mode.counts)).unwrap();
+        for step in &mode.steps {
+            let mrsl_abi::plan::Step::Pass(pass) = step else {
+                writeln!(snapshot, "{}", json(step)).unwrap();
+                continue;
+            };
+            writeln!(snapshot, "pass {:?} ({:?}) {}", pass.label, pass.stage, json(&pass.kernel)).unwrap();
+            for binding in &pass.bindings {
+                writeln!(snapshot, "  binding {}", json(binding)).unwrap();
+            }
+            for dispatch in &pass.dispatches {
+                writeln!(snapshot, "  dispatch {}", json(dispatch)).unwrap();
+            }
+        }
+    }
+    writeln!(snapshot, "----- RESOURCES").unwrap();
+    for resource in &plan.resources {
+        writeln!(snapshot, "{}", json(resource)).unwrap();
+    }
+    snapshot
+}
+
+/// Compact JSON of a value of the plan.
+fn json(value: &impl serde::Serialize) -> String {
+    serde_json::to_string(value).unwrap()
 }
 
 #[test]

@@ -5,12 +5,13 @@
 //! properties at scale (docs/fuzzing.md).
 
 use crate::wellformed::{self, SplitMix};
-use mrsl::{Options, Severity};
+use mrsl::{Mode, Options, Severity};
 use proptest::prelude::*;
 
 fn options() -> Options {
     // One block size keeps each case fast; the kernels are the same code shape.
-    Options { block_sizes: vec![4], ..Options::default() }
+    let modes: Vec<Mode> = Mode::ALL.into_iter().filter(|m| *m != Mode::Coarse2x2).collect();
+    Options::for_modes(&modes)
 }
 
 /// Compiles and fails the test on a panic or on an internal error.

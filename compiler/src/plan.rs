@@ -1,0 +1,308 @@
+//! The pass plan ([`mrsl_abi::Plan`]) of the modes a program is compiled
+//! for: for each mode its passes in dispatch order, what every binding of
+//! every kernel's stage group holds, and how each runtime-owned resource is
+//! sized. The kernels declare exactly these bindings (the contract test
+//! checks it); the runtimes interpret the plan and restate none of it.
+
+use mrsl_abi::geometry::{
+    self, DYNAMIC_INNER_BLOCK, DYNAMIC_OUTER_BLOCK, HIERARCHICAL_LEVEL0, HIERARCHICAL_LEVELS, QUEUE_WORDS_PER_LEVEL,
+    WORK_LIST_WORKGROUP,
+};
+use mrsl_abi::plan::{
+    BindingType, Counts, Dispatch, Evaluations, Extent, ModePlan, Pass, PassBinding, Plan, ResourceDesc, ResourceId,
+    SampleCount, Shape, Stage, Step, WorkListCounts, Workgroups,
+};
+use mrsl_abi::{KernelKind, KernelRef, Layout, Mode, TextureFormat, entry};
+
+/// The plan of `modes` (each once, in [`Mode::ALL`] order) for a program of `layout`.
+pub fn build(layout: &Layout, modes: &[Mode]) -> Plan {
+    let modes: Vec<ModePlan> =
+        Mode::ALL.into_iter().filter(|m| modes.contains(m)).map(|mode| mode_plan(layout, mode)).collect();
+    let mut ids: Vec<ResourceId> = modes.iter().flat_map(|m| m.resources()).filter(|id| !id.engine_bound()).collect();
+    ids.sort();
+    ids.dedup();
+    let resources = ids.into_iter().map(|id| resource(layout, id)).collect();
+    Plan { modes, resources }
+}
+
+/// The steps and counts of one mode.
+fn mode_plan(layout: &Layout, mode: Mode) -> ModePlan {
+    let mut steps = vec![Step::Clear { resource: ResourceId::Statistics }];
+    let counts = match mode {
+        Mode::Reference => {
+            let reference = KernelRef::new(KernelKind::Reference, None);
+            steps.push(pass(layout, "mrsl reference", Stage::Fine, reference, vec![tiles(entry::REFERENCE)]));
+            Counts { samples: SampleCount::None, evaluations: Evaluations::EveryPixel, work_lists: None }
+        }
+        Mode::Coarse2x2 | Mode::Coarse4x4 | Mode::Dynamic => block_steps(layout, mode, &mut steps),
+        Mode::Hierarchical => hierarchical_steps(layout, &mut steps),
+        Mode::Checkerboard => {
+            let kernel = KernelRef::new(KernelKind::Checkerboard, None);
+            let shade = dispatch(entry::CB_SHADE, Workgroups::CheckerboardQuads);
+            steps.push(pass(layout, "mrsl checkerboard", Stage::Fine, kernel, vec![shade, tiles(entry::CB_FINAL)]));
+            Counts { samples: SampleCount::None, evaluations: Evaluations::Counted, work_lists: None }
+        }
+        Mode::RateImage => rate_image_steps(layout, &mut steps),
+    };
+    steps.push(Step::Readback { resource: ResourceId::Statistics, bytes: None });
+    ModePlan { mode, kernels: mode.kernels().to_vec(), steps, counts }
+}
+
+/// The block modes and the dynamic mode: the coarse samples (their
+/// neighbour values first, when the program stores them), the dynamic
+/// mode's 2x2 level, then the per-pixel pass.
+fn block_steps(layout: &Layout, mode: Mode, steps: &mut Vec<Step>) -> Counts {
+    let block = mode.block_size().expect("block modes have a block size");
+    let samples = Workgroups::SampleGrid { block };
+    let mut coarse = vec![];
+    if layout.neighbours.words > 0 {
+        coarse.push(dispatch(entry::COARSE_NEIGHBOURS, samples));
+    }
+    coarse.push(dispatch(entry::COARSE, samples));
+    steps.push(pass(layout, "mrsl coarse", Stage::Coarse, KernelRef::new(KernelKind::Coarse, Some(block)), coarse));
+    let (fine, fine_entry) = if mode == Mode::Dynamic {
+        let inner = KernelRef::new(KernelKind::DynamicCoarse, Some(DYNAMIC_INNER_BLOCK));
+        let shade = dispatch(entry::DYNAMIC_COARSE, Workgroups::SampleGrid { block: DYNAMIC_INNER_BLOCK });
+        steps.push(pass(layout, "mrsl dynamic coarse 2x2", Stage::Coarse2x2, inner, vec![shade]));
+        (KernelKind::DynamicFine, entry::DYNAMIC_FINE)
+    } else {
+        (KernelKind::Fine, entry::FINE)
+    };
+    steps.push(pass(layout, "mrsl fine", Stage::Fine, KernelRef::new(fine, Some(block)), vec![tiles(fine_entry)]));
+    // The dynamic mode's last counter counts the 2x2 samples it shaded.
+    let counter = (mode == Mode::Dynamic).then_some(layout.stats.counters.len());
+    Counts {
+        samples: SampleCount::Grid { block, counter },
+        evaluations: Evaluations::SamplesAndCounted,
+        work_lists: None,
+    }
+}
+
+/// DACS: level 0, then per level classify into the work list, turn its
+/// count into indirect arguments and shade the list; then the final pass.
+fn hierarchical_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
+    let kernel = KernelRef::new(KernelKind::Hierarchical, None);
+    let level0 = HIERARCHICAL_LEVEL0;
+    let mut levels = vec![dispatch(entry::HIER_LEVEL0, Workgroups::Lattice { start: level0.start, step: level0.step })];
+    for (index, lattice) in HIERARCHICAL_LEVELS.iter().enumerate() {
+        let (start, step) = (lattice.start, lattice.step);
+        levels.push(dispatch(entry::HIER_CLASSIFY[index], Workgroups::Lattice { start, step }));
+        levels.push(Dispatch {
+            entry: entry::HIER_ARGS[index].into(),
+            arguments: Some(ResourceId::LevelArguments),
+            workgroups: Workgroups::One,
+        });
+        // Levels 2 and 4 queue only the lattice points with an odd coordinate sum.
+        let odd_only = index % 2 == 1;
+        levels.push(dispatch(
+            entry::HIER_SHADE[index],
+            Workgroups::Indirect {
+                buffer: ResourceId::LevelArguments,
+                offset: geometry::indirect_args_offset(index as u32 + 1),
+                at_most: Some(Extent::Lattice { start, step, odd_only }),
+                per_workgroup: WORK_LIST_WORKGROUP,
+            },
+        ));
+    }
+    steps.push(Step::Clear { resource: ResourceId::LevelCounts });
+    steps.push(pass(layout, "mrsl hierarchical levels", Stage::Coarse, kernel, levels));
+    steps.push(pass(layout, "mrsl hierarchical final", Stage::Fine, kernel, vec![tiles(entry::HIER_FINAL)]));
+    steps.push(Step::Readback { resource: ResourceId::LevelCounts, bytes: None });
+    Counts {
+        samples: SampleCount::None,
+        evaluations: Evaluations::Counted,
+        work_lists: Some(WorkListCounts {
+            resource: ResourceId::LevelCounts,
+            words_per_level: QUEUE_WORDS_PER_LEVEL,
+            levels: (1..=HIERARCHICAL_LEVELS.len() as u32).collect(),
+            lanes: WORK_LIST_WORKGROUP,
+        }),
+    }
+}
+
+/// Software VRS: list the samples each tile's rate needs, shade them from
+/// the list (indirect), then resolve every pixel.
+fn rate_image_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
+    let list = vec![
+        dispatch(entry::RATE_LIST, Workgroups::RateTiles),
+        Dispatch {
+            entry: entry::RATE_ARGS.into(),
+            arguments: Some(ResourceId::SampleArguments),
+            workgroups: Workgroups::One,
+        },
+        dispatch(
+            entry::RATE_COARSE,
+            Workgroups::Indirect {
+                buffer: ResourceId::SampleArguments,
+                offset: 0,
+                // The arguments lay the workgroups out in rows (`RATE_ARGS_MAX_X` wide).
+                at_most: None,
+                per_workgroup: WORK_LIST_WORKGROUP,
+            },
+        ),
+    ];
+    steps.push(Step::Clear { resource: ResourceId::SampleCount });
+    let coarse = KernelRef::new(KernelKind::RateCoarse, None);
+    steps.push(pass(layout, "mrsl rate-image coarse", Stage::Coarse, coarse, list));
+    let fine = KernelRef::new(KernelKind::RateFine, None);
+    steps.push(pass(layout, "mrsl rate-image fine", Stage::Fine, fine, vec![tiles(entry::RATE_FINE)]));
+    steps.push(Step::Readback { resource: ResourceId::SampleCount, bytes: Some(4) });
+    Counts {
+        samples: SampleCount::Listed { resource: ResourceId::SampleCount, word: 0 },
+        evaluations: Evaluations::SamplesAndCounted,
+        work_lists: None,
+    }
+}
+
+fn pass(layout: &Layout, label: &str, stage: Stage, kernel: KernelRef, dispatches: Vec<Dispatch>) -> Step {
+    Step::Pass(Pass { label: label.into(), stage, kernel, bindings: stage_bindings(layout, kernel), dispatches })
+}
+
+fn dispatch(entry: &str, workgroups: Workgroups) -> Dispatch {
+    Dispatch { entry: entry.into(), arguments: None, workgroups }
+}
+
+fn tiles(entry: &str) -> Dispatch {
+    dispatch(entry, Workgroups::Tiles)
+}
+
+/// The stage group (group 2) the kernel declares, in binding order: what
+/// the code generator writes and what a runtime binds.
+pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
+    use BindingType as T;
+    use ResourceId as R;
+    let h = &layout.hierarchical;
+    let at = |binding, resource, ty| PassBinding { binding, resource, ty };
+    let buffer = |binding, resource, read_only| at(binding, resource, T::Buffer { read_only });
+    let block = kernel.block.unwrap_or(1);
+    let interface = layout.interface.binding;
+    let shading_rate = at(layout.shading_rate.binding, R::ShadingRate, T::UintTexture);
+    let mut bindings = match kernel.kind {
+        KernelKind::Coarse => {
+            let mut coarse = vec![at(interface, R::Records { block }, T::RecordStorageTexture)];
+            if layout.neighbours.words > 0 {
+                coarse.push(at(layout.neighbours.binding, R::NeighbourValues { block }, T::WordTexture));
+            }
+            coarse
+        }
+        KernelKind::Fine => vec![at(interface, R::Records { block }, T::RecordTexture)],
+        // Reads the 4x4 level, writes the 2x2 level and counts its samples.
+        KernelKind::DynamicCoarse => vec![
+            at(interface, R::Records { block: DYNAMIC_OUTER_BLOCK }, T::RecordTexture),
+            buffer(layout.interface2.binding, R::TaggedRecords { block: DYNAMIC_INNER_BLOCK }, false),
+            buffer(layout.stats.binding, R::Statistics, false),
+        ],
+        KernelKind::DynamicFine => vec![
+            at(interface, R::Records { block: DYNAMIC_OUTER_BLOCK }, T::RecordTexture),
+            buffer(layout.interface2.binding, R::TaggedRecords { block: DYNAMIC_INNER_BLOCK }, true),
+        ],
+        KernelKind::Reference => vec![],
+        KernelKind::Hierarchical => vec![
+            at(h.values_binding, R::PixelRecords, T::WordTexture),
+            buffer(h.work_binding, R::WorkLists, false),
+            buffer(h.queue_binding, R::LevelCounts, false),
+        ],
+        KernelKind::Checkerboard => vec![at(h.values_binding, R::PixelRecords, T::WordTexture)],
+        KernelKind::RateCoarse => vec![
+            buffer(interface, R::RateRecords, false),
+            buffer(h.work_binding, R::SampleList, false),
+            buffer(h.queue_binding, R::SampleCount, false),
+            shading_rate,
+        ],
+        KernelKind::RateFine => vec![buffer(interface, R::RateRecords, true), shading_rate],
+    };
+    if !kernel.kind.is_coarse() {
+        bindings.extend(
+            layout
+                .outputs
+                .iter()
+                .enumerate()
+                .map(|(index, o)| at(o.binding, R::Output { index }, T::StorageTexture { format: o.format })),
+        );
+    }
+    let counts = kernel.kind.is_fine() || matches!(kernel.kind, KernelKind::Hierarchical | KernelKind::Checkerboard);
+    if counts && !layout.stats.counters.is_empty() {
+        bindings.push(buffer(layout.stats.binding, R::Statistics, false));
+        let format = TextureFormat::Rg32Uint;
+        bindings.push(at(layout.refine_mask.binding, R::RefineMask, T::StorageTexture { format }));
+    }
+    bindings.sort_by_key(|b| b.binding);
+    bindings
+}
+
+/// The descriptor of a runtime-owned resource.
+fn resource(layout: &Layout, id: ResourceId) -> ResourceDesc {
+    use ResourceId as R;
+    let words = |elements, words| Shape::Buffer { elements, words };
+    let counters = u64::from(geometry::HIERARCHICAL_LEVEL_COUNT * QUEUE_WORDS_PER_LEVEL);
+    let stride = layout.interface.stride_words;
+    let (what, shape) = match id {
+        R::Records { block } => (
+            "the record texture",
+            Shape::TextureArray {
+                texels: Extent::SampleGrid { block },
+                layers: layout.interface.layers(),
+                format: TextureFormat::Rgba32Uint,
+            },
+        ),
+        R::NeighbourValues { block } => (
+            "the neighbour values",
+            Shape::TextureArray {
+                texels: Extent::SampleGrid { block },
+                layers: layout.neighbours.words,
+                format: TextureFormat::R32Uint,
+            },
+        ),
+        R::TaggedRecords { block } => {
+            ("the 2x2 level", words(Extent::SampleGrid { block }, stride + geometry::DYNAMIC_TAG_WORDS))
+        }
+        R::PixelRecords => (
+            "the per-pixel record texture",
+            Shape::TextureArray {
+                texels: Extent::Pixels,
+                layers: layout.hierarchical.record_words,
+                format: TextureFormat::R32Uint,
+            },
+        ),
+        R::WorkLists => ("the hierarchical work lists", words(Extent::HierarchicalLevels, 1)),
+        R::LevelCounts => ("the hierarchical level counts", words(Extent::Fixed { count: counters }, 1)),
+        R::LevelArguments => ("the hierarchical dispatch arguments", words(Extent::Fixed { count: counters }, 1)),
+        R::RateRecords => ("the rate-image interface", words(Extent::Pixels, stride.max(1))),
+        R::SampleList => ("the rate-image sample list", words(Extent::Pixels, 1)),
+        R::SampleCount => ("the rate-image sample count", words(Extent::Fixed { count: rate_words() }, 1)),
+        R::SampleArguments => ("the rate-image dispatch arguments", words(Extent::Fixed { count: rate_words() }, 1)),
+        R::Statistics => ("the statistics counters", words(Extent::Fixed { count: layout.stats_counters() as u64 }, 1)),
+        R::RefineMask => ("the refine mask", Shape::Texture { format: TextureFormat::Rg32Uint }),
+        R::ShadingRate | R::Output { .. } => unreachable!("engine-bound resources have no descriptor"),
+    };
+    ResourceDesc { id, what: what.into(), shape, readable: id == R::RefineMask }
+}
+
+/// Words of the rate-image mode's counter and of its indirect arguments.
+fn rate_words() -> u64 {
+    geometry::RATE_QUEUE_BYTES / 4
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every pass of a kernel binds the same stage group, so a runtime can
+    /// make one bind group layout per kernel.
+    #[test]
+    fn a_kernel_binds_the_same_group_in_every_pass() {
+        let source = "in float3 normal;\ncoarse effect float d = normal.y;\nfine out float4 color = float4(d);\n";
+        let program = crate::compile(source, &crate::Options::default()).unwrap();
+        let plan = &program.layout.plan;
+        assert_eq!(plan.modes.len(), Mode::ALL.len());
+        for mode in &plan.modes {
+            for pass in mode.passes() {
+                assert_eq!(pass.bindings, stage_bindings(&program.layout, pass.kernel), "{}", pass.label);
+                assert!(mode.kernels.contains(&pass.kernel), "{}: {}", mode.mode, pass.kernel);
+            }
+        }
+        for id in plan.modes.iter().flat_map(|m| m.resources()) {
+            assert_eq!(plan.resource(id).is_none(), id.engine_bound(), "{id:?}");
+        }
+    }
+}
