@@ -1,5 +1,5 @@
-//! Small wgpu helpers the runtime's modules share: format conversion,
-//! buffer read-back and error descriptions.
+//! Small wgpu helpers: format conversion, buffer read-back and error
+//! descriptions, shared by the runtime's modules and the tools built on it.
 
 use crate::error::Error;
 use mrsl_abi::TextureFormat;
@@ -23,7 +23,7 @@ pub fn wgpu_format(format: TextureFormat) -> wgpu::TextureFormat {
 }
 
 /// Maps `buffer` and copies its contents out (waits for the GPU).
-pub(crate) fn read_buffer<T: bytemuck::Pod>(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<T>, Error> {
+pub fn read_buffer<T: bytemuck::Pod>(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<T>, Error> {
     let slice = buffer.slice(..);
     let (tx, rx) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {

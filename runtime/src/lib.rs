@@ -30,7 +30,7 @@
 
 pub mod controller;
 mod error;
-mod gpu;
+pub mod gpu;
 mod groups;
 mod pool;
 pub mod rate_source;
