@@ -1,40 +1,14 @@
 // The content-adaptive rate source of the `rate-image` mode (see
-// runtime/src/rate_source.rs and docs/rate-image.md): VALAR's per-tile
+// runtime/src/rate_source/ and docs/rate-image.md): VALAR's per-tile
 // decision from the previous frame's luminance and motion (`decide`), then
 // temporal damping, reprojection and the combiners (`resolve`).
 //
 // Codes are those of D3D12/Vulkan: (log2(width) << 2) | log2(height), width
 // along x. Per-axis rates are carried as log2 values 0 (1x), 1 (2x), 2 (4x).
 
-struct Params {
-    size: vec2<u32>,
-    rate_size: vec2<u32>,
-    tile: u32,
-    flags: u32,
-    sensitivity: f32,
-    env_luma: f32,
-    k: f32,
-    weber_fechner: f32,
-    fovea_inner: f32,
-    fovea_outer: f32,
-    gaze: vec2<f32>,
-    // External combiner in bits 0..3, foveation combiner in bits 4..7.
-    combiners: u32,
-    pad: u32,
-}
-
-// Keep in step with `flags` in rate_source.rs.
-const FLAG_WEBER_FECHNER: u32 = 1u;
-const FLAG_MOTION: u32 = 2u;
-const FLAG_FIRST_FRAME: u32 = 4u;
-const FLAG_REPROJECT: u32 = 8u;
-const FLAG_EXTERNAL: u32 = 16u;
-const FLAG_FOVEATION: u32 = 32u;
-const FLAG_HYSTERESIS: u32 = 64u;
-
-const COMBINE_MIN: u32 = 0u;
-const COMBINE_MAX: u32 = 1u;
-const COMBINE_OVERRIDE: u32 = 2u;
+// `Params`, the FLAG_ and COMBINE_ constants, WEBER_FLOOR and the bindings
+// are declared before this text by runtime/src/rate_source/interface.rs,
+// from the same description the Rust side binds and fills them from.
 
 // A history slot that holds no decision (before the first frame, or where the
 // reprojected source left the screen): it takes no part in the damping.
@@ -43,21 +17,8 @@ const NONE: u32 = 0xffu;
 // Rec.709 / sRGB primaries' luminance weights, as VALAR's RGBToLuminance.
 const REC709 = vec3<f32>(0.212671, 0.715160, 0.072169);
 
-// The smallest Weber–Fechner divisor (keep in step with rate_source.rs).
-const WEBER_FLOOR: f32 = 1.0e-4;
-
 // Larger than any velocity in pixels: the neutral element of the tile minimum.
 const FAR: f32 = 3.0e38;
-
-@group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var color: texture_2d<f32>;
-@group(0) @binding(2) var velocity: texture_2d<f32>;
-@group(0) @binding(3) var raw_out: texture_storage_2d<r32uint, write>;
-@group(0) @binding(4) var raw_in: texture_2d<u32>;
-@group(0) @binding(5) var history_in: texture_2d<u32>;
-@group(0) @binding(6) var external_rates: texture_2d<u32>;
-@group(0) @binding(7) var target_out: texture_storage_2d<r32uint, write>;
-@group(0) @binding(8) var history_out: texture_storage_2d<r32uint, write>;
 
 // Pixels per tile side: 8 or 16, set per pipeline.
 override TILE: u32 = 8u;
