@@ -39,6 +39,38 @@ pub fn read_buffer<T: bytemuck::Pod>(device: &wgpu::Device, buffer: &wgpu::Buffe
     Ok(data)
 }
 
+/// Copies a single-level 2D texture out and returns its texels row by row,
+/// tightly packed (waits for the GPU). The texture needs `COPY_SRC`.
+pub fn read_texture(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture) -> Result<Vec<u8>, Error> {
+    let bytes_per_texel = texture.format().block_copy_size(None).unwrap_or(4);
+    let (width, height) = (texture.width(), texture.height());
+    let row = width * bytes_per_texel;
+    // Rows of a texture-to-buffer copy are padded to 256 bytes.
+    let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("mrsl texture readback"),
+        size: u64::from(padded) * u64::from(height),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    encoder.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(height),
+            },
+        },
+        texture.size(),
+    );
+    queue.submit([encoder.finish()]);
+    let padded_rows: Vec<u8> = read_buffer(device, &buffer)?;
+    Ok(padded_rows.chunks(padded as usize).flat_map(|line| &line[..row as usize]).copied().collect())
+}
+
 /// A wgpu error's full description (its Display is only "Validation Error").
 pub fn describe(error: &wgpu::Error) -> String {
     match error {

@@ -2,7 +2,7 @@
 //! engine's rates, read back, checked, and measured in shading work.
 
 use crate::Error;
-use crate::gpu::read_buffer;
+use crate::gpu::read_texture;
 use mrsl_abi::shading_rate::{RATE_TILE_SIZES, ShadingRate, rate_image_size};
 
 /// The format of the rate image the rate source writes.
@@ -88,7 +88,7 @@ pub fn read_rate_image(
 ) -> Result<Vec<ShadingRate>, Error> {
     use wgpu::TextureFormat as F;
     let what = "the rate image to read back";
-    let bytes_per_texel = match texture.format() {
+    let bytes_per_texel: usize = match texture.format() {
         F::R8Uint => 1,
         F::R16Uint => 2,
         F::R32Uint => 4,
@@ -97,34 +97,11 @@ pub fn read_rate_image(
     if !texture.usage().contains(wgpu::TextureUsages::COPY_SRC) {
         return Err(Error::RateUsage { what, missing: "COPY_SRC" });
     }
-    let (width, height) = (texture.width(), texture.height());
-    let row = width * bytes_per_texel;
-    let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("mrsl rate image readback"),
-        size: u64::from(padded) * u64::from(height),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut encoder = device.create_command_encoder(&Default::default());
-    encoder.copy_texture_to_buffer(
-        texture.as_image_copy(),
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded),
-                rows_per_image: Some(height),
-            },
-        },
-        texture.size(),
-    );
-    queue.submit([encoder.finish()]);
-    let view: Vec<u8> = read_buffer(device, &buffer)?;
-    let mut rates = Vec::with_capacity((width * height) as usize);
-    for y in 0..height as usize {
-        let line = &view[y * padded as usize..][..row as usize];
-        for (x, texel) in line.chunks_exact(bytes_per_texel as usize).enumerate() {
+    let texels = read_texture(device, queue, texture)?;
+    let width = texture.width() as usize;
+    let mut rates = Vec::with_capacity(texels.len() / bytes_per_texel);
+    for (y, line) in texels.chunks(width * bytes_per_texel).enumerate() {
+        for (x, texel) in line.chunks_exact(bytes_per_texel).enumerate() {
             let mut word = [0u8; 4];
             word[..texel.len()].copy_from_slice(texel);
             let code = u32::from_le_bytes(word);
