@@ -3,29 +3,21 @@
 //! per pixel, the four samples around it and resamples or re-evaluates each
 //! coarse effect; the reference kernel evaluates everything per pixel. The
 //! dynamic mode's kernels are the coarse and fine ones over two levels of
-//! blocks; what only they add is in [`super::dynamic`].
+//! blocks; what only they add is in [`super::dynamic`]. What the fine
+//! kernels of every family share (levels, resolvers as data, the refine
+//! decisions) is in [`super::fine`]; the rate-image mode's coarse kernel
+//! reuses this one's body ([`Writer::coarse_main`]).
 
 use super::Writer;
 use super::effects::Key;
-use super::words::{bit, pack_words, test_bit, unpack_with, unpack_words};
+use super::fine::{CORNER_SAMPLES, Corners, LANES, Level, Resolver};
+use super::words::{pack_words, test_bit, unpack_with};
 use super::writer::{cut, fill};
 use crate::check::{EffectId, InputId};
 use crate::layout;
-use crate::syntax::ast::Rate;
 use mrsl_abi::KernelKind;
-use mrsl_abi::geometry::{DYNAMIC_TAG_WORDS, FINE_PIXELS_PER_LANE};
-use std::collections::{BTreeSet, HashMap};
-
-/// One level of coarse samples as a fine kernel reads it.
-pub(super) struct Level {
-    /// Suffix of the generated functions (`mrsl_resolve{suffix}`).
-    pub(super) suffix: &'static str,
-    pub(super) block: u32,
-    pub(super) buffer: &'static str,
-    /// Refines only within the parent level's refined effects (dynamic mode);
-    /// its records carry a validity tag.
-    pub(super) parent: bool,
-}
+use mrsl_abi::geometry::FINE_PIXELS_PER_LANE;
+use std::collections::BTreeSet;
 
 /// The corners of a block, in the order of `MrslBlock::corners`, and the
 /// pixels their keys are loaded at (in `mrsl_resolve` and `mrsl_corners`).
@@ -59,25 +51,17 @@ pub(super) fn corners_differ(key: &Key, prefix: &str) -> Vec<String> {
 }
 
 impl Writer<'_, '_, '_> {
-    /// The interface of the coarse (written) and fine (read) kernels: the
-    /// block modes' record texture, or the rate-image mode's buffer.
+    /// The interface of the block coarse kernel (the record texture,
+    /// written) and fine kernels (read), and what else they read.
     pub(super) fn interface_bindings(&mut self) {
         let l = self.i.layout;
-        let values: &super::writer::Values = &[("GROUP", &l.interface.group), ("BINDING", &l.interface.binding)];
-        match self.kind {
-            KernelKind::Coarse => self.template(0, include_str!("templates/records_write.wgsl"), values),
-            KernelKind::Fine | KernelKind::DynamicFine => {
-                self.template(0, include_str!("templates/records_read.wgsl"), values)
-            }
-            _ => {
-                let access = if self.kind == KernelKind::RateCoarse { "read_write" } else { "read" };
-                let values: &super::writer::Values =
-                    &[("GROUP", &l.interface.group), ("BINDING", &l.interface.binding), ("ACCESS", &access)];
-                self.template(0, include_str!("templates/interface.wgsl"), values)
-            }
-        }
+        let records = if self.kind == KernelKind::Coarse {
+            include_str!("templates/records_write.wgsl")
+        } else {
+            include_str!("templates/records_read.wgsl")
+        };
+        self.template(0, records, &[("GROUP", &l.interface.group), ("BINDING", &l.interface.binding)]);
         if self.stores_neighbours() {
-            let l = self.i.layout;
             self.template(
                 0,
                 include_str!("templates/neighbours_binding.wgsl"),
@@ -166,6 +150,8 @@ impl Writer<'_, '_, '_> {
         self.line(0, "");
     }
 
+    /// The entry points of the block modes' coarse kernel and of the dynamic
+    /// mode's second level.
     pub(super) fn coarse_entry(&mut self) {
         if self.kind == KernelKind::DynamicCoarse {
             self.parent_refined();
@@ -173,14 +159,14 @@ impl Writer<'_, '_, '_> {
         if self.kind == KernelKind::Coarse {
             self.neighbours_entry();
         }
-        let c = self.checked();
-        let iface = self.i.interface;
+        self.coarse_main(include_str!("templates/coarse_main.wgsl"));
+    }
+
+    /// The main entry point of a coarse kernel, from `main` (a template
+    /// with a `BODY` hole, after which the sample is at `mrsl_pos`): the
+    /// coarse effects evaluated, then the sample's record written.
+    pub(super) fn coarse_main(&mut self, main: &str) {
         let [x, y, z] = self.kind.workgroup_size();
-        let main = if self.kind == KernelKind::RateCoarse {
-            include_str!("templates/rate_coarse_main.wgsl")
-        } else {
-            include_str!("templates/coarse_main.wgsl")
-        };
         let [head, tail] = cut(main, &["BODY"]);
         // Where the sample's record starts in a buffer; the record texture is addressed by `mrsl_pos`.
         let record = if self.writes_record_texels() {
@@ -202,21 +188,31 @@ impl Writer<'_, '_, '_> {
         if self.kind == KernelKind::DynamicCoarse {
             self.dynamic_coarse_gate();
         }
-        let stride = iface.stride;
         if self.writes_record_texels() {
             // Words are gathered in locals and stored a texel at a time; a word no
             // effect writes here (a shared slot's other effect) is stored as 0.
-            for w in 0..stride {
+            for w in 0..self.i.interface.stride {
                 self.line(1, format!("var mrsl_w{w} = 0u;"));
             }
         }
-        let coarse = self.coarse_live();
+        self.coarse_values();
+        self.record_flags();
+        self.record_slots();
+        if self.writes_record_texels() {
+            self.record_texels();
+        }
+        self.template(0, tail, &[]);
+    }
+
+    /// Every live coarse effect at the sample, in dependency order.
+    fn coarse_values(&mut self) {
+        let c = self.checked();
         let stored: Vec<EffectId> = if self.stores_neighbours() {
             self.neighbour_values().into_iter().map(|(e, _)| e).collect()
         } else {
             vec![]
         };
-        for &e in &coarse {
+        for e in self.coarse_live() {
             let info = &c.effects[e.index()];
             self.line(1, format!("// coarse effect `{}`", info.name));
             if stored.contains(&e) && !info.has_refine {
@@ -227,18 +223,30 @@ impl Writer<'_, '_, '_> {
                 self.effect_chain(&[e], 1);
             }
         }
-        if iface.flag_words > 0 {
-            self.template(0, include_str!("templates/refine_flags.wgsl"), &[]);
-            self.declare_flag_words(iface.flag_words);
-            for &e in &coarse {
-                self.set_refine_flag(e, 1);
-            }
-            for w in 0..iface.flag_words {
-                let store = self.record_word_store(w, &format!("mrsl_flags{w}"));
-                self.line(1, store);
-            }
+    }
+
+    /// The sample's refine flags, into the first words of its record.
+    fn record_flags(&mut self) {
+        let flag_words = self.i.interface.flag_words;
+        if flag_words == 0 {
+            return;
         }
-        for (k, slot) in iface.slots.iter().enumerate() {
+        self.template(0, include_str!("templates/refine_flags.wgsl"), &[]);
+        self.declare_flag_words(flag_words);
+        for e in self.coarse_live() {
+            self.set_refine_flag(e, 1);
+        }
+        for w in 0..flag_words {
+            let store = self.record_word_store(w, &format!("mrsl_flags{w}"));
+            self.line(1, store);
+        }
+    }
+
+    /// The passed values, each into its slot of the record; a shared slot
+    /// holds whichever effect this sample's own flags say is passed.
+    fn record_slots(&mut self) {
+        let c = self.checked();
+        for (k, slot) in self.i.interface.slots.iter().enumerate() {
             let names: Vec<&str> = slot.effects.iter().map(|e| c.effects[e.index()].name.as_str()).collect();
             self.line(
                 1,
@@ -249,7 +257,6 @@ impl Writer<'_, '_, '_> {
                 let writes: Vec<String> =
                     words.iter().enumerate().map(|(j, w)| self.record_word_store(slot.offset + j as u32, w)).collect();
                 if slot.effects.len() > 1 {
-                    // A shared slot holds whichever effect this sample's own flags say is passed.
                     let cond = self.store_condition(e, &|bit| test_bit("mrsl_flags", bit));
                     self.line(1, format!("if ({cond}) {{"));
                     for wline in writes {
@@ -263,22 +270,21 @@ impl Writer<'_, '_, '_> {
                 }
             }
         }
-        if self.writes_record_texels() {
-            for layer in 0..stride.div_ceil(4) {
-                let words: Vec<String> = (4 * layer..4 * layer + 4)
-                    .map(|w| if w < stride { format!("mrsl_w{w}") } else { "0u".to_string() })
-                    .collect();
-                self.line(
-                    1,
-                    format!("textureStore(mrsl_interface, mrsl_pos, {layer}, vec4<u32>({}));", words.join(", ")),
-                );
-            }
+    }
+
+    /// The record's word locals stored into the record texture, four words a texel.
+    fn record_texels(&mut self) {
+        let stride = self.i.interface.stride;
+        for layer in 0..stride.div_ceil(4) {
+            let words: Vec<String> = (4 * layer..4 * layer + 4)
+                .map(|w| if w < stride { format!("mrsl_w{w}") } else { "0u".to_string() })
+                .collect();
+            self.line(1, format!("textureStore(mrsl_interface, mrsl_pos, {layer}, vec4<u32>({}));", words.join(", ")));
         }
-        self.template(0, tail, &[]);
     }
 
     /// The pass condition of `e` as WGSL, over flag bits rendered by `bit`.
-    fn store_condition(&self, e: EffectId, bit: &dyn Fn(u32) -> String) -> String {
+    pub(super) fn store_condition(&self, e: EffectId, bit: &dyn Fn(u32) -> String) -> String {
         let iface = self.i.interface;
         let cond = iface.conditions[e.index()].as_ref().expect("passed effects have a condition");
         let mut any = vec![];
@@ -299,56 +305,26 @@ impl Writer<'_, '_, '_> {
 
     /// `MrslBlock` and the resolvers, getters and resamplers of the fine kernel's levels.
     pub(super) fn fine_support(&mut self) {
-        let coarse = self.coarse_live();
-        if coarse.is_empty() {
+        if self.coarse_live().is_empty() {
             return;
         }
-        let mask_words = (coarse.len() as u32).div_ceil(32);
-        let rate = self.kind == KernelKind::RateFine;
-        let block_struct = if rate {
-            include_str!("templates/rate_block_struct.wgsl")
-        } else {
-            include_str!("templates/block_struct.wgsl")
-        };
-        let [head, tail] = cut(block_struct, &["REFINED_WORDS"]);
-        self.template(0, head, &[]);
-        // Separate words, not an array: llvmpipe spills dynamically indexed
-        // arrays in structs to memory, which made every lookup a memory access.
-        if !rate {
-            for (s, keys) in self.edge_sets().iter().enumerate() {
-                let names: Vec<&str> = keys.iter().map(|k| self.checked().inputs[k.index()].name.as_str()).collect();
-                self.line(
-                    1,
-                    format!("weights{s}: vec4<f32>, // the corners on the pixel's side of {}", names.join(", ")),
-                );
+        let block_struct = include_str!("templates/block_struct.wgsl");
+        self.block_struct(block_struct, |w| {
+            for (s, keys) in w.edge_sets().iter().enumerate() {
+                let names: Vec<&str> = keys.iter().map(|k| w.checked().inputs[k.index()].name.as_str()).collect();
+                w.line(1, format!("weights{s}: vec4<f32>, // the corners on the pixel's side of {}", names.join(", ")));
             }
-        }
-        for w in 0..mask_words {
-            self.line(1, format!("refined{w}: u32, // bit k: coarse effect 32 * {w} + k is evaluated per pixel"));
-        }
-        let mut word = "b.refined0".to_string();
-        for w in 1..mask_words {
-            word = format!("select({word}, b.refined{w}, k >= {}u)", 32 * w);
-        }
-        self.template(0, tail, &[("WORD", &word)]);
+        });
         if self.preloads_corners() {
             self.corners_function();
         }
         if self.kind == KernelKind::DynamicFine {
-            self.any_refined(mask_words);
+            self.any_refined(self.mask_words());
             self.fine_level(&Level::DYNAMIC_OUTER);
             self.fine_level(&Level::DYNAMIC_INNER);
         } else {
-            self.fine_level(&Level { suffix: "", block: self.block, buffer: "mrsl_interface", parent: false });
+            self.fine_level(&Level::own(self.block));
         }
-    }
-
-    /// Whether the kernel's resolvers and resamplers of its first level
-    /// take the block's corners preloaded (`MrslCorners`): the block modes'
-    /// fine kernels and the dynamic fine kernel (its 4x4 level), whose lanes
-    /// shade [`FINE_PIXELS_PER_LANE`] pixels of one block.
-    pub(super) fn preloads_corners(&self) -> bool {
-        matches!(self.kind, KernelKind::Fine | KernelKind::DynamicFine)
     }
 
     /// `MrslCorners` and `mrsl_corners`: the keys and record words of a block's four coarse samples.
@@ -384,7 +360,7 @@ impl Writer<'_, '_, '_> {
                 self.line(1, format!("let {corner}_{layer} = textureLoad(mrsl_interface, {at}, {layer}, 0);"));
             }
             for w in 4 * layer..(4 * layer + 4).min(stride) {
-                let lane = ["x", "y", "z", "w"][(w % 4) as usize];
+                let lane = LANES[(w % 4) as usize];
                 let words: Vec<String> = TEXELS.iter().map(|corner| format!("{corner}_{layer}.{lane}")).collect();
                 self.line(1, format!("c.w{w} = vec4<u32>({});", words.join(", ")));
             }
@@ -451,403 +427,113 @@ impl Writer<'_, '_, '_> {
         }
     }
 
-    /// `mrsl_resolve{suffix}`: where a pixel takes its coarse values from at
-    /// one level, and which coarse effects it evaluates per pixel. With
-    /// `only`, `mrsl_resolve{suffix}_<effect>` for the neighbour function of
-    /// that effect: the same function deciding only the given effects (the
-    /// coarse effects the neighbour evaluation reads, and the users their
-    /// decisions depend on, [`Writer::neighbour_decisions`]), so that a
-    /// derivative does not decide every coarse effect of the program again
-    /// at each neighbour. Their decisions are those of the full function.
-    pub(super) fn resolve_function(&mut self, level: &Level, only: Option<(&str, &BTreeSet<EffectId>)>) {
-        let c = self.checked();
-        let coarse: Vec<EffectId> =
-            self.coarse_live().into_iter().filter(|e| only.is_none_or(|(_, set)| set.contains(e))).collect();
-        let iface = self.i.interface;
-        let (sfx, bk, buf) = (level.suffix, level.block, level.buffer);
-        let stride = if level.parent { iface.stride + DYNAMIC_TAG_WORDS } else { iface.stride };
-        // The samples a pixel resamples from: a block's four corners, or in the
-        // rate-image mode each corner's two border samples.
-        let rate = self.kind == KernelKind::RateFine;
-        let samples: &[&str] = if rate {
-            &[
-                "b.corners.x",
-                "b.corners.y",
-                "b.corners.z",
-                "b.corners.w",
-                "b.others.x",
-                "b.others.y",
-                "b.others.z",
-                "b.others.w",
-            ]
-        } else {
-            &["b.corners.x", "b.corners.y", "b.corners.z", "b.corners.w"]
+    /// The resampling weights of coarse effect `e`: those of its key set's
+    /// corners on the pixel's side, or of all four.
+    fn edge_weights_of(&self, e: EffectId) -> String {
+        match self.edge_set_of(e) {
+            Some(s) => format!("b.weights{s}"),
+            None => "b.weights".to_string(),
+        }
+    }
+
+    /// `mrsl_resolve{suffix}` of a block level: where a pixel takes its
+    /// coarse values from at the level, and which of `r.coarse` it
+    /// evaluates per pixel. A neighbour function's resolver decides only
+    /// the coarse effects its evaluation reads and the users their decisions
+    /// depend on ([`Writer::neighbour_decisions`]), so that a derivative
+    /// does not decide every coarse effect of the program again at each
+    /// neighbour; their decisions are those of the full resolver.
+    pub(super) fn resolve_function(&mut self, r: &Resolver) {
+        let [head, corners, refined] = cut(include_str!("templates/resolve.wgsl"), &["CORNERS", "REFINED"]);
+        let level = r.level;
+        let params = match (level.parent, r.corners) {
+            (true, _) => "pos: vec2<i32>, parent: MrslBlock",
+            (false, Corners::Preloaded) => "pos: vec2<i32>, c: MrslCorners",
+            (false, Corners::Loaded) => "pos: vec2<i32>",
         };
-        let resolve =
-            if rate { include_str!("templates/rate_resolve.wgsl") } else { include_str!("templates/resolve.wgsl") };
-        let [head, corners, refined] = cut(resolve, &["CORNERS", "REFINED"]);
-        let preloaded = self.preloads_corners() && !level.parent;
-        let params = if level.parent {
-            self.inner_level_note(bk);
-            "pos: vec2<i32>, parent: MrslBlock"
-        } else if preloaded {
-            "pos: vec2<i32>, c: MrslCorners"
-        } else {
-            "pos: vec2<i32>"
-        };
-        let name = match only {
-            Some((effect, _)) => format!("{sfx}_{effect}"),
-            None => sfx.to_string(),
-        };
-        let geometry = block_geometry(bk);
-        self.template(0, head, &[("SUFFIX", &name), ("PARAMS", &params), ("GEOMETRY", &geometry)]);
         if level.parent {
-            self.stale_corners(buf, stride);
+            self.inner_level_note(level.block);
         }
-        for key in self.keys_of(&coarse) {
-            let name = key.name;
-            if rate {
-                let mut tests: Vec<String> =
-                    (0..8).map(|s| key.differs(&format!("k_{name}"), &format!("k{s}_{name}"))).collect();
-                tests.extend((1..4).map(|s| key.differs(&format!("k0_{name}"), &format!("k{s}_{name}"))));
-                self.template(
-                    0,
-                    include_str!("templates/rate_resolve_key.wgsl"),
-                    &[("NAME", &name), ("TESTS", &tests.join(" || "))],
-                );
-                continue;
-            }
-            // Which corners are on the pixel's side of the key.
-            let side: Vec<String> =
-                CORNERS.iter().map(|corner| key.matches(&format!("k_{name}"), &format!("{corner}_{name}"))).collect();
-            let at: Vec<String> = CORNERS
-                .iter()
-                .zip(CORNER_PIXELS)
-                .map(
-                    |(corner, pixel)| {
-                        if preloaded { format!("c.{corner}_{name}") } else { format!("mrsl_load_{name}({pixel})") }
-                    },
-                )
-                .collect();
-            self.template(
-                0,
-                include_str!("templates/resolve_key.wgsl"),
-                &[
-                    ("NAME", &name),
-                    ("K00", &at[0]),
-                    ("K10", &at[1]),
-                    ("K01", &at[2]),
-                    ("K11", &at[3]),
-                    ("SIDE", &side.join(", ")),
-                ],
-            );
+        let geometry = block_geometry(level.block);
+        self.template(0, head, &[("SUFFIX", &r.name), ("PARAMS", &params), ("GEOMETRY", &geometry)]);
+        if level.parent {
+            self.stale_corners(level.buffer, level.stride(self.i.interface));
         }
-        if !rate {
-            self.edge_weights(&coarse);
+        for key in self.keys_of(&r.coarse) {
+            self.key_sides(r, &key);
         }
-        let words: Vec<u32> = match only {
-            None => (0..iface.flag_words).collect(),
-            Some(_) => self.flag_words_read(&coarse).into_iter().collect(),
-        };
-        for (ci, sample) in samples.iter().enumerate().take(4) {
-            for &w in &words {
-                let word = if preloaded {
-                    format!("c.w{w}.{}", ["x", "y", "z", "w"][ci])
-                } else {
-                    format!("{buf}[{sample} * {stride}u + {w}u]")
-                };
-                self.line(1, format!("let f{ci}_{w} = {word};"));
-            }
-        }
-        if rate && !words.is_empty() {
-            // The second border samples' flags, read only where a corner blends two.
-            for ci in 4..8 {
-                for &w in &words {
-                    self.line(1, format!("var f{ci}_{w} = f{}_{w};", ci - 4));
-                }
-            }
-            self.line(1, "if (blended) {");
-            for (ci, sample) in samples.iter().enumerate().skip(4) {
-                for &w in &words {
-                    self.line(2, format!("f{ci}_{w} = {buf}[{sample} * {stride}u + {w}u];"));
-                }
-            }
-            self.line(1, "}");
-        }
+        self.edge_weights(&r.coarse);
+        self.corner_flag_words(r);
         self.template(0, corners, &[]);
-        for &e in coarse.iter().rev() {
-            let info = &c.effects[e.index()];
-            let k = self.coarse_index[&e];
-            let mut terms = vec![if rate { self.discontinuity(e) } else { self.edge_discontinuity(e) }];
-            if let Some(b) = iface.refine_bit[e.index()] {
-                let (word, mask) = bit(b);
-                let words: Vec<String> = (0..samples.len()).map(|ci| format!("f{ci}_{word}")).collect();
-                terms.push(format!("((({}) & {mask}u) != 0u)", words.join(" | ")));
-            }
-            // Needed coarsely: some live user runs per pixel here.
-            let mut needed = vec![];
-            for &u in &self.i.graph.users[e.index()] {
-                if !self.i.graph.live[u.index()] {
-                    continue;
-                }
-                match c.effects[u.index()].rate {
-                    Rate::Coarse => needed.push(format!("mrsl_r{}", self.coarse_index[&u])),
-                    _ => needed.push("true".into()),
-                }
-            }
-            needed.sort();
-            needed.dedup();
-            let needed = if needed.is_empty() { "false".to_string() } else { needed.join(" || ") };
-            if !iface.is_passed(e) {
-                terms.push(format!("({needed})"));
-            } else if iface.is_shared(e) {
-                let misses: Vec<String> = (0..samples.len())
-                    .map(|ci| format!("!({})", self.store_condition(e, &|b| test_bit(&format!("f{ci}_"), b))))
-                    .collect();
-                terms.push(format!("(({needed}) && ({}))", misses.join(" || ")));
-            }
-            let value = if level.parent {
-                format!("mrsl_is_refined(parent, {k}u) && ({})", terms.join(" || "))
-            } else {
-                terms.join(" || ")
-            };
-            let (word, mask) = bit(k);
-            self.line(1, format!("let mrsl_r{k} = {value}; // `{}`", info.name));
-            self.line(1, format!("if (mrsl_r{k}) {{ b.refined{word} |= {mask}u; }}"));
-        }
+        self.refine_decisions(r, CORNER_SAMPLES.len(), &|w, e| w.edge_discontinuity(e));
         self.template(0, refined, &[]);
     }
 
-    /// The flag words the decisions of `effects` read: their own refine
-    /// bits, and for a shared slot the bits of its pass condition.
-    fn flag_words_read(&self, effects: &[EffectId]) -> BTreeSet<u32> {
-        let iface = self.i.interface;
-        let mut words = BTreeSet::new();
-        for &e in effects {
-            let mut bits: Vec<u32> = iface.refine_bit[e.index()].into_iter().collect();
-            if iface.is_passed(e) && iface.is_shared(e) {
-                let cond = iface.conditions[e.index()].as_ref().expect("passed effects have a condition");
-                bits.extend(cond.refining_users.iter().filter_map(|u| iface.refine_bit[u.index()]));
-            }
-            words.extend(bits.into_iter().map(|b| bit(b).0));
-        }
-        words
+    /// In a block resolver: `key` at the pixel and at the corners, and which
+    /// corners are on the pixel's side of it.
+    fn key_sides(&mut self, r: &Resolver, key: &Key) {
+        let name = key.name;
+        let side: Vec<String> =
+            CORNERS.iter().map(|corner| key.matches(&format!("k_{name}"), &format!("{corner}_{name}"))).collect();
+        let at: Vec<String> = CORNERS
+            .iter()
+            .zip(CORNER_PIXELS)
+            .map(|(corner, pixel)| match r.corners {
+                Corners::Preloaded => format!("c.{corner}_{name}"),
+                Corners::Loaded => format!("mrsl_load_{name}({pixel})"),
+            })
+            .collect();
+        self.template(
+            0,
+            include_str!("templates/resolve_key.wgsl"),
+            &[
+                ("NAME", &name),
+                ("K00", &at[0]),
+                ("K10", &at[1]),
+                ("K01", &at[2]),
+                ("K11", &at[3]),
+                ("SIDE", &side.join(", ")),
+            ],
+        );
     }
 
-    /// The resolvers of the neighbour function of effect `e`, which
-    /// evaluates `chain` (in a fine kernel): `mrsl_resolve_<e>`, and in the
-    /// dynamic fine kernel `mrsl_resolve2_<e>`, unless an earlier neighbour
-    /// function's decide the same effects, or they decide every coarse
-    /// effect (then the kernel's own resolvers serve). Returns the suffix of
-    /// the resolvers to call: `_<name>` or empty.
-    pub(super) fn neighbour_resolvers(
-        &mut self,
-        e: EffectId,
-        chain: &[EffectId],
-        written: &mut HashMap<BTreeSet<EffectId>, String>,
-    ) -> String {
-        let decisions = self.neighbour_decisions(chain);
-        if decisions.len() == self.coarse_live().len() {
-            return String::new();
-        }
-        if let Some(suffix) = written.get(&decisions) {
-            return suffix.clone();
-        }
-        let name = &self.checked().effects[e.index()].name;
-        self.line(0, format!("// Where neighbour evaluations of `{name}` take their coarse values from."));
-        if self.kind == KernelKind::DynamicFine {
-            self.resolve_function(&Level::DYNAMIC_OUTER, Some((name, &decisions)));
-            self.resolve_function(&Level::DYNAMIC_INNER, Some((name, &decisions)));
-        } else {
-            let level = Level { suffix: "", block: self.block, buffer: "mrsl_interface", parent: false };
-            self.resolve_function(&level, Some((name, &decisions)));
-        }
-        let suffix = format!("_{name}");
-        written.insert(decisions, suffix.clone());
-        suffix
-    }
-
-    /// The coarse effects whose decisions a neighbour evaluation of `chain`
-    /// needs: its coarse effects, and, where a decision reads its users'
-    /// (an effect not passed, or in a shared slot: rule 4 of
-    /// docs/language.md, section 8.3), those users, transitively.
-    pub(super) fn neighbour_decisions(&self, chain: &[EffectId]) -> BTreeSet<EffectId> {
-        let c = self.checked();
-        let iface = self.i.interface;
-        let mut set: BTreeSet<EffectId> =
-            chain.iter().copied().filter(|e| c.effects[e.index()].rate == Rate::Coarse).collect();
-        let mut stack: Vec<EffectId> = set.iter().copied().collect();
-        while let Some(e) = stack.pop() {
-            if iface.is_passed(e) && !iface.is_shared(e) {
-                continue;
-            }
-            for &u in &self.i.graph.users[e.index()] {
-                if self.i.graph.live[u.index()] && c.effects[u.index()].rate == Rate::Coarse && set.insert(u) {
-                    stack.push(u);
-                }
-            }
-        }
-        set
-    }
-
-    /// `mrsl_resolve{suffix}` and the getters and resamplers of one level of coarse samples.
+    /// `mrsl_resolve{suffix}` and the getters and resamplers of one block level of coarse samples.
     fn fine_level(&mut self, level: &Level) {
-        self.resolve_function(level, None);
-        let c = self.checked();
-        let coarse = self.coarse_live();
-        let iface = self.i.interface;
-        let (sfx, buf) = (level.suffix, level.buffer);
-        let stride = if level.parent { iface.stride + DYNAMIC_TAG_WORDS } else { iface.stride };
-        for &e in &coarse {
-            let Some(slot) = iface.slot_of[e.index()].map(|s| &iface.slots[s]) else {
+        let r = self.resolver(level, None);
+        self.resolve_function(&r);
+        for s in self.resamplers(level, &|w, e| w.edge_weights_of(e)) {
+            if r.corners == Corners::Loaded {
+                self.template(0, include_str!("templates/resample.wgsl"), &s.values());
                 continue;
-            };
-            let info = &c.effects[e.index()];
-            let (filter, value) = if layout::uses_nearest(c, e) {
-                // `select` takes no matrix: a matrix goes through `mrsl_select_m<N>`.
-                let select = match info.ty {
-                    crate::types::Type::Matrix(n) => format!("mrsl_select_m{n}"),
-                    _ => "select".to_string(),
-                };
-                (
-                    "nearest corner",
-                    format!(
-                        "{select}({select}(v0, v1, b.nearest == 1u), {select}(v2, v3, b.nearest == 3u), b.nearest >= 2u)"
-                    ),
-                )
-            } else {
-                let weights = match self.edge_set_of(e) {
-                    Some(s) if self.kind != KernelKind::RateFine => format!("b.weights{s}"),
-                    _ => "b.weights".to_string(),
-                };
-                ("bilinear", format!("v0 * {weights}.x + v1 * {weights}.y + v2 * {weights}.z + v3 * {weights}.w"))
-            };
+            }
+            let corner = |lane: &str| unpack_with(s.ty, |k| format!("c.w{}.{lane}", s.offset + k));
+            let (v0, v1, v2, v3) = (corner("x"), corner("y"), corner("z"), corner("w"));
+            let ty = s.ty.wgsl();
             let values: &super::writer::Values = &[
-                ("SUFFIX", &sfx),
-                ("NAME", &info.name),
-                ("TYPE", &info.ty.wgsl()),
-                ("STRIDE", &stride),
-                ("OFFSET", &slot.offset),
-                ("UNPACK", &unpack_words(&info.ty, buf)),
-                ("FILTER", &filter),
-                ("VALUE", &value),
+                ("NAME", &s.name),
+                ("TYPE", &ty),
+                ("V0", &v0),
+                ("V1", &v1),
+                ("V2", &v2),
+                ("V3", &v3),
+                ("FILTER", &s.filter),
+                ("VALUE", &s.value),
             ];
-            if self.preloads_corners() && !level.parent {
-                let corner = |lane: &str| unpack_with(&info.ty, |k| format!("c.w{}.{lane}", slot.offset + k));
-                let (v0, v1, v2, v3) = (corner("x"), corner("y"), corner("z"), corner("w"));
-                let values: &super::writer::Values = &[
-                    ("NAME", &info.name),
-                    ("TYPE", &info.ty.wgsl()),
-                    ("V0", &v0),
-                    ("V1", &v1),
-                    ("V2", &v2),
-                    ("V3", &v3),
-                    ("FILTER", &filter),
-                    ("VALUE", &value),
-                ];
-                self.template(0, include_str!("templates/resample_corners.wgsl"), values);
-                continue;
-            }
-            if self.kind != KernelKind::RateFine {
-                self.template(0, include_str!("templates/resample.wgsl"), values);
-                continue;
-            }
-            // The rate-image mode: a corner on a border may blend two border samples.
-            let [head, tail] = cut(include_str!("templates/rate_resample.wgsl"), &["CORNERS"]);
-            self.template(0, head, values);
-            let get = format!("mrsl_get{sfx}_{}", info.name);
-            for (k, lane) in ["x", "y", "z", "w"].iter().enumerate() {
-                self.line(1, format!("var v{k} = {get}(b.corners.{lane});"));
-                if layout::uses_nearest(c, e) {
-                    self.line(1, format!("if (b.lerps.{lane} >= 0.5) {{ v{k} = {get}(b.others.{lane}); }}"));
-                } else {
-                    self.line(
-                        1,
-                        format!(
-                            "if (b.lerps.{lane} != 0.0) {{ v{k} = v{k} * (1.0 - b.lerps.{lane}) + {get}(b.others.{lane}) * b.lerps.{lane}; }}"
-                        ),
-                    );
-                }
-            }
-            self.template(0, tail, values);
+            self.template(0, include_str!("templates/resample_corners.wgsl"), values);
         }
     }
 
-    /// Declares `mrsl_b` (and in the dynamic mode `mrsl_b2`) for the pixel at
-    /// `mrsl_pos` in the fine kernels; nothing elsewhere. `name` is the suffix
-    /// of a neighbour function's own resolvers (`mrsl_resolve_<effect>`), or empty.
-    pub(super) fn resolve_preamble(&mut self, indent: usize, name: &str) {
-        if self.pixels_resolved {
-            return;
-        }
-        if self.preloads_corners() {
-            // The entry point loads its lane's corners once; elsewhere each position loads its own.
-            if !self.corners_loaded {
-                self.line(indent, "let mrsl_c = mrsl_corners(mrsl_pos);");
-            }
-            self.line(indent, format!("let mrsl_b = mrsl_resolve{name}(mrsl_pos, mrsl_c);"));
-        } else if self.kind.is_fine() {
-            self.line(indent, format!("let mrsl_b = mrsl_resolve{name}(mrsl_pos);"));
-        }
-        if self.kind == KernelKind::DynamicFine {
-            self.resolve_inner(indent, name, ["mrsl_pos", "mrsl_b", "mrsl_b2"]);
-        }
-    }
-
-    /// A coarse effect in a fine kernel: evaluated where it is refined,
-    /// resampled elsewhere (when it is passed).
-    pub(super) fn resolved_coarse_value(&mut self, e: EffectId, indent: usize) {
-        let info = &self.checked().effects[e.index()];
-        let (index, name) = (self.coarse_index[&e], self.effect_name(e));
-        self.line(indent, format!("var {name}: {};", info.ty.wgsl()));
-        if self.kind == KernelKind::DynamicFine {
-            return self.dynamic_coarse_value(e, indent);
-        }
-        self.line(indent, format!("if (mrsl_is_refined(mrsl_b, {index}u)) {{"));
-        self.evaluate(e, indent + 1, "");
-        if self.i.interface.is_passed(e) {
-            self.line(indent, "} else {");
-            let corners = if self.preloads_corners() { ", mrsl_c" } else { "" };
-            self.line(indent + 1, format!("{name} = mrsl_resample_{}(mrsl_b{corners});", info.name));
-        }
-        self.line(indent, "}");
-    }
-
-    /// Entry point of the fine and reference kernels.
+    /// Entry point of the block and dynamic fine kernels and of the reference kernel.
     pub(super) fn pixel_entry(&mut self) {
-        // The reference kernel has no blocks; it lays its tiles out in 2x2 ones.
-        // The rate-image mode's cells are at most 4x4: 4x4 blocks keep a cell's pixels on neighbouring lanes.
         if self.compacts() {
             self.tile_pixel_blocks(self.block, 1);
             return self.compacted_fine_entry();
         }
         match self.kind {
             KernelKind::Fine | KernelKind::DynamicFine => self.tile_pixel_blocks(self.block, FINE_PIXELS_PER_LANE),
-            KernelKind::RateFine => self.tile_pixel_blocks(4, 1),
+            // The reference kernel has no blocks; it lays its tiles out in 2x2 ones.
             _ => self.tile_pixel_blocks(2, 1),
         }
-        let counted = self.counts_stats();
-        let coarse = self.coarse_live().len();
-        self.pixel_main(
-            |w| {
-                if !counted {
-                    return;
-                }
-                w.resolve_preamble(2, "");
-                // `mrsl_last` holds the innermost level: effects refined there are evaluated per pixel.
-                let (last, from_inner) = if w.kind == KernelKind::DynamicFine {
-                    ("mrsl_b2", "mrsl_b.refined0 & ~mrsl_b2.refined0")
-                } else {
-                    ("mrsl_b", "0u")
-                };
-                w.statistics_on(2);
-                w.template(3, include_str!("templates/rate.wgsl"), &[("LAST", &last), ("FROM_INNER", &from_inner)]);
-                for k in 0..coarse {
-                    w.count_refined(k, &format!("mrsl_is_refined(mrsl_last, {k}u)"));
-                }
-                w.line(2, "}");
-            },
-            |w, e, indent| w.effect_chain(&[e], indent),
-        );
+        self.fine_main();
     }
 }

@@ -7,7 +7,8 @@
 //! kernels ([`super::block`]) add for it.
 
 use super::Writer;
-use super::block::{Level, corners_differ, sample_grid};
+use super::block::{corners_differ, sample_grid};
+use super::fine::Level;
 use super::writer::cut;
 use crate::check::EffectId;
 use mrsl_abi::geometry::{DYNAMIC_INNER_BLOCK, DYNAMIC_OUTER_BLOCK};

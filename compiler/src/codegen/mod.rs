@@ -40,10 +40,13 @@
 //! from `templates/*.wgsl`), [`body`] (user statements and expressions),
 //! [`words`] (values as `u32` words), [`effects`] (what every kernel
 //! declares: bindings, loaders, effect functions, derivatives, key tests),
-//! [`pixel`] (per-pixel entry points), then one module per kernel family:
-//! [`block`] (coarse, fine, reference), [`dynamic`], [`records`] (what the
-//! hierarchical and checkerboard modes share), [`hierarchical`] and
-//! [`checkerboard`].
+//! [`pixel`] (per-pixel entry points), [`fine`] (what the fine kernels of
+//! every family share: levels, resolvers as data, refine decisions,
+//! resamplers), then one module per kernel family: [`block`] (coarse, fine,
+//! reference), [`compact`] (the block fine kernel's compacted entry point),
+//! [`dynamic`], [`rate`] (the rate-image mode's coarse and fine kernels),
+//! [`records`] (what the hierarchical and checkerboard modes share),
+//! [`hierarchical`] and [`checkerboard`].
 
 mod block;
 mod body;
@@ -51,6 +54,7 @@ mod checkerboard;
 mod compact;
 mod dynamic;
 mod effects;
+mod fine;
 mod hierarchical;
 mod pixel;
 mod rate;
@@ -295,8 +299,8 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             KernelKind::RateCoarse => self.rate_coarse_entries(),
             KernelKind::RateFine => {
                 self.rate_tiles();
-                self.fine_support();
-                self.pixel_entry();
+                self.rate_fine_support();
+                self.rate_fine_entry();
             }
         }
     }
