@@ -9,7 +9,7 @@
 //! reuses this one's body ([`Writer::coarse_main`]).
 
 use super::Writer;
-use super::effects::Key;
+use super::effects::{Evaluation, Key};
 use super::fine::{CORNER_SAMPLES, Corners, LANES, Level, Resolver};
 use super::words::{pack_words, test_bit, unpack_with};
 use super::writer::{cut, fill};
@@ -133,9 +133,7 @@ impl Writer<'_, '_, '_> {
         // The stored effects and what they read, each evaluated once, in dependency order.
         let needed: BTreeSet<EffectId> = stored.iter().flat_map(|&(e, _)| self.i.graph.closure(e, c)).collect();
         let chain: Vec<EffectId> = self.i.graph.order.iter().copied().filter(|e| needed.contains(e)).collect();
-        self.value_only = true;
-        self.effect_chain(&chain, 1);
-        self.value_only = false;
+        self.effect_chain(&chain, 1, Evaluation::ValueOnly);
         for (e, offset) in stored {
             let info = &c.effects[e.index()];
             for (j, word) in pack_words(&self.effect_name(e), &info.ty).iter().enumerate() {
@@ -220,7 +218,7 @@ impl Writer<'_, '_, '_> {
                 let name = self.effect_name(e);
                 self.line(1, format!("let {name} = mrsl_at_{}(mrsl_pos);", info.name));
             } else {
-                self.effect_chain(&[e], 1);
+                self.effect_chain(&[e], 1, Evaluation::Kernel);
             }
         }
     }

@@ -12,6 +12,7 @@ use crate::check::{Callee, Checked, LocalId, Symbol, UniformKind};
 use crate::syntax::ast::*;
 use crate::types::{Scalar, Type};
 use mrsl_abi::{KernelKind, entry};
+use std::collections::HashSet;
 
 /// The WGSL name of a user identifier: the name itself where WGSL takes it
 /// and nothing generated can be called so, else an escaped form. Distinct
@@ -95,7 +96,7 @@ impl Writer<'_, '_, '_> {
             }
         }
         for s in &f.body.stmts {
-            self.stmt(s, 1);
+            self.stmt(s, 1, None);
         }
         self.line(0, "}");
         self.line(0, "");
@@ -145,8 +146,11 @@ impl Writer<'_, '_, '_> {
         }
     }
 
-    pub(super) fn stmt(&mut self, s: &Stmt, indent: usize) {
-        if self.skipped.is_some_and(|skipped| skipped.contains(&s.id)) {
+    /// Writes statement `s`, unless it is in `skipped` (the statements a
+    /// value-only function leaves out, [`Writer::eval_function`]), and its
+    /// sub-statements that are not.
+    pub(super) fn stmt(&mut self, s: &Stmt, indent: usize, skipped: Option<&HashSet<NodeId>>) {
+        if skipped.is_some_and(|skipped| skipped.contains(&s.id)) {
             return;
         }
         let c = self.checked();
@@ -178,10 +182,10 @@ impl Writer<'_, '_, '_> {
             StmtKind::If { cond, then, otherwise } => {
                 let cond = self.expr(cond, Mode::Body);
                 self.line(indent, format!("if ({cond}) {{"));
-                self.body(then, indent + 1);
+                self.body(then, indent + 1, skipped);
                 if let Some(o) = otherwise {
                     self.line(indent, "} else {");
-                    self.body(o, indent + 1);
+                    self.body(o, indent + 1, skipped);
                 }
                 self.line(indent, "}");
             }
@@ -190,13 +194,13 @@ impl Writer<'_, '_, '_> {
                 let cond = cond.as_ref().map(|x| self.expr(x, Mode::Body)).unwrap_or_default();
                 let step = step.as_ref().map(|st| self.simple_stmt(st)).unwrap_or_default();
                 self.line(indent, format!("for ({init}; {cond}; {step}) {{"));
-                self.body(body, indent + 1);
+                self.body(body, indent + 1, skipped);
                 self.line(indent, "}");
             }
             StmtKind::Block(b) => {
                 self.line(indent, "{");
                 for s in &b.stmts {
-                    self.stmt(s, indent + 1);
+                    self.stmt(s, indent + 1, skipped);
                 }
                 self.line(indent, "}");
             }
@@ -211,15 +215,15 @@ impl Writer<'_, '_, '_> {
         }
     }
 
-    fn body(&mut self, s: &Stmt, indent: usize) {
+    fn body(&mut self, s: &Stmt, indent: usize, skipped: Option<&HashSet<NodeId>>) {
         // A branch or loop body left out of a value-only function as a
         // whole: its statements are not in the skipped set themselves.
-        if self.skipped.is_some_and(|skipped| skipped.contains(&s.id)) {
+        if skipped.is_some_and(|skipped| skipped.contains(&s.id)) {
             return;
         }
         match &s.kind {
-            StmtKind::Block(b) => b.stmts.iter().for_each(|s| self.stmt(s, indent)),
-            _ => self.stmt(s, indent),
+            StmtKind::Block(b) => b.stmts.iter().for_each(|s| self.stmt(s, indent, skipped)),
+            _ => self.stmt(s, indent, skipped),
         }
     }
 

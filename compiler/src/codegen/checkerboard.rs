@@ -7,6 +7,7 @@
 //! evaluates the fine effects and outputs.
 
 use super::Writer;
+use super::effects::Evaluation;
 use super::records::{axis_neighbours, neighbours};
 use super::writer::cut;
 use crate::types::{Scalar, Type};
@@ -41,7 +42,7 @@ impl Writer<'_, '_, '_> {
             ],
         );
         for &e in &coarse {
-            self.effect_chain(&[e], 1);
+            self.effect_chain(&[e], 1, Evaluation::Kernel);
             let info = &c.effects[e.index()];
             self.line(1, format!("mrsl_hput_{}(mrsl_pos, {});", info.name, self.effect_name(e)));
         }
@@ -81,7 +82,7 @@ impl Writer<'_, '_, '_> {
         let [head, stats, end] = cut(include_str!("templates/checkerboard_final.wgsl"), &["STATS", "COUNTS"]);
         let [value, evaluated] = cut(include_str!("templates/checkerboard_value.wgsl"), &["EVALUATE"]);
         self.record_final(
-            |w| {
+            |w, _| {
                 w.template(0, head, &[]);
                 if coarse > 0 {
                     let all = if coarse >= 32 { u32::MAX } else { (1u32 << coarse) - 1 };
@@ -97,7 +98,7 @@ impl Writer<'_, '_, '_> {
                 let (var, ty) = (w.effect_name(e), info.ty.wgsl());
                 let values: [(&str, &dyn Display); 3] = [("VAR", &var), ("TYPE", &ty), ("NAME", &info.name)];
                 w.template(indent, value, &values);
-                w.evaluate(e, indent + 1, "");
+                w.evaluate(e, indent + 1, "", Evaluation::Kernel);
                 w.template(indent, evaluated, &values);
             },
         );

@@ -22,6 +22,7 @@
 //! [`MAX_COMPACTION_BYTES`] keeps the uncompacted entry point.
 
 use super::Writer;
+use super::effects::Evaluation;
 use crate::check::EffectId;
 use crate::syntax::ast::Rate;
 use crate::types::Type;
@@ -121,7 +122,7 @@ impl Writer<'_, '_, '_> {
             for (d, _) in self.checked().effects[e.index()].deps.clone() {
                 self.compacted_value(d, 2, "mrsl_q");
             }
-            self.evaluate(e, 2, "let ");
+            self.evaluate(e, 2, "let ", Evaluation::Kernel);
             self.line(2, format!("mrsl_cv_{name}[mrsl_q] = {};", self.effect_name(e)));
             self.line(1, "}");
             self.line(1, "workgroupBarrier();");
@@ -134,7 +135,7 @@ impl Writer<'_, '_, '_> {
             if self.checked().effects[e.index()].rate == Rate::Coarse {
                 self.compacted_value(e, 2, "mrsl_li");
             } else {
-                self.evaluate(e, 2, "let ");
+                self.evaluate(e, 2, "let ", Evaluation::Kernel);
             }
         }
         self.output_stores(&order, 2);

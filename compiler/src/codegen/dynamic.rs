@@ -8,6 +8,7 @@
 
 use super::Writer;
 use super::block::{corners_differ, sample_grid};
+use super::effects::Evaluation;
 use super::fine::Level;
 use super::writer::cut;
 use crate::check::EffectId;
@@ -131,7 +132,7 @@ impl Writer<'_, '_, '_> {
     /// A coarse effect in `dynamic_fine_main`, into its declared variable:
     /// resampled from the outer level unless refined there, else from the
     /// inner level unless refined there, else evaluated.
-    pub(super) fn dynamic_coarse_value(&mut self, e: EffectId, indent: usize) {
+    pub(super) fn dynamic_coarse_value(&mut self, e: EffectId, indent: usize, how: Evaluation) {
         let info = &self.checked().effects[e.index()];
         let (index, name) = (self.coarse_index[&e], self.effect_name(e));
         if self.i.interface.is_passed(e) {
@@ -143,7 +144,7 @@ impl Writer<'_, '_, '_> {
         } else {
             self.line(indent, format!("if (mrsl_is_refined(mrsl_b2, {index}u)) {{"));
         }
-        self.evaluate(e, indent + 1, "");
+        self.evaluate(e, indent + 1, "", how);
         self.line(indent, "}");
     }
 }

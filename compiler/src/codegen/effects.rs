@@ -51,6 +51,18 @@ impl Key<'_> {
     }
 }
 
+/// What an evaluation does with the refine flags of the effects it evaluates.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Evaluation {
+    /// What the kernel does: an effect that can refine sets its flag where
+    /// the kernel reads them ([`Writer::keeps_refine_flags`]), and is
+    /// evaluated for its value alone (`mrsl_val_<effect>`) where it does not.
+    Kernel,
+    /// For the value alone, the flags discarded: the neighbour evaluations
+    /// (`mrsl_at_<effect>`, `coarse_neighbours`).
+    ValueOnly,
+}
+
 impl<'b> Writer<'_, '_, 'b> {
     /// The discontinuity keys that concern any of `effects` (those they read,
     /// directly or through other effects: `EffectGraph::keys`), in
@@ -203,9 +215,9 @@ impl<'b> Writer<'_, '_, 'b> {
         format!("fn mrsl_{prefix}_{}({}) -> {}", info.name, params.join(", "), info.ty.wgsl())
     }
 
-    /// Inputs an effect body reads directly (outside the statements the
-    /// function being written leaves out).
-    fn inputs_read(&self, decl: &EffectDecl) -> BTreeSet<usize> {
+    /// Inputs an effect body reads directly, outside the statements in
+    /// `skipped` (those a value-only function leaves out).
+    fn inputs_read(&self, decl: &EffectDecl, skipped: Option<&HashSet<NodeId>>) -> BTreeSet<usize> {
         let c = self.checked();
         let mut read = BTreeSet::new();
         let mut visit = |e: &Expr| {
@@ -217,7 +229,7 @@ impl<'b> Writer<'_, '_, 'b> {
         };
         match &decl.body {
             EffectBody::Expr(e) => visit(e),
-            EffectBody::Block(b) => match self.skipped {
+            EffectBody::Block(b) => match skipped {
                 None => b.stmts.iter().for_each(|s| visit_stmt_exprs(s, &mut visit)),
                 Some(skipped) => b.stmts.iter().for_each(|s| visit_kept_exprs(s, skipped, &mut visit)),
             },
@@ -281,8 +293,9 @@ impl<'b> Writer<'_, '_, 'b> {
         let c = self.checked();
         let info = &c.effects[e.index()];
         let decl = c.effect_decl(e);
+        // The statements a value-only function leaves out.
+        let skipped = if value_only { self.i.deriv.value_skips.get(&e) } else { None };
         if value_only {
-            self.skipped = self.i.deriv.value_skips.get(&e);
             self.line(
                 0,
                 format!("// `{}`'s value alone, without the statements that only decide its refine flag", info.name),
@@ -297,7 +310,7 @@ impl<'b> Writer<'_, '_, 'b> {
         }
         let sig = self.eval_signature(e, value_only);
         self.line(0, format!("{sig} {{"));
-        for i in self.inputs_read(decl) {
+        for i in self.inputs_read(decl, skipped) {
             let name = &c.inputs[i].name;
             self.line(1, format!("let {} = mrsl_load_{name}(mrsl_pos);", wgsl_ident(name)));
         }
@@ -312,7 +325,7 @@ impl<'b> Writer<'_, '_, 'b> {
                 self.line(1, format!("var {name}: {};", info.ty.wgsl()));
                 self.line(1, "{");
                 for s in &b.stmts {
-                    self.stmt(s, 2);
+                    self.stmt(s, 2, skipped);
                 }
                 self.line(1, "}");
                 self.line(1, format!("return {name};"));
@@ -320,7 +333,6 @@ impl<'b> Writer<'_, '_, 'b> {
         }
         self.line(0, "}");
         self.line(0, "");
-        self.skipped = None;
     }
 
     // ---- Derivatives and values at other positions ------------------------------
@@ -479,9 +491,7 @@ impl<'b> Writer<'_, '_, 'b> {
             if coarse {
                 self.resolve_preamble(1, &resolver);
             }
-            self.value_only = true;
-            self.effect_chain(&chain, 1);
-            self.value_only = false;
+            self.effect_chain(&chain, 1, Evaluation::ValueOnly);
             self.line(1, format!("return {};", self.effect_name(e)));
             self.line(0, "}");
             self.line(0, "");
@@ -491,35 +501,41 @@ impl<'b> Writer<'_, '_, 'b> {
     // ---- Evaluating effects ----------------------------------------------------------
 
     /// Computes `effects` (in dependency order) into locals named after them:
-    /// evaluated, except coarse effects in the fine kernels, which may be resampled.
-    pub(super) fn effect_chain(&mut self, effects: &[EffectId], indent: usize) {
+    /// evaluated (as `how` says), except coarse effects in the fine kernels,
+    /// which may be resampled.
+    pub(super) fn effect_chain(&mut self, effects: &[EffectId], indent: usize, how: Evaluation) {
         let c = self.checked();
         for &e in effects {
             if self.kind.is_fine() && c.effects[e.index()].rate == Rate::Coarse {
-                self.resolved_coarse_value(e, indent);
+                self.resolved_coarse_value(e, indent, how);
             } else {
-                self.evaluate(e, indent, "let ");
+                self.evaluate(e, indent, "let ", how);
             }
         }
     }
 
     /// Evaluates effect `e` at `mrsl_pos` into `{declare}{name}` (`declare`
     /// is `"let "`, or empty for a variable already declared), declaring its
-    /// refine flag first if it has one.
-    /// In the neighbour functions (`value_only`) and in kernels that discard
-    /// refine flags, an effect that can refine is evaluated by
-    /// `mrsl_val_<effect>`, with no flag.
-    pub(super) fn evaluate(&mut self, e: EffectId, indent: usize, declare: &str) {
-        self.evaluate_at(e, indent, declare, "mrsl_pos", "");
+    /// refine flag first if it has one and `how` keeps it ([`Evaluation`]).
+    pub(super) fn evaluate(&mut self, e: EffectId, indent: usize, declare: &str, how: Evaluation) {
+        self.evaluate_at(e, indent, declare, "mrsl_pos", "", how);
     }
 
     /// [`Self::evaluate`] at position `pos`, with the values of `e` and of
     /// its dependencies named `{prefix}{name}` (the block fine kernel's
     /// per-pixel values, `mrsl_v<k>_<effect>`).
-    pub(super) fn evaluate_at(&mut self, e: EffectId, indent: usize, declare: &str, pos: &str, prefix: &str) {
+    pub(super) fn evaluate_at(
+        &mut self,
+        e: EffectId,
+        indent: usize,
+        declare: &str,
+        pos: &str,
+        prefix: &str,
+        how: Evaluation,
+    ) {
         let info = &self.checked().effects[e.index()];
         let mut args = vec![pos.to_string()];
-        let function = if info.has_refine && (self.value_only || !self.keeps_refine_flags()) {
+        let function = if info.has_refine && (how == Evaluation::ValueOnly || !self.keeps_refine_flags()) {
             "val"
         } else {
             if info.has_refine {

@@ -9,6 +9,8 @@
 //! in [`super::block`] and [`super::rate`].
 
 use super::Writer;
+use super::effects::Evaluation;
+use super::pixel::Scope;
 use super::words::{bit, test_bit, unpack_words};
 use super::writer::cut;
 use crate::check::EffectId;
@@ -372,14 +374,11 @@ impl<'b> Writer<'_, '_, 'b> {
     /// `mrsl_pos` in the fine kernels; nothing elsewhere. `name` is the suffix
     /// of a neighbour function's own resolvers (`mrsl_resolve_<effect>`), or empty.
     pub(super) fn resolve_preamble(&mut self, indent: usize, name: &str) {
-        if self.pixels_resolved {
-            return;
-        }
         if self.preloads_corners() {
-            // The entry point loads its lane's corners once; elsewhere each position loads its own.
-            if !self.corners_loaded {
-                self.line(indent, "let mrsl_c = mrsl_corners(mrsl_pos);");
-            }
+            // Where the entry point loaded its lane's corners, it resolved its
+            // pixels too ([`Writer::effect_major_pixels`]); a position resolved
+            // here (a neighbour function's, a compacted pixel's) loads its own.
+            self.line(indent, "let mrsl_c = mrsl_corners(mrsl_pos);");
             self.line(indent, format!("let mrsl_b = mrsl_resolve{name}(mrsl_pos, mrsl_c);"));
         } else if self.kind.is_fine() {
             self.line(indent, format!("let mrsl_b = mrsl_resolve{name}(mrsl_pos);"));
@@ -391,15 +390,15 @@ impl<'b> Writer<'_, '_, 'b> {
 
     /// A coarse effect in a fine kernel: evaluated where it is refined,
     /// resampled elsewhere (when it is passed).
-    pub(super) fn resolved_coarse_value(&mut self, e: EffectId, indent: usize) {
+    pub(super) fn resolved_coarse_value(&mut self, e: EffectId, indent: usize, how: Evaluation) {
         let info = &self.checked().effects[e.index()];
         let (index, name) = (self.coarse_index[&e], self.effect_name(e));
         self.line(indent, format!("var {name}: {};", info.ty.wgsl()));
         if self.kind == KernelKind::DynamicFine {
-            return self.dynamic_coarse_value(e, indent);
+            return self.dynamic_coarse_value(e, indent, how);
         }
         self.line(indent, format!("if (mrsl_is_refined(mrsl_b, {index}u)) {{"));
-        self.evaluate(e, indent + 1, "");
+        self.evaluate(e, indent + 1, "", how);
         if self.i.interface.is_passed(e) {
             self.line(indent, "} else {");
             let corners = if self.preloads_corners() { ", mrsl_c" } else { "" };
@@ -409,18 +408,20 @@ impl<'b> Writer<'_, '_, 'b> {
     }
 
     /// The fine kernels' `main` after `mrsl_tile_pixel`: the pixel's
-    /// prologue resolves it (where the entry point has not) and, with
+    /// prologue resolves it (where the entry point has not: [`Scope`]) and, with
     /// statistics on, writes the rate image and counts the coarse effects
     /// it re-evaluates; then the effects (see [`Writer::pixel_main`]).
     pub(super) fn fine_main(&mut self) {
         let counted = self.counts_stats();
         let coarse = self.coarse_live().len();
         self.pixel_main(
-            |w| {
+            |w, scope| {
                 if !counted {
                     return;
                 }
-                w.resolve_preamble(2, "");
+                if scope == Scope::Position {
+                    w.resolve_preamble(2, "");
+                }
                 // `mrsl_last` holds the innermost level: effects refined there are evaluated per pixel.
                 let (last, from_inner) = if w.kind == KernelKind::DynamicFine {
                     ("mrsl_b2", "mrsl_b.refined0 & ~mrsl_b2.refined0")
@@ -434,7 +435,7 @@ impl<'b> Writer<'_, '_, 'b> {
                 }
                 w.line(2, "}");
             },
-            |w, e, indent| w.effect_chain(&[e], indent),
+            |w, e, indent| w.effect_chain(&[e], indent, Evaluation::Kernel),
         );
     }
 }

@@ -10,6 +10,7 @@
 //! too: they come from `mrsl_abi::geometry`.
 
 use super::Writer;
+use super::effects::Evaluation;
 use super::records::{axis_neighbours, diagonal_neighbours, neighbours};
 use super::words::bit;
 use super::writer::cut;
@@ -131,7 +132,7 @@ impl Writer<'_, '_, '_> {
         let flag_words = self.i.layout.hierarchical.flag_words;
         let coarse = self.coarse_live().len();
         self.record_final(
-            |w| {
+            |w, _| {
                 if coarse == 0 {
                     return;
                 }
@@ -188,7 +189,7 @@ impl Writer<'_, '_, '_> {
             let values: [(&str, &dyn Display); 5] =
                 [("VAR", &var), ("TYPE", &ty), ("WORD", &word), ("MASK", &mask), ("NAME", &info.name)];
             self.template(1, evaluate, &values);
-            self.evaluate(e, 2, "");
+            self.evaluate(e, 2, "", Evaluation::Kernel);
             self.template(1, flag, &values);
             self.set_refine_flag(e, 2);
             self.template(1, read, &values);

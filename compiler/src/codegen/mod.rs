@@ -66,7 +66,6 @@ use crate::check::{Checked, EffectId, FunctionId};
 use crate::deriv::DerivInfo;
 use crate::graph::EffectGraph;
 use crate::interface::Interface;
-use crate::syntax::ast::NodeId;
 use crate::syntax::ast::{Rate, Span};
 use body::{Mode, wgsl_ident};
 use mrsl_abi::geometry::{
@@ -74,7 +73,7 @@ use mrsl_abi::geometry::{
 };
 use mrsl_abi::{KernelKind, Layout};
 use std::cell::RefCell;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 use writer::{Code, Values};
 
 /// Everything the writer reads.
@@ -150,18 +149,6 @@ struct Writer<'i, 'a, 'b> {
     code: Code,
     /// Live coarse effects, numbered for refine masks, statistics counters and records.
     coarse_index: HashMap<EffectId, u32>,
-    /// While writing a value-only function (`mrsl_val_<effect>`): the body's
-    /// statements it leaves out.
-    skipped: Option<&'i HashSet<NodeId>>,
-    /// While writing the neighbour functions: effects are evaluated for their
-    /// value alone, with `mrsl_val_<effect>` where the effect can refine.
-    value_only: bool,
-    /// While writing the block fine kernel's entry point: `mrsl_c`, the
-    /// corners of the lane's block (`mrsl_corners`), is in scope.
-    corners_loaded: bool,
-    /// While writing the block fine kernel's statistics for one of its
-    /// pixels: `mrsl_b`, the pixel's resolved block, is in scope.
-    pixels_resolved: bool,
 }
 
 impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
@@ -174,17 +161,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             .enumerate()
             .map(|(k, e)| (*e, k as u32))
             .collect();
-        Writer {
-            i,
-            kind,
-            block,
-            code: Code::default(),
-            coarse_index,
-            skipped: None,
-            value_only: false,
-            corners_loaded: false,
-            pixels_resolved: false,
-        }
+        Writer { i, kind, block, code: Code::default(), coarse_index }
     }
 
     fn checked(&self) -> &'b Checked<'a> {

@@ -4,6 +4,7 @@
 //! stores, and the per-workgroup statistics that must all reach a barrier.
 
 use super::Writer;
+use super::effects::Evaluation;
 use super::writer::cut;
 use crate::check::EffectId;
 use crate::syntax::ast::Rate;
@@ -14,6 +15,16 @@ use mrsl_abi::geometry::{FINE_PIXELS_PER_LANE, TILE};
 /// The condition of the instrumentation a dispatch runs only with statistics
 /// on (control field `statistics`): the rate image and the counters.
 pub(super) const STATISTICS_ON: &str = "mrsl_ctl.statistics != 0u";
+
+/// What a per-pixel prologue ([`Writer::pixel_main`]) finds in scope besides `mrsl_pos`.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Scope {
+    /// Nothing more: a fine kernel's prologue resolves the pixel.
+    Position,
+    /// `mrsl_b` (in the dynamic mode also `mrsl_b2`), the pixel's blocks,
+    /// which the entry point resolved for its lane's pixels ([`Writer::effect_major_pixels`]).
+    Resolved,
+}
 
 impl Writer<'_, '_, '_> {
     /// Whether the kernel counts per-pixel re-evaluations of coarse effects
@@ -101,7 +112,7 @@ impl Writer<'_, '_, '_> {
     /// docs/evaluation.md.)
     pub(super) fn pixel_main(
         &mut self,
-        mut prologue: impl FnMut(&mut Self),
+        mut prologue: impl FnMut(&mut Self, Scope),
         mut coarse: impl FnMut(&mut Self, EffectId, usize),
     ) {
         let [x, y, z] = self.kind.workgroup_size();
@@ -153,16 +164,16 @@ impl Writer<'_, '_, '_> {
     fn pixel_body(
         &mut self,
         indent: usize,
-        prologue: &mut impl FnMut(&mut Self),
+        prologue: &mut impl FnMut(&mut Self, Scope),
         coarse: &mut impl FnMut(&mut Self, EffectId, usize),
     ) {
-        prologue(self);
+        prologue(self, Scope::Position);
         let order = self.i.graph.order.clone();
         for &e in &order {
             if self.checked().effects[e.index()].rate == Rate::Coarse {
                 coarse(self, e, indent);
             } else {
-                self.evaluate(e, indent, "let ");
+                self.evaluate(e, indent, "let ", Evaluation::Kernel);
             }
         }
         self.output_stores(&order, indent);
@@ -223,7 +234,7 @@ impl Writer<'_, '_, '_> {
     /// is refined; the loop costs one per lane, and where a lane refines one
     /// pixel of its two it runs the evaluation once, not twice (ablation
     /// "nothing refined at run time", docs/evaluation.md).
-    fn effect_major_pixels(&mut self, prologue: &mut impl FnMut(&mut Self)) {
+    fn effect_major_pixels(&mut self, prologue: &mut impl FnMut(&mut Self, Scope)) {
         let pixels: Vec<u32> = (0..FINE_PIXELS_PER_LANE).collect();
         // The dynamic mode: the innermost level a pixel refined to
         // (`mrsl_inner<k>`), whose refined effects it evaluates.
@@ -232,7 +243,6 @@ impl Writer<'_, '_, '_> {
         // A lane past the image's edge still loads (clamped) corners and
         // resolves; its pixels' statistics and stores are skipped below.
         self.line(1, "let mrsl_c = mrsl_corners(min(mrsl_first, mrsl_grid() - vec2<i32>(1)));");
-        self.corners_loaded = true;
         for &k in &pixels {
             self.line(1, format!("let mrsl_pos{k} = {};", self.lane_pixel(k)));
             self.line(1, format!("let mrsl_in{k} = all(mrsl_pos{k} < mrsl_grid());"));
@@ -242,7 +252,6 @@ impl Writer<'_, '_, '_> {
                 self.resolve_inner(1, "", names.each_ref().map(String::as_str));
             }
         }
-        self.pixels_resolved = true;
         for &k in &pixels {
             self.line(1, format!("if (mrsl_in{k}) {{"));
             self.line(2, format!("let mrsl_pos = mrsl_pos{k};"));
@@ -250,10 +259,9 @@ impl Writer<'_, '_, '_> {
             if dynamic {
                 self.line(2, format!("let mrsl_b2 = mrsl_inner{k};"));
             }
-            prologue(self);
+            prologue(self, Scope::Resolved);
             self.line(1, "}");
         }
-        self.pixels_resolved = false;
         let c = self.checked();
         let order = self.i.graph.order.clone();
         for &e in &order {
@@ -261,7 +269,8 @@ impl Writer<'_, '_, '_> {
             let name = self.effect_name(e);
             if info.rate != Rate::Coarse {
                 for &k in &pixels {
-                    self.evaluate_at(e, 1, "let ", &format!("mrsl_pos{k}"), &format!("mrsl_v{k}_"));
+                    let (pos, prefix) = (format!("mrsl_pos{k}"), format!("mrsl_v{k}_"));
+                    self.evaluate_at(e, 1, "let ", &pos, &prefix, Evaluation::Kernel);
                 }
                 continue;
             }
@@ -304,7 +313,7 @@ impl Writer<'_, '_, '_> {
                     self.line(2, format!("if (mrsl_k == {k}u) {{ {local} = {}; }}", at(k)));
                 }
             }
-            self.evaluate(e, 2, "let ");
+            self.evaluate(e, 2, "let ", Evaluation::Kernel);
             for &k in &pixels {
                 self.line(2, format!("if (mrsl_k == {k}u) {{ mrsl_v{k}_{name} = {name}; }}"));
             }
@@ -315,7 +324,6 @@ impl Writer<'_, '_, '_> {
             self.output_stores_at(&order, 2, &format!("mrsl_pos{k}"), &format!("mrsl_v{k}_"));
             self.line(1, "}");
         }
-        self.corners_loaded = false;
     }
 }
 

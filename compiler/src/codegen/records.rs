@@ -7,6 +7,7 @@
 //! opposite pairs, only complete pairs used) and the final pass.
 
 use super::Writer;
+use super::pixel::Scope;
 use super::words::{pack_words, unpack_with};
 use super::writer::cut;
 use crate::check::EffectId;
@@ -83,7 +84,7 @@ impl Writer<'_, '_, '_> {
     /// the others evaluated, then the outputs (see [`Writer::pixel_main`]).
     pub(super) fn record_final(
         &mut self,
-        prologue: impl FnMut(&mut Self),
+        prologue: impl FnMut(&mut Self, Scope),
         coarse: impl FnMut(&mut Self, EffectId, usize),
     ) {
         self.tile_pixel_rows();
