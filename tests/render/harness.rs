@@ -13,7 +13,10 @@ pub fn gpu(gpu_tests: usize) -> Option<&'static Gpu> {
     static GPU: OnceLock<Option<Gpu>> = OnceLock::new();
     locate_sponza();
     let gpu = GPU.get_or_init(|| match Gpu::new() {
-        Ok(gpu) => Some(gpu),
+        Ok(gpu) => {
+            println!("render tests on {}", describe_adapter(&gpu.adapter_info));
+            Some(gpu)
+        }
         Err(e) if std::env::var("CI").is_ok_and(|v| v == "true") => panic!("CI=true but no GPU adapter: {e}"),
         Err(e) => {
             println!(
@@ -24,6 +27,26 @@ pub fn gpu(gpu_tests: usize) -> Option<&'static Gpu> {
         }
     });
     gpu.as_ref()
+}
+
+/// The device for a run that must have one (the second-driver subset): a
+/// missing adapter is a failure wherever it runs.
+pub fn gpu_or_fail() -> &'static Gpu {
+    static GPU: OnceLock<Gpu> = OnceLock::new();
+    locate_sponza();
+    GPU.get_or_init(|| {
+        let gpu = Gpu::new().unwrap_or_else(|e| panic!("the requested driver gives no adapter: {e}"));
+        println!("render tests on {}", describe_adapter(&gpu.adapter_info));
+        gpu
+    })
+}
+
+/// The adapter's name, driver and backend, as the test output names it.
+fn describe_adapter(info: &wgpu::AdapterInfo) -> String {
+    match info.driver_info.as_str() {
+        "" => format!("{} ({:?})", info.name, info.backend),
+        driver => format!("{} ({driver}, {:?})", info.name, info.backend),
+    }
 }
 
 /// The Sponza model's path, as cargo unpacked the `obj-rs` 0.7.4 package

@@ -15,6 +15,7 @@ mod frames;
 mod modes;
 mod rate_image;
 mod rate_source;
+mod second_driver;
 mod sponza;
 mod textures;
 
@@ -130,6 +131,9 @@ fn main() {
     // SAFETY: no other thread exists yet.
     unsafe { mrsl_lab::runtime_dir::ensure_xdg_runtime_dir() };
     let args = Arguments::from_args();
+    if std::env::var_os(second_driver::SUBSET_VARIABLE).is_some() {
+        return second_driver_subset(&args);
+    }
     let gpu = harness::gpu(GPU_TESTS.len() + rate_source::GPU_TESTS.len() + DUNGEON_TESTS.len());
     let dungeon = mrsl_lab::mesh::dungeon_path();
     if let (Some(_), Err(e)) = (gpu, &dungeon) {
@@ -159,5 +163,45 @@ fn main() {
             Ok(())
         })
     }));
+    trials.push(second_driver_trial(gpu.is_some()));
     libtest_mimic::run(&args, trials).exit();
+}
+
+/// The subset of the GPU tests that runs again on SwiftShader, in a child
+/// process ([`second_driver`]); skipped visibly where SwiftShader is not
+/// installed, a failure under `CI=true`.
+fn second_driver_trial(has_gpu: bool) -> Trial {
+    const NAME: &str = "second_driver::subset_on_swiftshader";
+    match second_driver::swiftshader_icd() {
+        Ok(icd) if has_gpu => Trial::test(NAME, move || {
+            second_driver::subset_on_swiftshader(&icd);
+            Ok(())
+        }),
+        Err(e) if std::env::var("CI").is_ok_and(|v| v == "true") => {
+            Trial::test(NAME, move || Err(format!("CI=true but {e}").into()))
+        }
+        Err(e) => {
+            println!("SKIPPING {NAME} (reported as ignored below): {e}");
+            Trial::test(NAME, || Ok(())).with_ignored_flag(true)
+        }
+        Ok(_) => Trial::test(NAME, || Ok(())).with_ignored_flag(true),
+    }
+}
+
+/// In the child of [`second_driver_trial`]: the subset alone, on the adapter
+/// `VK_ICD_FILENAMES` leaves (a missing one is a failure: it was asked for).
+fn second_driver_subset(args: &Arguments) {
+    let gpu = harness::gpu_or_fail();
+    let all = GPU_TESTS.iter().chain(rate_source::GPU_TESTS);
+    let trials: Vec<Trial> = all
+        .filter(|(name, _)| second_driver::SUBSET.contains(name))
+        .map(|&(name, test)| {
+            Trial::test(format!("{name} (second driver)"), move || {
+                test(gpu);
+                Ok(())
+            })
+        })
+        .collect();
+    assert_eq!(trials.len(), second_driver::SUBSET.len(), "every test of the subset exists");
+    libtest_mimic::run(args, trials).exit();
 }
