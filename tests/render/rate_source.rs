@@ -26,6 +26,10 @@ pub const GPU_TESTS: &[crate::GpuTest] = &[
     ("rate_source::motion_lowers_the_rate_by_the_velocity_terms", motion_lowers_the_rate_by_the_velocity_terms),
     ("rate_source::weber_fechner_is_more_conservative_in_the_dark", weber_fechner_is_more_conservative_in_the_dark),
     ("rate_source::half_float_inputs_are_read_alike", half_float_inputs_are_read_alike),
+    (
+        "rate_source::one_and_two_channel_inputs_are_read_as_their_luminance",
+        one_and_two_channel_inputs_are_read_as_their_luminance,
+    ),
     ("rate_source::first_frame_and_resizes_are_full_rate", first_frame_and_resizes_are_full_rate),
     (
         "rate_source::hysteresis_stops_an_alternating_input_from_flickering",
@@ -225,6 +229,35 @@ pub fn half_float_inputs_are_read_alike(gpu: &Gpu) {
     assert!(full.iter().collect::<std::collections::BTreeSet<_>>().len() >= 3, "varied rates: {full:?}");
 }
 
+/// A one- or two-channel output (an AO or shadow pass, say) is read as its
+/// luminance: the value itself, or the mean of the two; so a grey frame
+/// given as R32Float, as Rg32Float (the value twice) and as RGBA gets the
+/// same rates.
+pub fn one_and_two_channel_inputs_are_read_as_their_luminance(gpu: &Gpu) {
+    let size = (48, 40);
+    // Flat on the left (4x4), stripes across x on the right (full rate across them).
+    let grey = Frame::grey(size, |x, _| if x < 24 { 0.5 } else { [0.375, 0.625][(x % 2) as usize] });
+    let options = undamped(Preset::Balanced);
+    let rgba = settled(gpu, &grey, None, &options);
+    let value = |c: &[f32; 3]| c[0];
+    let bytes = |values: Vec<f32>| -> Vec<u8> { values.into_iter().flat_map(f32::to_le_bytes).collect() };
+    let one =
+        gpu.texture_with_data("r", size, wgpu::TextureFormat::R32Float, &bytes(grey.rgb.iter().map(value).collect()));
+    let two = gpu.texture_with_data(
+        "rg",
+        size,
+        wgpu::TextureFormat::Rg32Float,
+        &bytes(grey.rgb.iter().flat_map(|c| [value(c); 2]).collect()),
+    );
+    for color in [&one, &two] {
+        let mut source = RateSource::new(&gpu.device).unwrap();
+        frame(gpu, &mut source, &RateInputs::new(color), &options).unwrap();
+        let rates = frame(gpu, &mut source, &RateInputs::new(color), &options).unwrap();
+        assert_eq!(rates, rgba, "{:?}", color.format());
+    }
+    assert!(rgba.iter().collect::<std::collections::BTreeSet<_>>().len() >= 2, "varied rates: {rgba:?}");
+}
+
 pub fn first_frame_and_resizes_are_full_rate(gpu: &Gpu) {
     let mut source = RateSource::new(&gpu.device).unwrap();
     let options = RateOptions::preset(Preset::Performance);
@@ -407,16 +440,14 @@ pub fn bad_inputs_are_typed_errors(gpu: &Gpu) {
         Err(Error::BadTileSize(4))
     );
     assert_eq!(create_rate_image(&gpu.device, size, 12).err(), Some(Error::BadTileSize(12)));
-    // A colour input the source cannot read as linear float RGB.
+    // A colour input the source cannot read as linear float values.
     let unorm = gpu.texture_with_data("unorm", size, F::Rgba8Unorm, &vec![0u8; (size.0 * size.1 * 4) as usize]);
-    assert_eq!(
-        encode(&RateInputs::new(&unorm), &options, &target),
-        Err(Error::RateFormat {
-            what: "the colour input",
-            expected: "Rgba32Float or Rgba16Float",
-            found: F::Rgba8Unorm
-        })
-    );
+    match encode(&RateInputs::new(&unorm), &options, &target) {
+        Err(Error::RateFormat { what: "the colour input", expected, found: F::Rgba8Unorm }) => {
+            assert!(expected.contains("R32Float") && expected.contains("Rgba16Float"), "{expected}")
+        }
+        other => panic!("expected a format error, got {other:?}"),
+    }
     // Motion without a velocity texture; a velocity of the wrong size or format.
     let motion = RateOptions { motion: true, ..options };
     assert_eq!(encode(&RateInputs::new(&color), &motion, &target), Err(Error::MissingVelocity));

@@ -24,7 +24,8 @@ pub(super) struct Params {
     pub gaze: [f32; 2],
     /// The external combiner in bits 0..3, the foveation combiner in bits 4..7.
     pub combiners: u32,
-    pub pad: u32,
+    /// Channels of the colour input (1, 2 or 4): what its luminance is made of.
+    pub color_channels: u32,
 }
 
 /// The fields of [`Params`] in order: name, WGSL type, byte offset.
@@ -41,7 +42,7 @@ const PARAMS_FIELDS: [(&str, &str, usize); 13] = [
     ("fovea_outer", "f32", 44),
     ("gaze", "vec2<f32>", 48),
     ("combiners", "u32", 56),
-    ("pad", "u32", 60),
+    ("color_channels", "u32", 60),
 ];
 
 /// A bit of `Params::flags`; the shader tests them as `FLAG_<NAME>`.
@@ -261,7 +262,7 @@ mod tests {
             offset_of!(Params, fovea_outer),
             offset_of!(Params, gaze),
             offset_of!(Params, combiners),
-            offset_of!(Params, pad),
+            offset_of!(Params, color_channels),
         ];
         let table: Vec<usize> = PARAMS_FIELDS.iter().map(|(.., offset)| *offset).collect();
         assert_eq!(table, offsets);

@@ -185,7 +185,7 @@ impl RateSource {
             fovea_outer: fovea.map_or(0.0, |f| f.outer_radius),
             gaze: fovea.map_or([0.0; 2], |f| f.gaze),
             combiners: inputs.external.map_or(0, |e| e.combiner.code()) | fovea.map_or(0, |f| f.combiner.code()) << 4,
-            pad: 0,
+            color_channels: color_channels(inputs.color.format()).expect("validated"),
         };
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         // A buffer per call rather than `queue.write_buffer`: two frames
@@ -237,16 +237,27 @@ impl RateSource {
     }
 }
 
+/// The colour formats the rate source reads.
+const COLOR_FORMATS: &str =
+    "a float format of one, two or four channels (R32Float, R16Float, Rg32Float, Rg16Float, Rgba32Float, Rgba16Float)";
+
+/// The channels of a colour input the rate source reads, by format.
+fn color_channels(format: wgpu::TextureFormat) -> Option<u32> {
+    use wgpu::TextureFormat as F;
+    match format {
+        F::R32Float | F::R16Float => Some(1),
+        F::Rg32Float | F::Rg16Float => Some(2),
+        F::Rgba32Float | F::Rgba16Float => Some(4),
+        _ => None,
+    }
+}
+
 /// Checks the inputs against each other and the options; returns the image size.
 fn validate_inputs(inputs: &RateInputs, options: &RateOptions) -> Result<(u32, u32), Error> {
     use wgpu::TextureFormat as F;
     let color = inputs.color;
-    if !matches!(color.format(), F::Rgba32Float | F::Rgba16Float) {
-        return Err(Error::RateFormat {
-            what: "the colour input",
-            expected: "Rgba32Float or Rgba16Float",
-            found: color.format(),
-        });
+    if color_channels(color.format()).is_none() {
+        return Err(Error::RateFormat { what: "the colour input", expected: COLOR_FORMATS, found: color.format() });
     }
     if !color.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING) {
         return Err(Error::RateUsage { what: "the colour input", missing: "TEXTURE_BINDING" });

@@ -225,8 +225,10 @@ pub struct ExternalRates<'a> {
 /// What one rate computation reads.
 #[derive(Debug, Clone, Copy)]
 pub struct RateInputs<'a> {
-    /// The previous frame's output: linear RGB, `Rgba32Float` or
-    /// `Rgba16Float`, with `TEXTURE_BINDING`. Its size is the image size.
+    /// The previous frame's output, with `TEXTURE_BINDING`; its size is the
+    /// image size. Linear RGB in `Rgba32Float` or `Rgba16Float` (luminance:
+    /// Rec.709), or a one- or two-channel float output (`R32Float`,
+    /// `R16Float`: the value; `Rg32Float`, `Rg16Float`: the mean of the two).
     pub color: &'a wgpu::Texture,
     /// Motion vectors of that frame: current minus previous position in
     /// pixels, `Rg16Float` or `Rg32Float` (or the RGBA float formats: x and

@@ -27,8 +27,21 @@ fn has(flag: u32) -> bool {
     return (params.flags & flag) != 0u;
 }
 
+// The luminance of what the colour input holds: Rec.709 of an RGB(A)
+// colour, the mean of a two-channel one, the value of a one-channel one.
 fn luma(p: vec2<i32>) -> f32 {
-    return dot(textureLoad(color, p, 0).rgb, REC709);
+    let c = textureLoad(color, p, 0);
+    switch params.color_channels {
+        case 1u: {
+            return c.r;
+        }
+        case 2u: {
+            return 0.5 * (c.r + c.g);
+        }
+        default: {
+            return dot(c.rgb, REC709);
+        }
+    }
 }
 
 // The minimum luminance of the 3x3 neighbourhood, clamped to the image
