@@ -11,6 +11,7 @@
 use super::Writer;
 use super::effects::{Evaluation, Key};
 use super::fine::{CORNER_SAMPLES, Corners, LANES, Level, Resolver};
+use super::names::{BLOCK_STRUCT, CORNERS_STRUCT, GID, INTERFACE, NEIGHBOURS, Name, POS, RECORD, SAMPLES, STRIDE};
 use super::words::{pack_words, test_bit, unpack_with};
 use super::writer::{cut, fill};
 use crate::check::{EffectId, InputId};
@@ -84,9 +85,9 @@ impl Writer<'_, '_, '_> {
     /// the kernel) or into the interface buffer.
     fn record_word_store(&self, word: u32, value: &str) -> String {
         if self.writes_record_texels() {
-            format!("mrsl_w{word} = {value};")
+            format!("{} = {value};", Name::RecordWord.of(word))
         } else {
-            format!("mrsl_interface[mrsl_rec + {word}u] = {value};")
+            format!("{INTERFACE}[{RECORD} + {word}u] = {value};")
         }
     }
 
@@ -138,10 +139,7 @@ impl Writer<'_, '_, '_> {
             let info = &c.effects[e.index()];
             for (j, word) in pack_words(&self.effect_name(e), &info.ty).iter().enumerate() {
                 let layer = offset + j as u32;
-                self.line(
-                    1,
-                    format!("textureStore(mrsl_neighbours, mrsl_pos, {layer}, vec4<u32>({word}, 0u, 0u, 0u));"),
-                );
+                self.line(1, format!("textureStore({NEIGHBOURS}, {POS}, {layer}, vec4<u32>({word}, 0u, 0u, 0u));"));
             }
         }
         self.template(0, tail, &[]);
@@ -170,7 +168,7 @@ impl Writer<'_, '_, '_> {
         let record = if self.writes_record_texels() {
             String::new()
         } else {
-            "\n    let mrsl_rec = (mrsl_gid.y * u32(mrsl_n.x) + mrsl_gid.x) * MRSL_STRIDE;".to_string()
+            format!("\n    let {RECORD} = ({GID}.y * u32({SAMPLES}.x) + {GID}.x) * {STRIDE};")
         };
         self.template(
             0,
@@ -190,7 +188,7 @@ impl Writer<'_, '_, '_> {
             // Words are gathered in locals and stored a texel at a time; a word no
             // effect writes here (a shared slot's other effect) is stored as 0.
             for w in 0..self.i.interface.stride {
-                self.line(1, format!("var mrsl_w{w} = 0u;"));
+                self.line(1, format!("var {} = 0u;", Name::RecordWord.of(w)));
             }
         }
         self.coarse_values();
@@ -216,7 +214,7 @@ impl Writer<'_, '_, '_> {
             if stored.contains(&e) && !info.has_refine {
                 // Its value here is what `coarse_neighbours` stored here: the same evaluation.
                 let name = self.effect_name(e);
-                self.line(1, format!("let {name} = mrsl_at_{}(mrsl_pos);", info.name));
+                self.line(1, format!("let {name} = {}({POS});", Name::At.of(&info.name)));
             } else {
                 self.effect_chain(&[e], 1, Evaluation::Kernel);
             }
@@ -235,7 +233,7 @@ impl Writer<'_, '_, '_> {
             self.set_refine_flag(e, 1);
         }
         for w in 0..flag_words {
-            let store = self.record_word_store(w, &format!("mrsl_flags{w}"));
+            let store = self.record_word_store(w, &Name::FlagWord.of(w));
             self.line(1, store);
         }
     }
@@ -255,7 +253,7 @@ impl Writer<'_, '_, '_> {
                 let writes: Vec<String> =
                     words.iter().enumerate().map(|(j, w)| self.record_word_store(slot.offset + j as u32, w)).collect();
                 if slot.effects.len() > 1 {
-                    let cond = self.store_condition(e, &|bit| test_bit("mrsl_flags", bit));
+                    let cond = self.store_condition(e, &|bit| test_bit(Name::FlagWord.prefix(), bit));
                     self.line(1, format!("if ({cond}) {{"));
                     for wline in writes {
                         self.line(2, wline);
@@ -275,9 +273,9 @@ impl Writer<'_, '_, '_> {
         let stride = self.i.interface.stride;
         for layer in 0..stride.div_ceil(4) {
             let words: Vec<String> = (4 * layer..4 * layer + 4)
-                .map(|w| if w < stride { format!("mrsl_w{w}") } else { "0u".to_string() })
+                .map(|w| if w < stride { Name::RecordWord.of(w) } else { "0u".to_string() })
                 .collect();
-            self.line(1, format!("textureStore(mrsl_interface, mrsl_pos, {layer}, vec4<u32>({}));", words.join(", ")));
+            self.line(1, format!("textureStore({INTERFACE}, {POS}, {layer}, vec4<u32>({}));", words.join(", ")));
         }
     }
 
@@ -348,14 +346,14 @@ impl Writer<'_, '_, '_> {
         for key in &keys {
             let name = key.name;
             for (corner, at) in CORNERS.iter().zip(CORNER_PIXELS) {
-                self.line(1, format!("c.{corner}_{name} = mrsl_load_{name}({at});"));
+                self.line(1, format!("c.{corner}_{name} = {}({at});", Name::Load.of(name)));
             }
         }
         // A texel holds four words of a record: one load per corner and texel.
         let texels = ["i0", "vec2<i32>(i1.x, i0.y)", "vec2<i32>(i0.x, i1.y)", "i1"];
         for layer in 0..stride.div_ceil(4) {
             for (corner, at) in TEXELS.iter().zip(texels) {
-                self.line(1, format!("let {corner}_{layer} = textureLoad(mrsl_interface, {at}, {layer}, 0);"));
+                self.line(1, format!("let {corner}_{layer} = textureLoad({INTERFACE}, {at}, {layer}, 0);"));
             }
             for w in 4 * layer..(4 * layer + 4).min(stride) {
                 let lane = LANES[(w % 4) as usize];
@@ -445,9 +443,9 @@ impl Writer<'_, '_, '_> {
         let [head, corners, refined] = cut(include_str!("templates/resolve.wgsl"), &["CORNERS", "REFINED"]);
         let level = r.level;
         let params = match (level.parent, r.corners) {
-            (true, _) => "pos: vec2<i32>, parent: MrslBlock",
-            (false, Corners::Preloaded) => "pos: vec2<i32>, c: MrslCorners",
-            (false, Corners::Loaded) => "pos: vec2<i32>",
+            (true, _) => format!("pos: vec2<i32>, parent: {BLOCK_STRUCT}"),
+            (false, Corners::Preloaded) => format!("pos: vec2<i32>, c: {CORNERS_STRUCT}"),
+            (false, Corners::Loaded) => "pos: vec2<i32>".to_string(),
         };
         if level.parent {
             self.inner_level_note(level.block);
@@ -478,7 +476,7 @@ impl Writer<'_, '_, '_> {
             .zip(CORNER_PIXELS)
             .map(|(corner, pixel)| match r.corners {
                 Corners::Preloaded => format!("c.{corner}_{name}"),
-                Corners::Loaded => format!("mrsl_load_{name}({pixel})"),
+                Corners::Loaded => format!("{}({pixel})", Name::Load.of(name)),
             })
             .collect();
         self.template(
@@ -508,6 +506,7 @@ impl Writer<'_, '_, '_> {
             let (v0, v1, v2, v3) = (corner("x"), corner("y"), corner("z"), corner("w"));
             let ty = s.ty.wgsl();
             let values: &super::writer::Values = &[
+                ("SUFFIX", &level.suffix),
                 ("NAME", &s.name),
                 ("TYPE", &ty),
                 ("V0", &v0),

@@ -7,6 +7,7 @@
 //! are loaded and effects fetched there instead.
 
 use super::Writer;
+use super::names::{Name, POS, REFINE, UNIFORMS};
 use crate::builtins::Builtin;
 use crate::check::{Callee, Checked, LocalId, Symbol, UniformKind};
 use crate::syntax::ast::*;
@@ -45,8 +46,8 @@ pub(super) fn wgsl_ident(name: &str) -> String {
         || name.ends_with("_l")
         || matches!(name, "u" | "pos");
     match (prefixed, suffixed) {
-        (true, true) => format!("mrsl_user_{name}_"),
-        (true, false) => format!("mrsl_user_{name}"),
+        (true, true) => Name::User.of(format!("{name}_")),
+        (true, false) => Name::User.of(name),
         (false, true) => format!("{name}_"),
         (false, false) => name.to_string(),
     }
@@ -139,7 +140,7 @@ impl Writer<'_, '_, '_> {
         for n in self.matrix_select_sizes() {
             let ty = crate::types::Type::Matrix(n).wgsl();
             let columns: Vec<String> = (0..n).map(|k| format!("select(f[{k}], t[{k}], c)")).collect();
-            self.line(0, format!("fn mrsl_select_m{n}(f: {ty}, t: {ty}, c: bool) -> {ty} {{"));
+            self.line(0, format!("fn {}(f: {ty}, t: {ty}, c: bool) -> {ty} {{", Name::SelectMatrix.of(n)));
             self.line(1, format!("return {ty}({});", columns.join(", ")));
             self.line(0, "}");
             self.line(0, "");
@@ -204,7 +205,7 @@ impl Writer<'_, '_, '_> {
                 }
                 self.line(indent, "}");
             }
-            StmtKind::Refine => self.line(indent, "*mrsl_refine = true; // refine"),
+            StmtKind::Refine => self.line(indent, format!("*{REFINE} = true; // refine")),
             StmtKind::Return(Some(v)) => {
                 let v = self.expr(v, Mode::Body);
                 self.line(indent, format!("return {v};"));
@@ -312,7 +313,7 @@ impl Writer<'_, '_, '_> {
                 // selected column by column in a helper (`matrix_selects`),
                 // which, like `select`, evaluates both branches once.
                 match c.ty(e) {
-                    Type::Matrix(n) => format!("mrsl_select_m{n}({y}, {x}, {cond})"),
+                    Type::Matrix(n) => format!("{}({y}, {x}, {cond})", Name::SelectMatrix.of(n)),
                     _ => format!("select({y}, {x}, {cond})"),
                 }
             }
@@ -336,25 +337,25 @@ impl Writer<'_, '_, '_> {
             },
             Some(Symbol::Input(i)) => match mode {
                 Mode::Body => wgsl_ident(name),
-                Mode::Neighbour(_) => format!("mrsl_load_{}(mrsl_pos)", c.inputs[i.index()].name),
+                Mode::Neighbour(_) => format!("{}({POS})", Name::Load.of(&c.inputs[i.index()].name)),
             },
             Some(Symbol::Uniform(u)) => {
                 let info = &c.uniforms[u.index()];
                 match (&info.kind, &info.ty) {
                     (UniformKind::Value { .. }, Type::Scalar(Scalar::Bool)) => {
-                        format!("(mrsl_u.{} != 0u)", wgsl_ident(name))
+                        format!("({UNIFORMS}.{} != 0u)", wgsl_ident(name))
                     }
                     (UniformKind::Value { .. }, Type::Vector(Scalar::Bool, n)) => {
-                        format!("(mrsl_u.{} != vec{n}<u32>(0u))", wgsl_ident(name))
+                        format!("({UNIFORMS}.{} != vec{n}<u32>(0u))", wgsl_ident(name))
                     }
-                    (UniformKind::Value { .. }, _) => format!("mrsl_u.{}", wgsl_ident(name)),
+                    (UniformKind::Value { .. }, _) => format!("{UNIFORMS}.{}", wgsl_ident(name)),
                     _ => wgsl_ident(name),
                 }
             }
             Some(Symbol::Const(_)) => wgsl_ident(name),
             Some(Symbol::Effect(id)) => match mode {
                 Mode::Body => self.effect_name(*id),
-                Mode::Neighbour(_) => format!("mrsl_at_{}(mrsl_pos)", c.effects[id.index()].name),
+                Mode::Neighbour(_) => format!("{}({POS})", Name::At.of(&c.effects[id.index()].name)),
             },
             None => wgsl_ident(name),
         }
@@ -376,7 +377,7 @@ impl Writer<'_, '_, '_> {
             Some(Callee::Builtin(builtin)) if builtin.is_derivative() => {
                 let site_index = self.i.deriv.site_of[&e.id];
                 let site = &self.i.deriv.sites[site_index];
-                let mut call_args = vec!["mrsl_pos".to_string()];
+                let mut call_args = vec![POS.to_string()];
                 call_args.extend(site.params.iter().map(|p| local_name(c, *p)));
                 // The operand here, as this code already computes it (an
                 // effect's or input's local), where that is what the helpers
@@ -385,8 +386,8 @@ impl Writer<'_, '_, '_> {
                     call_args.push(self.expr(site.operand, mode));
                 }
                 let call_args = call_args.join(", ");
-                let dx = format!("mrsl_ddx_{site_index}({call_args})");
-                let dy = format!("mrsl_ddy_{site_index}({call_args})");
+                let dx = format!("{}({call_args})", Name::Ddx.of(site_index));
+                let dy = format!("{}({call_args})", Name::Ddy.of(site_index));
                 match builtin {
                     Builtin::Ddx => dx,
                     Builtin::Ddy => dy,

@@ -8,6 +8,7 @@
 
 use super::Writer;
 use super::effects::Evaluation;
+use super::names::{Name, POS, WORKGROUP_STATS};
 use super::records::{axis_neighbours, neighbours};
 use super::writer::cut;
 use crate::types::{Scalar, Type};
@@ -44,7 +45,7 @@ impl Writer<'_, '_, '_> {
         for &e in &coarse {
             self.effect_chain(&[e], 1, Evaluation::Kernel);
             let info = &c.effects[e.index()];
-            self.line(1, format!("mrsl_hput_{}(mrsl_pos, {});", info.name, self.effect_name(e)));
+            self.line(1, format!("{}({POS}, {});", Name::RecordPut.of(&info.name), self.effect_name(e)));
         }
         self.template(0, end, &[]);
 
@@ -57,7 +58,7 @@ impl Writer<'_, '_, '_> {
             .keys_of(&coarse)
             .iter()
             .map(|key| {
-                let load = |at: &str| format!("mrsl_load_{}({at})", key.name);
+                let load = |at: &str| format!("{}({at})", Name::Load.of(key.name));
                 format!("ok[k] = ok[k] && ({});", key.matches(&load("taps[k]"), &load("p")))
             })
             .collect();
@@ -86,9 +87,9 @@ impl Writer<'_, '_, '_> {
                 w.template(0, head, &[]);
                 if coarse > 0 {
                     let all = if coarse >= 32 { u32::MAX } else { (1u32 << coarse) - 1 };
-                    w.template(0, stats, &[("ALL", &all), ("STATISTICS_ON", &super::pixel::STATISTICS_ON)]);
+                    w.template(0, stats, &[("ALL", &all), ("STATISTICS_ON", &super::pixel::statistics_enabled())]);
                     for k in 0..coarse {
-                        w.line(4, format!("atomicAdd(&mrsl_wg_stats[{k}], 1u);"));
+                        w.line(4, format!("atomicAdd(&{WORKGROUP_STATS}[{k}], 1u);"));
                     }
                     w.template(0, end, &[]);
                 }

@@ -23,6 +23,11 @@
 
 use super::Writer;
 use super::effects::Evaluation;
+use super::fine::Level;
+use super::names::{
+    BLOCK, BLOCK_STRUCT, COMPACT_BLOCKS, COMPACT_COUNTS, COMPACT_LISTS, GRID, IN, IS_REFINED, LANE, LAST_BLOCK, LISTED,
+    LOAD_CORNERS, Name, POS, TILE_PIXEL, WORKGROUP,
+};
 use crate::check::EffectId;
 use crate::syntax::ast::Rate;
 use crate::types::Type;
@@ -69,12 +74,15 @@ impl Writer<'_, '_, '_> {
         let k = coarse.len();
         self.line(0, "// Compaction: per coarse effect, the workgroup's pixels that re-evaluate it (local");
         self.line(0, "// indices), each pixel's block, and the values evaluated for them.");
-        self.line(0, format!("var<workgroup> mrsl_cq_n: array<atomic<u32>, {k}>;"));
-        self.line(0, format!("var<workgroup> mrsl_cq: array<u32, {}>;", k as u32 * wg));
-        self.line(0, format!("var<workgroup> mrsl_cb: array<MrslBlock, {wg}>;"));
+        self.line(0, format!("var<workgroup> {COMPACT_COUNTS}: array<atomic<u32>, {k}>;"));
+        self.line(0, format!("var<workgroup> {COMPACT_LISTS}: array<u32, {}>;", k as u32 * wg));
+        self.line(0, format!("var<workgroup> {COMPACT_BLOCKS}: array<{BLOCK_STRUCT}, {wg}>;"));
         for &e in &coarse {
             let info = &self.checked().effects[e.index()];
-            self.line(0, format!("var<workgroup> mrsl_cv_{}: array<{}, {wg}>;", info.name, info.ty.wgsl()));
+            self.line(
+                0,
+                format!("var<workgroup> {}: array<{}, {wg}>;", Name::CompactValues.of(&info.name), info.ty.wgsl()),
+            );
         }
         self.line(0, "");
         // One pixel per lane, unlike the ordinary fine kernel's pairs.
@@ -82,20 +90,20 @@ impl Writer<'_, '_, '_> {
         self.line(
             0,
             format!(
-                "fn {}(@builtin(workgroup_id) mrsl_wg: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {{",
+                "fn {}(@builtin(workgroup_id) {WORKGROUP}: vec3<u32>, @builtin(local_invocation_index) {LANE}: u32) {{",
                 self.kind.main_entry_point()
             ),
         );
-        self.line(1, "let mrsl_pos = mrsl_tile_pixel(mrsl_wg.xy, mrsl_li);");
-        self.line(1, "let mrsl_in = all(mrsl_pos < mrsl_grid());");
+        self.line(1, format!("let {POS} = {TILE_PIXEL}({WORKGROUP}.xy, {LANE});"));
+        self.line(1, format!("let {IN} = all({POS} < {GRID}());"));
         // 1. Resolve, count, and list the pixel for each coarse effect it re-evaluates.
-        self.line(1, "if (mrsl_in) {");
+        self.line(1, format!("if ({IN}) {{"));
         self.resolve_preamble(2, "");
-        self.line(2, "mrsl_cb[mrsl_li] = mrsl_b;");
+        self.line(2, format!("{COMPACT_BLOCKS}[{LANE}] = {BLOCK};"));
         self.statistics_on(2);
-        self.template(3, include_str!("templates/rate.wgsl"), &[("LAST", &"mrsl_b"), ("FROM_INNER", &"0u")]);
+        self.template(3, include_str!("templates/rate.wgsl"), &[("LAST", &BLOCK), ("FROM_INNER", &"0u")]);
         for j in 0..k {
-            self.count_refined(j, &format!("mrsl_is_refined(mrsl_last, {j}u)"));
+            self.count_refined(j, &format!("{IS_REFINED}({LAST_BLOCK}, {j}u)"));
         }
         self.line(2, "}");
         for &e in &coarse {
@@ -103,7 +111,7 @@ impl Writer<'_, '_, '_> {
             self.line(
                 2,
                 format!(
-                    "if (mrsl_is_refined(mrsl_b, {j}u)) {{ mrsl_cq[{}u + atomicAdd(&mrsl_cq_n[{j}], 1u)] = mrsl_li; }}",
+                    "if ({IS_REFINED}({BLOCK}, {j}u)) {{ {COMPACT_LISTS}[{}u + atomicAdd(&{COMPACT_COUNTS}[{j}], 1u)] = {LANE}; }}",
                     j * wg
                 ),
             );
@@ -115,25 +123,25 @@ impl Writer<'_, '_, '_> {
             let j = self.coarse_index[&e];
             let name = self.checked().effects[e.index()].name.clone();
             self.line(1, format!("// `{name}` where it is re-evaluated, one lane per listed pixel"));
-            self.line(1, format!("if (mrsl_li < atomicLoad(&mrsl_cq_n[{j}])) {{"));
-            self.line(2, format!("let mrsl_q = mrsl_cq[{}u + mrsl_li];", j * wg));
-            self.line(2, "let mrsl_pos = mrsl_tile_pixel(mrsl_wg.xy, mrsl_q);");
-            self.line(2, "let mrsl_b = mrsl_cb[mrsl_q];");
+            self.line(1, format!("if ({LANE} < atomicLoad(&{COMPACT_COUNTS}[{j}])) {{"));
+            self.line(2, format!("let {LISTED} = {COMPACT_LISTS}[{}u + {LANE}];", j * wg));
+            self.line(2, format!("let {POS} = {TILE_PIXEL}({WORKGROUP}.xy, {LISTED});"));
+            self.line(2, format!("let {BLOCK} = {COMPACT_BLOCKS}[{LISTED}];"));
             for (d, _) in self.checked().effects[e.index()].deps.clone() {
-                self.compacted_value(d, 2, "mrsl_q");
+                self.compacted_value(d, 2, LISTED);
             }
             self.evaluate(e, 2, "let ", Evaluation::Kernel);
-            self.line(2, format!("mrsl_cv_{name}[mrsl_q] = {};", self.effect_name(e)));
+            self.line(2, format!("{}[{LISTED}] = {};", Name::CompactValues.of(&name), self.effect_name(e)));
             self.line(1, "}");
             self.line(1, "workgroupBarrier();");
         }
         // 3. Per pixel: coarse values from the workgroup or resampled, then the fine effects.
-        self.line(1, "if (mrsl_in) {");
-        self.line(2, "let mrsl_b = mrsl_cb[mrsl_li];");
+        self.line(1, format!("if ({IN}) {{"));
+        self.line(2, format!("let {BLOCK} = {COMPACT_BLOCKS}[{LANE}];"));
         let order = self.i.graph.order.clone();
         for &e in &order {
             if self.checked().effects[e.index()].rate == Rate::Coarse {
-                self.compacted_value(e, 2, "mrsl_li");
+                self.compacted_value(e, 2, LANE);
             } else {
                 self.evaluate(e, 2, "let ", Evaluation::Kernel);
             }
@@ -143,7 +151,11 @@ impl Writer<'_, '_, '_> {
         self.template(
             0,
             include_str!("templates/stats_flush.wgsl"),
-            &[("COUNTERS", &k), ("WORKGROUP", &PIXEL_WORKGROUP), ("STATISTICS_ON", &super::pixel::STATISTICS_ON)],
+            &[
+                ("COUNTERS", &k),
+                ("WORKGROUP", &PIXEL_WORKGROUP),
+                ("STATISTICS_ON", &super::pixel::statistics_enabled()),
+            ],
         );
         self.line(0, "}");
     }
@@ -155,12 +167,13 @@ impl Writer<'_, '_, '_> {
         let info = &self.checked().effects[e.index()];
         let (j, var) = (self.coarse_index[&e], self.effect_name(e));
         self.line(indent, format!("var {var}: {};", info.ty.wgsl()));
-        self.line(indent, format!("if (mrsl_is_refined(mrsl_b, {j}u)) {{"));
-        self.line(indent + 1, format!("{var} = mrsl_cv_{}[{lane}];", info.name));
+        self.line(indent, format!("if ({IS_REFINED}({BLOCK}, {j}u)) {{"));
+        self.line(indent + 1, format!("{var} = {}[{lane}];", Name::CompactValues.of(&info.name)));
         if self.i.interface.is_passed(e) {
             self.line(indent, "} else {");
             // The corners are not kept across the barriers: each position loads its own again.
-            self.line(indent + 1, format!("{var} = mrsl_resample_{}(mrsl_b, mrsl_corners(mrsl_pos));", info.name));
+            let resample = Name::Resample.within(Level::own(self.block).suffix, &info.name);
+            self.line(indent + 1, format!("{var} = {resample}({BLOCK}, {LOAD_CORNERS}({POS}));"));
         }
         self.line(indent, "}");
     }

@@ -10,6 +10,7 @@ use super::Writer;
 use super::block::{corners_differ, sample_grid};
 use super::effects::Evaluation;
 use super::fine::Level;
+use super::names::{BLOCK, CONTROL, CORNERS, INNER_BLOCK, INTERFACE, INTERFACE2, IS_REFINED, Name, PARENT};
 use super::writer::cut;
 use crate::check::EffectId;
 use mrsl_abi::geometry::{DYNAMIC_INNER_BLOCK, DYNAMIC_OUTER_BLOCK};
@@ -17,10 +18,10 @@ use mrsl_abi::geometry::{DYNAMIC_INNER_BLOCK, DYNAMIC_OUTER_BLOCK};
 impl Level {
     /// The outer level: the ordinary coarse kernel's records.
     pub(super) const DYNAMIC_OUTER: Level =
-        Level { suffix: "", block: DYNAMIC_OUTER_BLOCK, buffer: "mrsl_interface", parent: false };
+        Level { suffix: "", block: DYNAMIC_OUTER_BLOCK, buffer: INTERFACE, parent: false };
     /// The inner level: `dynamic_coarse_main`'s tagged records.
     pub(super) const DYNAMIC_INNER: Level =
-        Level { suffix: "2", block: DYNAMIC_INNER_BLOCK, buffer: "mrsl_interface2", parent: true };
+        Level { suffix: "2", block: DYNAMIC_INNER_BLOCK, buffer: INTERFACE2, parent: true };
 }
 
 impl Writer<'_, '_, '_> {
@@ -61,7 +62,7 @@ impl Writer<'_, '_, '_> {
         let [head, flags, keys] = cut(include_str!("templates/parent_refined.wgsl"), &["FLAGS", "KEYS"]);
         self.template(0, head, &[("GRID", &sample_grid(block)), ("BLOCK", &block)]);
         for layer in 0..iface.flag_words.div_ceil(4) {
-            self.line(3, format!("let t{layer} = textureLoad(mrsl_parent, corners[j], {layer}, 0);"));
+            self.line(3, format!("let t{layer} = textureLoad({PARENT}, corners[j], {layer}, 0);"));
         }
         for w in 0..iface.flag_words {
             let lane = ["x", "y", "z", "w"][(w % 4) as usize];
@@ -91,7 +92,7 @@ impl Writer<'_, '_, '_> {
                 ("OUTER", &DYNAMIC_OUTER_BLOCK),
                 // The counter after the per-effect ones (layout `stats.counters`).
                 ("SAMPLES", &self.coarse_live().len()),
-                ("STATISTICS_ON", &super::pixel::STATISTICS_ON),
+                ("STATISTICS_ON", &super::pixel::statistics_enabled()),
             ],
         );
     }
@@ -113,7 +114,7 @@ impl Writer<'_, '_, '_> {
     pub(super) fn stale_corners(&mut self, buffer: &str, stride: u32) {
         let tags: Vec<String> = ["x", "y", "z", "w"]
             .iter()
-            .map(|corner| format!("{buffer}[b.corners.{corner} * {stride}u + {}u] != mrsl_ctl.frame + 1u", stride - 1))
+            .map(|corner| format!("{buffer}[b.corners.{corner} * {stride}u + {}u] != {CONTROL}.frame + 1u", stride - 1))
             .collect();
         self.line(1, format!("disc = disc || {};", tags.join(" || ")));
     }
@@ -125,7 +126,13 @@ impl Writer<'_, '_, '_> {
         self.template(
             indent,
             include_str!("templates/resolve_inner.wgsl"),
-            &[("NAME", &name), ("POS", &pos), ("OUTER", &outer), ("INNER", &inner)],
+            &[
+                ("LEVEL", &Level::DYNAMIC_INNER.suffix),
+                ("NAME", &name),
+                ("POS", &pos),
+                ("OUTER", &outer),
+                ("INNER", &inner),
+            ],
         );
     }
 
@@ -136,13 +143,15 @@ impl Writer<'_, '_, '_> {
         let info = &self.checked().effects[e.index()];
         let (index, name) = (self.coarse_index[&e], self.effect_name(e));
         if self.i.interface.is_passed(e) {
-            self.line(indent, format!("if (!mrsl_is_refined(mrsl_b, {index}u)) {{"));
-            self.line(indent + 1, format!("{name} = mrsl_resample_{}(mrsl_b, mrsl_c);", info.name));
-            self.line(indent, format!("}} else if (!mrsl_is_refined(mrsl_b2, {index}u)) {{"));
-            self.line(indent + 1, format!("{name} = mrsl_resample2_{}(mrsl_b2);", info.name));
+            let outer = Name::Resample.within(Level::DYNAMIC_OUTER.suffix, &info.name);
+            let inner = Name::Resample.within(Level::DYNAMIC_INNER.suffix, &info.name);
+            self.line(indent, format!("if (!{IS_REFINED}({BLOCK}, {index}u)) {{"));
+            self.line(indent + 1, format!("{name} = {outer}({BLOCK}, {CORNERS});"));
+            self.line(indent, format!("}} else if (!{IS_REFINED}({INNER_BLOCK}, {index}u)) {{"));
+            self.line(indent + 1, format!("{name} = {inner}({INNER_BLOCK});"));
             self.line(indent, "} else {");
         } else {
-            self.line(indent, format!("if (mrsl_is_refined(mrsl_b2, {index}u)) {{"));
+            self.line(indent, format!("if ({IS_REFINED}({INNER_BLOCK}, {index}u)) {{"));
         }
         self.evaluate(e, indent + 1, "", how);
         self.line(indent, "}");

@@ -6,6 +6,7 @@
 //! entry points of every family use.
 
 use super::body::{Mode, float_literal, local_name, wgsl_ident};
+use super::names::{BLOCK_SIZE, CONTROL, FORCE, NEIGHBOURS, Name, POS, REFINE};
 use super::words::{bit, unpack_with};
 use super::writer::cut;
 use super::{Derivatives, Writer};
@@ -128,8 +129,11 @@ impl<'b> Writer<'_, '_, 'b> {
             self.line(
                 0,
                 format!(
-                    "@group({}) @binding({}) var mrsl_gb_{}: texture_2d<{sample}>; // {}",
-                    ch.group, ch.binding, ch.name, ch.format
+                    "@group({}) @binding({}) var {}: texture_2d<{sample}>; // {}",
+                    ch.group,
+                    ch.binding,
+                    Name::GBuffer.of(&ch.name),
+                    ch.format
                 ),
             );
         }
@@ -150,8 +154,11 @@ impl<'b> Writer<'_, '_, 'b> {
                 self.line(
                     0,
                     format!(
-                        "@group({}) @binding({}) var mrsl_out_{}: texture_storage_2d<{}, write>;",
-                        o.group, o.binding, o.name, o.format
+                        "@group({}) @binding({}) var {}: texture_storage_2d<{}, write>;",
+                        o.group,
+                        o.binding,
+                        Name::Out.of(&o.name),
+                        o.format
                     ),
                 );
             }
@@ -169,11 +176,11 @@ impl<'b> Writer<'_, '_, 'b> {
         }
         let (grid, pixel) = if self.kind.is_coarse() {
             (
-                "(size + vec2<i32>(MRSL_BLOCK - 2)) / MRSL_BLOCK + vec2<i32>(1)",
-                "min(pos * MRSL_BLOCK, vec2<i32>(mrsl_ctl.size) - vec2<i32>(1))",
+                format!("(size + vec2<i32>({BLOCK_SIZE} - 2)) / {BLOCK_SIZE} + vec2<i32>(1)"),
+                format!("min(pos * {BLOCK_SIZE}, vec2<i32>({CONTROL}.size) - vec2<i32>(1))"),
             )
         } else {
-            ("size", "pos")
+            ("size".to_string(), "pos".to_string())
         };
         self.template(0, include_str!("templates/positions.wgsl"), &[("GRID", &grid), ("PIXEL", &pixel)]);
     }
@@ -204,15 +211,15 @@ impl<'b> Writer<'_, '_, 'b> {
     fn eval_signature(&self, e: EffectId, value_only: bool) -> String {
         let c = self.checked();
         let info = &c.effects[e.index()];
-        let mut params = vec!["mrsl_pos: vec2<i32>".to_string()];
+        let mut params = vec![format!("{POS}: vec2<i32>")];
         if info.has_refine && !value_only {
-            params.push("mrsl_refine: ptr<function, bool>".into());
+            params.push(format!("{REFINE}: ptr<function, bool>"));
         }
         for d in self.deps_params(e) {
             params.push(format!("{}: {}", self.effect_name(d), c.effects[d.index()].ty.wgsl()));
         }
-        let prefix = if value_only { "val" } else { "eval" };
-        format!("fn mrsl_{prefix}_{}({}) -> {}", info.name, params.join(", "), info.ty.wgsl())
+        let function = if value_only { Name::Val } else { Name::Eval };
+        format!("fn {}({}) -> {}", function.of(&info.name), params.join(", "), info.ty.wgsl())
     }
 
     /// Inputs an effect body reads directly, outside the statements in
@@ -312,7 +319,7 @@ impl<'b> Writer<'_, '_, 'b> {
         self.line(0, format!("{sig} {{"));
         for i in self.inputs_read(decl, skipped) {
             let name = &c.inputs[i].name;
-            self.line(1, format!("let {} = mrsl_load_{name}(mrsl_pos);", wgsl_ident(name)));
+            self.line(1, format!("let {} = {}({POS});", wgsl_ident(name), Name::Load.of(name)));
         }
         match &decl.body {
             EffectBody::Expr(x) => {
@@ -363,7 +370,7 @@ impl<'b> Writer<'_, '_, 'b> {
                 t if t.is_abstract() => crate::types::FLOAT,
                 t => t.clone(),
             };
-            let mut params = vec!["mrsl_pos: vec2<i32>".to_string()];
+            let mut params = vec![format!("{POS}: vec2<i32>")];
             params.extend(
                 site.params.iter().map(|p| format!("{}: {}", local_name(c, *p), c.locals[p.index()].ty.wgsl())),
             );
@@ -460,9 +467,8 @@ impl<'b> Writer<'_, '_, 'b> {
             for (e, offset) in self.neighbour_values() {
                 let info = &c.effects[e.index()];
                 self.line(0, format!("// `{}` at another sample, as `coarse_neighbours` stored it there.", info.name));
-                self.line(0, format!("fn mrsl_at_{}(mrsl_pos: vec2<i32>) -> {} {{", info.name, info.ty.wgsl()));
-                let value =
-                    unpack_with(&info.ty, |j| format!("textureLoad(mrsl_neighbours, mrsl_pos, {}).x", offset + j));
+                self.line(0, format!("fn {}({POS}: vec2<i32>) -> {} {{", Name::At.of(&info.name), info.ty.wgsl()));
+                let value = unpack_with(&info.ty, |j| format!("textureLoad({NEIGHBOURS}, {POS}, {}).x", offset + j));
                 self.line(1, format!("return {value};"));
                 self.line(0, "}");
                 self.line(0, "");
@@ -487,7 +493,7 @@ impl<'b> Writer<'_, '_, 'b> {
                     self.kind.name()
                 ),
             );
-            self.line(0, format!("fn mrsl_at_{}(mrsl_pos: vec2<i32>) -> {} {{", info.name, info.ty.wgsl()));
+            self.line(0, format!("fn {}({POS}: vec2<i32>) -> {} {{", Name::At.of(&info.name), info.ty.wgsl()));
             if coarse {
                 self.resolve_preamble(1, &resolver);
             }
@@ -518,7 +524,7 @@ impl<'b> Writer<'_, '_, 'b> {
     /// is `"let "`, or empty for a variable already declared), declaring its
     /// refine flag first if it has one and `how` keeps it ([`Evaluation`]).
     pub(super) fn evaluate(&mut self, e: EffectId, indent: usize, declare: &str, how: Evaluation) {
-        self.evaluate_at(e, indent, declare, "mrsl_pos", "", how);
+        self.evaluate_at(e, indent, declare, POS, "", how);
     }
 
     /// [`Self::evaluate`] at position `pos`, with the values of `e` and of
@@ -536,18 +542,19 @@ impl<'b> Writer<'_, '_, 'b> {
         let info = &self.checked().effects[e.index()];
         let mut args = vec![pos.to_string()];
         let function = if info.has_refine && (how == Evaluation::ValueOnly || !self.keeps_refine_flags()) {
-            "val"
+            Name::Val
         } else {
             if info.has_refine {
-                self.line(indent, format!("var mrsl_r_{} = false;", info.name));
-                args.push(format!("&mrsl_r_{}", info.name));
+                let flag = Name::RefineFlag.of(&info.name);
+                self.line(indent, format!("var {flag} = false;"));
+                args.push(format!("&{flag}"));
             }
-            "eval"
+            Name::Eval
         };
         args.extend(self.deps_params(e).into_iter().map(|d| format!("{prefix}{}", self.effect_name(d))));
         self.line(
             indent,
-            format!("{declare}{prefix}{} = mrsl_{function}_{}({});", self.effect_name(e), info.name, args.join(", ")),
+            format!("{declare}{prefix}{} = {}({});", self.effect_name(e), function.of(&info.name), args.join(", ")),
         );
     }
 
@@ -556,7 +563,7 @@ impl<'b> Writer<'_, '_, 'b> {
     /// Declares the refine flag words `mrsl_flags<w>`, all clear.
     pub(super) fn declare_flag_words(&mut self, words: u32) {
         for w in 0..words {
-            self.line(1, format!("var mrsl_flags{w} = 0u;"));
+            self.line(1, format!("var {} = 0u;", Name::FlagWord.of(w)));
         }
     }
 
@@ -565,7 +572,8 @@ impl<'b> Writer<'_, '_, 'b> {
         if let Some(k) = self.i.interface.refine_bit[e.index()] {
             let (word, mask) = bit(k);
             let name = &self.checked().effects[e.index()].name;
-            self.line(indent, format!("if (mrsl_r_{name} || mrsl_force) {{ mrsl_flags{word} |= {mask}u; }}"));
+            let (flag, word) = (Name::RefineFlag.of(name), Name::FlagWord.of(word));
+            self.line(indent, format!("if ({flag} || {FORCE}) {{ {word} |= {mask}u; }}"));
         }
     }
 }

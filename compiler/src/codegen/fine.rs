@@ -10,6 +10,7 @@
 
 use super::Writer;
 use super::effects::Evaluation;
+use super::names::{BLOCK, CORNERS, INNER_BLOCK, INTERFACE, IS_REFINED, LAST_BLOCK, LOAD_CORNERS, Name, POS};
 use super::pixel::Scope;
 use super::words::{bit, test_bit, unpack_words};
 use super::writer::cut;
@@ -39,7 +40,7 @@ pub(super) struct Level {
 impl Level {
     /// The only level of a kernel with one: the coarse kernel's records, in `mrsl_interface`.
     pub(super) const fn own(block: u32) -> Level {
-        Level { suffix: "", block, buffer: "mrsl_interface", parent: false }
+        Level { suffix: "", block, buffer: INTERFACE, parent: false }
     }
 
     /// The words of one sample's record at this level (the validity tag included).
@@ -231,13 +232,14 @@ impl<'b> Writer<'_, '_, 'b> {
                 terms.push(format!("(({needed}) && ({}))", misses.join(" || ")));
             }
             let value = if r.level.parent {
-                format!("mrsl_is_refined(parent, {k}u) && ({})", terms.join(" || "))
+                format!("{IS_REFINED}(parent, {k}u) && ({})", terms.join(" || "))
             } else {
                 terms.join(" || ")
             };
             let (word, mask) = bit(k);
-            self.line(1, format!("let mrsl_r{k} = {value}; // `{}`", self.checked().effects[e.index()].name));
-            self.line(1, format!("if (mrsl_r{k}) {{ b.refined{word} |= {mask}u; }}"));
+            let refined = Name::Refined.of(k);
+            self.line(1, format!("let {refined} = {value}; // `{}`", self.checked().effects[e.index()].name));
+            self.line(1, format!("if ({refined}) {{ b.refined{word} |= {mask}u; }}"));
         }
     }
 
@@ -251,7 +253,7 @@ impl<'b> Writer<'_, '_, 'b> {
                 continue;
             }
             match c.effects[u.index()].rate {
-                Rate::Coarse => needed.push(format!("mrsl_r{}", self.coarse_index[&u])),
+                Rate::Coarse => needed.push(Name::Refined.of(self.coarse_index[&u])),
                 _ => needed.push("true".into()),
             }
         }
@@ -291,7 +293,7 @@ impl<'b> Writer<'_, '_, 'b> {
             let (filter, value) = if layout::uses_nearest(c, e) {
                 // `select` takes no matrix: a matrix goes through `mrsl_select_m<N>`.
                 let select = match info.ty {
-                    Type::Matrix(n) => format!("mrsl_select_m{n}"),
+                    Type::Matrix(n) => Name::SelectMatrix.of(n),
                     _ => "select".to_string(),
                 };
                 (
@@ -374,17 +376,19 @@ impl<'b> Writer<'_, '_, 'b> {
     /// `mrsl_pos` in the fine kernels; nothing elsewhere. `name` is the suffix
     /// of a neighbour function's own resolvers (`mrsl_resolve_<effect>`), or empty.
     pub(super) fn resolve_preamble(&mut self, indent: usize, name: &str) {
+        // The first level's (in the dynamic mode the outer level's) resolver.
+        let resolve = Name::Resolve.of(format!("{}{name}", Level::own(self.block).suffix));
         if self.preloads_corners() {
             // Where the entry point loaded its lane's corners, it resolved its
             // pixels too ([`Writer::effect_major_pixels`]); a position resolved
             // here (a neighbour function's, a compacted pixel's) loads its own.
-            self.line(indent, "let mrsl_c = mrsl_corners(mrsl_pos);");
-            self.line(indent, format!("let mrsl_b = mrsl_resolve{name}(mrsl_pos, mrsl_c);"));
+            self.line(indent, format!("let {CORNERS} = {LOAD_CORNERS}({POS});"));
+            self.line(indent, format!("let {BLOCK} = {resolve}({POS}, {CORNERS});"));
         } else if self.kind.is_fine() {
-            self.line(indent, format!("let mrsl_b = mrsl_resolve{name}(mrsl_pos);"));
+            self.line(indent, format!("let {BLOCK} = {resolve}({POS});"));
         }
         if self.kind == KernelKind::DynamicFine {
-            self.resolve_inner(indent, name, ["mrsl_pos", "mrsl_b", "mrsl_b2"]);
+            self.resolve_inner(indent, name, [POS, BLOCK, INNER_BLOCK]);
         }
     }
 
@@ -397,12 +401,13 @@ impl<'b> Writer<'_, '_, 'b> {
         if self.kind == KernelKind::DynamicFine {
             return self.dynamic_coarse_value(e, indent, how);
         }
-        self.line(indent, format!("if (mrsl_is_refined(mrsl_b, {index}u)) {{"));
+        self.line(indent, format!("if ({IS_REFINED}({BLOCK}, {index}u)) {{"));
         self.evaluate(e, indent + 1, "", how);
         if self.i.interface.is_passed(e) {
             self.line(indent, "} else {");
-            let corners = if self.preloads_corners() { ", mrsl_c" } else { "" };
-            self.line(indent + 1, format!("{name} = mrsl_resample_{}(mrsl_b{corners});", info.name));
+            let resample = Name::Resample.within(Level::own(self.block).suffix, &info.name);
+            let corners = if self.preloads_corners() { format!(", {CORNERS}") } else { String::new() };
+            self.line(indent + 1, format!("{name} = {resample}({BLOCK}{corners});"));
         }
         self.line(indent, "}");
     }
@@ -424,14 +429,14 @@ impl<'b> Writer<'_, '_, 'b> {
                 }
                 // `mrsl_last` holds the innermost level: effects refined there are evaluated per pixel.
                 let (last, from_inner) = if w.kind == KernelKind::DynamicFine {
-                    ("mrsl_b2", "mrsl_b.refined0 & ~mrsl_b2.refined0")
+                    (INNER_BLOCK, format!("{BLOCK}.refined0 & ~{INNER_BLOCK}.refined0"))
                 } else {
-                    ("mrsl_b", "0u")
+                    (BLOCK, "0u".to_string())
                 };
                 w.statistics_on(2);
                 w.template(3, include_str!("templates/rate.wgsl"), &[("LAST", &last), ("FROM_INNER", &from_inner)]);
                 for k in 0..coarse {
-                    w.count_refined(k, &format!("mrsl_is_refined(mrsl_last, {k}u)"));
+                    w.count_refined(k, &format!("{IS_REFINED}({LAST_BLOCK}, {k}u)"));
                 }
                 w.line(2, "}");
             },

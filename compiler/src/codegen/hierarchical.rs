@@ -11,6 +11,7 @@
 
 use super::Writer;
 use super::effects::Evaluation;
+use super::names::{CONTROL, COUNT, Name, POS, SET_WORD, WORD};
 use super::records::{axis_neighbours, diagonal_neighbours, neighbours};
 use super::words::bit;
 use super::writer::cut;
@@ -137,16 +138,20 @@ impl Writer<'_, '_, '_> {
                     return;
                 }
                 let [head, end] = cut(include_str!("templates/hierarchical_final.wgsl"), &["COUNTS"]);
-                w.template(0, head, &[("FLAG_WORDS", &flag_words), ("STATISTICS_ON", &super::pixel::STATISTICS_ON)]);
+                w.template(
+                    0,
+                    head,
+                    &[("FLAG_WORDS", &flag_words), ("STATISTICS_ON", &super::pixel::statistics_enabled())],
+                );
                 for k in 0..coarse {
                     let (word, mask) = bit(k as u32);
-                    w.count_refined(k, &format!("(mrsl_word(mrsl_pos, {}u) & {mask}u) != 0u", flag_words + word));
+                    w.count_refined(k, &format!("({WORD}({POS}, {}u) & {mask}u) != 0u", flag_words + word));
                 }
                 w.template(0, end, &[]);
             },
             |w, e, indent| {
                 let name = &w.checked().effects[e.index()].name;
-                w.line(indent, format!("let {} = mrsl_hget_{name}(mrsl_pos);", w.effect_name(e)));
+                w.line(indent, format!("let {} = {}({POS});", w.effect_name(e), Name::RecordGet.of(name)));
             },
         );
     }
@@ -158,7 +163,7 @@ impl Writer<'_, '_, '_> {
         self.template(0, head, &[]);
         let last = HIERARCHICAL_LEVELS.len();
         for (index, l) in HIERARCHICAL_LEVELS[..last - 1].iter().enumerate() {
-            let count = |axis: &str| format!("mrsl_count({}u, {}u, {axis})", l.start, l.step);
+            let count = |axis: &str| format!("{COUNT}({}u, {}u, {axis})", l.start, l.step);
             self.line(1, format!("let c{} = {} * {};", index + 1, count("w"), count("h")));
         }
         let mut offset = "0u".to_string();
@@ -195,7 +200,7 @@ impl Writer<'_, '_, '_> {
             self.template(1, read, &values);
         }
         for w in 0..flag_words {
-            self.line(1, format!("mrsl_set_word(mrsl_pos, {w}u, mrsl_flags{w});"));
+            self.line(1, format!("{SET_WORD}({POS}, {w}u, {});", Name::FlagWord.of(w)));
         }
         self.template(0, end, &[]);
     }
@@ -218,7 +223,7 @@ impl Writer<'_, '_, '_> {
         for w in 0..h.mask_words {
             let bits = coarse.saturating_sub(w * 32).min(32);
             let mask = if bits == 32 { u32::MAX } else { (1u32 << bits) - 1 };
-            self.line(1, format!("mrsl_set_word(p, {}u, {mask}u);", h.flag_words + w));
+            self.line(1, format!("{SET_WORD}(p, {}u, {mask}u);", h.flag_words + w));
         }
         self.template(0, tail, &[]);
     }
@@ -236,7 +241,7 @@ impl Writer<'_, '_, '_> {
         self.template(0, pairs, &[]);
         for key in self.keys_of(&self.coarse_live()) {
             let name = key.name;
-            let differs = key.differs(&format!("k_{name}"), &format!("mrsl_load_{name}(q[k])"));
+            let differs = key.differs(&format!("k_{name}"), &format!("{}(q[k])", Name::Load.of(name)));
             self.template(0, include_str!("templates/classify_key.wgsl"), &[("NAME", &name), ("DIFFERS", &differs)]);
         }
         self.template(0, keys, &[]);
@@ -268,7 +273,7 @@ impl Writer<'_, '_, '_> {
                     3 => "max(max(variance.x, variance.y), variance.z)",
                     _ => "max(max(variance.x, variance.y), max(variance.z, variance.w))",
                 };
-                need.push(format!("!({spread} <= mrsl_ctl.similarity)"));
+                need.push(format!("!({spread} <= {CONTROL}.similarity)"));
                 "mean"
             } else {
                 // Integer, bool and matrix values are copied only when every neighbour agrees.
@@ -300,10 +305,10 @@ impl Writer<'_, '_, '_> {
             );
         }
         for w in 0..fw {
-            self.line(1, format!("mrsl_set_word(p, {w}u, 0u);"));
+            self.line(1, format!("{SET_WORD}(p, {w}u, 0u);"));
         }
         for w in 0..mw {
-            self.line(1, format!("mrsl_set_word(p, {}u, mask{w});", fw + w));
+            self.line(1, format!("{SET_WORD}(p, {}u, mask{w});", fw + w));
         }
         let any: Vec<String> = (0..mw).map(|w| format!("mask{w}")).collect();
         self.template(0, end, &[("ANY_MASK", &any.join(" | ")), ("QUEUE_WORDS", &QUEUE_WORDS_PER_LEVEL)]);

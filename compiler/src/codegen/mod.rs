@@ -56,6 +56,7 @@ mod dynamic;
 mod effects;
 mod fine;
 mod hierarchical;
+mod names;
 mod pixel;
 mod rate;
 mod records;
@@ -232,7 +233,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         if self.kind != KernelKind::Reference {
             // The dynamic mode's second level carries a validity tag after each record.
             let extra = if self.kind == KernelKind::DynamicCoarse { DYNAMIC_TAG_WORDS } else { 0 };
-            self.line(0, format!("const MRSL_STRIDE: u32 = {}u;", self.i.interface.stride + extra));
+            self.line(0, format!("const {}: u32 = {}u;", names::STRIDE, self.i.interface.stride + extra));
         }
         self.line(0, "");
         self.bindings();

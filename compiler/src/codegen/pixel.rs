@@ -5,6 +5,10 @@
 
 use super::Writer;
 use super::effects::Evaluation;
+use super::fine::Level;
+use super::names::{
+    BLOCK, CONTROL, CORNERS, FIRST, GRID, INNER_BLOCK, IS_REFINED, LANE_PIXEL, LOAD_CORNERS, Name, POS, WORKGROUP_STATS,
+};
 use super::writer::cut;
 use crate::check::EffectId;
 use crate::syntax::ast::Rate;
@@ -14,7 +18,9 @@ use mrsl_abi::geometry::{FINE_PIXELS_PER_LANE, TILE};
 
 /// The condition of the instrumentation a dispatch runs only with statistics
 /// on (control field `statistics`): the rate image and the counters.
-pub(super) const STATISTICS_ON: &str = "mrsl_ctl.statistics != 0u";
+pub(super) fn statistics_enabled() -> String {
+    format!("{CONTROL}.statistics != 0u")
+}
 
 /// What a per-pixel prologue ([`Writer::pixel_main`]) finds in scope besides `mrsl_pos`.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -123,7 +129,7 @@ impl Writer<'_, '_, '_> {
             &[
                 ("WORKGROUP", &format!("{x}, {y}, {z}")),
                 ("ENTRY", &self.kind.main_entry_point()),
-                ("FIRST", &if pairs { "mrsl_first" } else { "mrsl_pos" }),
+                ("FIRST", &if pairs { FIRST } else { POS }),
             ],
         );
         let counted = self.counts_stats();
@@ -133,8 +139,8 @@ impl Writer<'_, '_, '_> {
             // No coarse effects: the pixels' work, one after the other.
             for k in 0..FINE_PIXELS_PER_LANE {
                 let at = self.lane_pixel(k);
-                self.line(1, format!("if (all({at} < mrsl_grid())) {{"));
-                self.line(2, format!("let mrsl_pos = {at};"));
+                self.line(1, format!("if (all({at} < {GRID}())) {{"));
+                self.line(2, format!("let {POS} = {at};"));
                 self.pixel_body(2, &mut prologue, &mut coarse);
                 self.line(1, "}");
             }
@@ -142,10 +148,10 @@ impl Writer<'_, '_, '_> {
             // The record modes' final passes keep one shape, counting or not.
             let returns = !counted && !matches!(self.kind, KernelKind::Hierarchical | KernelKind::Checkerboard);
             if returns {
-                self.line(1, "if (any(mrsl_pos >= mrsl_grid())) { return; }");
+                self.line(1, format!("if (any({POS} >= {GRID}())) {{ return; }}"));
                 self.pixel_body(1, &mut prologue, &mut coarse);
             } else {
-                self.line(1, "if (all(mrsl_pos < mrsl_grid())) {");
+                self.line(1, format!("if (all({POS} < {GRID}())) {{"));
                 self.pixel_body(2, &mut prologue, &mut coarse);
                 self.line(1, "}");
             }
@@ -154,7 +160,7 @@ impl Writer<'_, '_, '_> {
             self.template(
                 0,
                 include_str!("templates/stats_flush.wgsl"),
-                &[("COUNTERS", &self.coarse_live().len()), ("WORKGROUP", &x), ("STATISTICS_ON", &STATISTICS_ON)],
+                &[("COUNTERS", &self.coarse_live().len()), ("WORKGROUP", &x), ("STATISTICS_ON", &statistics_enabled())],
             );
         }
         self.line(0, "}");
@@ -182,18 +188,18 @@ impl Writer<'_, '_, '_> {
     /// Counts coarse effect `k` as re-evaluated by this pixel where `condition`
     /// holds (inside a `statistics_on` block, hence the indentation).
     pub(super) fn count_refined(&mut self, k: usize, condition: &str) {
-        self.line(3, format!("if ({condition}) {{ atomicAdd(&mrsl_wg_stats[{k}], 1u); }}"));
+        self.line(3, format!("if ({condition}) {{ atomicAdd(&{WORKGROUP_STATS}[{k}], 1u); }}"));
     }
 
     /// Opens the block of instrumentation a dispatch runs only with
     /// statistics on (control field `statistics`): the rate image and the
     /// counters. Timed runs leave it out; the branch is uniform.
     pub(super) fn statistics_on(&mut self, indent: usize) {
-        self.line(indent, format!("if ({STATISTICS_ON}) {{"));
+        self.line(indent, format!("if ({}) {{", statistics_enabled()));
     }
 
     pub(super) fn output_stores(&mut self, order: &[EffectId], indent: usize) {
-        self.output_stores_at(order, indent, "mrsl_pos", "");
+        self.output_stores_at(order, indent, POS, "");
     }
 
     /// [`Self::output_stores`] at `pos`, of the values named `{prefix}{output}`.
@@ -205,7 +211,7 @@ impl Writer<'_, '_, '_> {
                 continue;
             }
             let value = to_vec4(&format!("{prefix}{}", self.effect_name(*e)), &info.ty);
-            self.line(indent, format!("textureStore(mrsl_out_{}, {pos}, {value});", info.name));
+            self.line(indent, format!("textureStore({}, {pos}, {value});", Name::Out.of(&info.name)));
         }
     }
 
@@ -213,8 +219,8 @@ impl Writer<'_, '_, '_> {
     /// (`mrsl_first`), or `B / FINE_PIXELS_PER_LANE` rows per step below it.
     fn lane_pixel(&self, k: u32) -> String {
         match k * self.block / FINE_PIXELS_PER_LANE {
-            0 => "mrsl_first".to_string(),
-            dy => format!("mrsl_first + vec2<i32>(0, {dy})"),
+            0 => FIRST.to_string(),
+            dy => format!("{FIRST} + vec2<i32>(0, {dy})"),
         }
     }
 
@@ -236,94 +242,121 @@ impl Writer<'_, '_, '_> {
     /// "nothing refined at run time", docs/evaluation.md).
     fn effect_major_pixels(&mut self, prologue: &mut impl FnMut(&mut Self, Scope)) {
         let pixels: Vec<u32> = (0..FINE_PIXELS_PER_LANE).collect();
-        // The dynamic mode: the innermost level a pixel refined to
-        // (`mrsl_inner<k>`), whose refined effects it evaluates.
-        let dynamic = self.kind == KernelKind::DynamicFine;
-        let last = if dynamic { "mrsl_inner" } else { "mrsl_b" };
-        // A lane past the image's edge still loads (clamped) corners and
-        // resolves; its pixels' statistics and stores are skipped below.
-        self.line(1, "let mrsl_c = mrsl_corners(min(mrsl_first, mrsl_grid() - vec2<i32>(1)));");
-        for &k in &pixels {
-            self.line(1, format!("let mrsl_pos{k} = {};", self.lane_pixel(k)));
-            self.line(1, format!("let mrsl_in{k} = all(mrsl_pos{k} < mrsl_grid());"));
-            self.line(1, format!("let mrsl_b{k} = mrsl_resolve(mrsl_pos{k}, mrsl_c);"));
-            if dynamic {
-                let names = [format!("mrsl_pos{k}"), format!("mrsl_b{k}"), format!("mrsl_inner{k}")];
-                self.resolve_inner(1, "", names.each_ref().map(String::as_str));
+        self.resolve_lane_pixels(prologue);
+        let c = self.checked();
+        let order = self.i.graph.order.clone();
+        for &e in &order {
+            if c.effects[e.index()].rate == Rate::Coarse {
+                self.lane_coarse_value(e);
+                continue;
+            }
+            for &k in &pixels {
+                let (pos, prefix) = (Name::LanePos.of(k), Name::LaneValue.within(k, ""));
+                self.evaluate_at(e, 1, "let ", &pos, &prefix, Evaluation::Kernel);
             }
         }
         for &k in &pixels {
-            self.line(1, format!("if (mrsl_in{k}) {{"));
-            self.line(2, format!("let mrsl_pos = mrsl_pos{k};"));
-            self.line(2, format!("let mrsl_b = mrsl_b{k};"));
+            self.line(1, format!("if ({}) {{", Name::LaneIn.of(k)));
+            self.output_stores_at(&order, 2, &Name::LanePos.of(k), &Name::LaneValue.within(k, ""));
+            self.line(1, "}");
+        }
+    }
+
+    /// The start of [`Self::effect_major_pixels`]: the lane's block corners,
+    /// each pixel's position (`mrsl_pos<k>`), whether it is in the image
+    /// (`mrsl_in<k>`) and its resolved blocks (`mrsl_b<k>`, `mrsl_inner<k>`),
+    /// then each pixel's `prologue`.
+    fn resolve_lane_pixels(&mut self, prologue: &mut impl FnMut(&mut Self, Scope)) {
+        let dynamic = self.kind == KernelKind::DynamicFine;
+        let resolve = Name::Resolve.of(Level::own(self.block).suffix);
+        // A lane past the image's edge still loads (clamped) corners and
+        // resolves; its pixels' statistics and stores are skipped below.
+        self.line(1, format!("let {CORNERS} = {LOAD_CORNERS}(min({FIRST}, {GRID}() - vec2<i32>(1)));"));
+        for k in 0..FINE_PIXELS_PER_LANE {
+            let (pos, block) = (Name::LanePos.of(k), Name::LaneBlock.of(k));
+            self.line(1, format!("let {pos} = {};", self.lane_pixel(k)));
+            self.line(1, format!("let {} = all({pos} < {GRID}());", Name::LaneIn.of(k)));
+            self.line(1, format!("let {block} = {resolve}({pos}, {CORNERS});"));
             if dynamic {
-                self.line(2, format!("let mrsl_b2 = mrsl_inner{k};"));
+                self.resolve_inner(1, "", [&pos, &block, &Name::LaneInner.of(k)]);
+            }
+        }
+        for k in 0..FINE_PIXELS_PER_LANE {
+            self.line(1, format!("if ({}) {{", Name::LaneIn.of(k)));
+            self.line(2, format!("let {POS} = {};", Name::LanePos.of(k)));
+            self.line(2, format!("let {BLOCK} = {};", Name::LaneBlock.of(k)));
+            if dynamic {
+                self.line(2, format!("let {INNER_BLOCK} = {};", Name::LaneInner.of(k)));
             }
             prologue(self, Scope::Resolved);
             self.line(1, "}");
         }
-        let c = self.checked();
-        let order = self.i.graph.order.clone();
-        for &e in &order {
-            let info = &c.effects[e.index()];
-            let name = self.effect_name(e);
-            if info.rate != Rate::Coarse {
-                for &k in &pixels {
-                    let (pos, prefix) = (format!("mrsl_pos{k}"), format!("mrsl_v{k}_"));
-                    self.evaluate_at(e, 1, "let ", &pos, &prefix, Evaluation::Kernel);
-                }
+    }
+
+    /// Coarse effect `e` at the lane's pixels in [`Self::effect_major_pixels`]:
+    /// resampled at each (when passed), then re-evaluated in a loop at the
+    /// pixels that refine it at their innermost level (`mrsl_b<k>`, or in
+    /// the dynamic mode `mrsl_inner<k>`).
+    fn lane_coarse_value(&mut self, e: EffectId) {
+        let pixels: Vec<u32> = (0..FINE_PIXELS_PER_LANE).collect();
+        let dynamic = self.kind == KernelKind::DynamicFine;
+        let info = &self.checked().effects[e.index()];
+        let (index, name) = (self.coarse_index[&e], self.effect_name(e));
+        let value = |k: u32| Name::LaneValue.within(k, &name);
+        for &k in &pixels {
+            if !self.i.interface.is_passed(e) {
+                self.line(1, format!("var {}: {};", value(k), info.ty.wgsl()));
                 continue;
             }
-            let index = self.coarse_index[&e];
-            for &k in &pixels {
-                if self.i.interface.is_passed(e) {
-                    self.line(1, format!("var mrsl_v{k}_{name} = mrsl_resample_{}(mrsl_b{k}, mrsl_c);", info.name));
-                    if dynamic {
-                        self.line(
-                            1,
-                            format!(
-                                "if (mrsl_is_refined(mrsl_b{k}, {index}u) && !mrsl_is_refined(mrsl_inner{k}, {index}u)) {{ mrsl_v{k}_{name} = mrsl_resample2_{}(mrsl_inner{k}); }}",
-                                info.name
-                            ),
-                        );
-                    }
-                } else {
-                    self.line(1, format!("var mrsl_v{k}_{name}: {};", info.ty.wgsl()));
-                }
+            let (block, inner) = (Name::LaneBlock.of(k), Name::LaneInner.of(k));
+            let resample = Name::Resample.within(Level::own(self.block).suffix, &info.name);
+            self.line(1, format!("var {} = {resample}({block}, {CORNERS});", value(k)));
+            if dynamic {
+                let resample2 = Name::Resample.within(Level::DYNAMIC_INNER.suffix, &info.name);
+                self.line(
+                    1,
+                    format!(
+                        "if ({IS_REFINED}({block}, {index}u) && !{IS_REFINED}({inner}, {index}u)) {{ {} = {resample2}({inner}); }}",
+                        value(k)
+                    ),
+                );
             }
-            let todo: Vec<String> = pixels
-                .iter()
-                .map(|k| format!("select(0u, {}u, mrsl_in{k} && mrsl_is_refined({last}{k}, {index}u))", 1u32 << k))
-                .collect();
-            self.line(1, format!("// `{}`, re-evaluated at the lane's pixels that refine it", info.name));
-            self.line(1, format!("var mrsl_todo_{name} = {};", todo.join(" | ")));
-            self.line(1, "loop {");
-            self.line(2, format!("if (mrsl_todo_{name} == 0u) {{ break; }}"));
-            self.line(2, format!("let mrsl_k = countTrailingZeros(mrsl_todo_{name});"));
-            self.line(2, format!("mrsl_todo_{name} &= mrsl_todo_{name} - 1u;"));
-            // The position and the dependencies of pixel `mrsl_k`, under the
-            // names `evaluate` uses: `mrsl_pos` from `mrsl_pos<k>`, each
-            // dependency from `mrsl_v<k>_<dependency>`.
-            let mut locals = vec![("mrsl_pos".to_string(), "mrsl_pos".to_string())];
-            locals.extend(self.deps_params(e).into_iter().map(|d| (self.effect_name(d), "mrsl_v".to_string())));
-            for (local, stem) in &locals {
-                let at = |k: u32| if stem == local { format!("{stem}{k}") } else { format!("{stem}{k}_{local}") };
-                self.line(2, format!("var {local} = {};", at(0)));
-                for &k in &pixels[1..] {
-                    self.line(2, format!("if (mrsl_k == {k}u) {{ {local} = {}; }}", at(k)));
-                }
-            }
-            self.evaluate(e, 2, "let ", Evaluation::Kernel);
-            for &k in &pixels {
-                self.line(2, format!("if (mrsl_k == {k}u) {{ mrsl_v{k}_{name} = {name}; }}"));
-            }
-            self.line(1, "}");
         }
+        let last = if dynamic { Name::LaneInner } else { Name::LaneBlock };
+        let todo: Vec<String> = pixels
+            .iter()
+            .map(|&k| {
+                let (inside, at) = (Name::LaneIn.of(k), last.of(k));
+                format!("select(0u, {}u, {inside} && {IS_REFINED}({at}, {index}u))", 1u32 << k)
+            })
+            .collect();
+        let todo_name = Name::Todo.of(&name);
+        self.line(1, format!("// `{}`, re-evaluated at the lane's pixels that refine it", info.name));
+        self.line(1, format!("var {todo_name} = {};", todo.join(" | ")));
+        self.line(1, "loop {");
+        self.line(2, format!("if ({todo_name} == 0u) {{ break; }}"));
+        self.line(2, format!("let {LANE_PIXEL} = countTrailingZeros({todo_name});"));
+        self.line(2, format!("{todo_name} &= {todo_name} - 1u;"));
+        // The position and the dependencies of pixel `mrsl_k`, under the
+        // names `evaluate` uses: `mrsl_pos` from `mrsl_pos<k>`, each
+        // dependency from `mrsl_v<k>_<dependency>`.
+        let mut locals = vec![(POS.to_string(), pixels.iter().map(|&k| Name::LanePos.of(k)).collect::<Vec<_>>())];
+        for d in self.deps_params(e) {
+            let dep = self.effect_name(d);
+            let at = pixels.iter().map(|&k| Name::LaneValue.within(k, &dep)).collect();
+            locals.push((dep, at));
+        }
+        for (local, at) in &locals {
+            self.line(2, format!("var {local} = {};", at[0]));
+            for &k in &pixels[1..] {
+                self.line(2, format!("if ({LANE_PIXEL} == {k}u) {{ {local} = {}; }}", at[k as usize]));
+            }
+        }
+        self.evaluate(e, 2, "let ", Evaluation::Kernel);
         for &k in &pixels {
-            self.line(1, format!("if (mrsl_in{k}) {{"));
-            self.output_stores_at(&order, 2, &format!("mrsl_pos{k}"), &format!("mrsl_v{k}_"));
-            self.line(1, "}");
+            self.line(2, format!("if ({LANE_PIXEL} == {k}u) {{ {} = {name}; }}", value(k)));
         }
+        self.line(1, "}");
     }
 }
 

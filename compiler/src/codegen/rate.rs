@@ -12,6 +12,7 @@
 
 use super::Writer;
 use super::fine::{CORNER_SAMPLES, LANES, Level, Resolver};
+use super::names::Name;
 use super::writer::cut;
 use crate::layout;
 use mrsl_abi::KernelKind;
@@ -97,7 +98,7 @@ impl Writer<'_, '_, '_> {
             let values = s.values();
             self.template(0, head, &values);
             // A corner on a border may blend two border samples.
-            let get = format!("mrsl_get{}_{}", level.suffix, s.name);
+            let get = Name::Get.within(level.suffix, s.name);
             for (k, lane) in LANES.iter().enumerate() {
                 self.line(1, format!("var v{k} = {get}(b.corners.{lane});"));
                 if layout::uses_nearest(c, s.effect) {

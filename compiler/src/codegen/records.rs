@@ -7,6 +7,7 @@
 //! opposite pairs, only complete pairs used) and the final pass.
 
 use super::Writer;
+use super::names::{SET_WORD, WORD};
 use super::pixel::Scope;
 use super::words::{pack_words, unpack_with};
 use super::writer::cut;
@@ -48,12 +49,12 @@ impl Writer<'_, '_, '_> {
         for (k, &e) in self.coarse_live().iter().enumerate() {
             let info = &c.effects[e.index()];
             let offset = h.value_offsets[k];
-            let unpack = unpack_with(&info.ty, |j| format!("mrsl_word(p, {}u)", offset + j));
+            let unpack = unpack_with(&info.ty, |j| format!("{WORD}(p, {}u)", offset + j));
             let values =
                 [("NAME", &info.name as &dyn std::fmt::Display), ("TYPE", &info.ty.wgsl()), ("UNPACK", &unpack)];
             self.template(0, access, &values);
             for (j, word) in pack_words("v", &info.ty).iter().enumerate() {
-                self.line(1, format!("mrsl_set_word(p, {}u, {word});", offset + j as u32));
+                self.line(1, format!("{SET_WORD}(p, {}u, {word});", offset + j as u32));
             }
             self.template(0, end, &[]);
         }

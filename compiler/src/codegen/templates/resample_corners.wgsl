@@ -1,4 +1,4 @@
-fn mrsl_resample_{{NAME}}(b: MrslBlock, c: MrslCorners) -> {{TYPE}} {
+fn mrsl_resample{{SUFFIX}}_{{NAME}}(b: MrslBlock, c: MrslCorners) -> {{TYPE}} {
     let v0 = {{V0}};
     let v1 = {{V1}};
     let v2 = {{V2}};

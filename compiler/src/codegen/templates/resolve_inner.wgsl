@@ -1,2 +1,2 @@
 var {{INNER}} = {{OUTER}};
-if (mrsl_any_refined({{OUTER}})) { {{INNER}} = mrsl_resolve2{{NAME}}({{POS}}, {{OUTER}}); }
+if (mrsl_any_refined({{OUTER}})) { {{INNER}} = mrsl_resolve{{LEVEL}}{{NAME}}({{POS}}, {{OUTER}}); }

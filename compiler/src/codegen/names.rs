@@ -1,0 +1,461 @@
+//! Generated names: the one place where the kernels' own identifiers are
+//! made, as naga's `proc::Namer` makes a module's. Every name the generator
+//! writes starts with `mrsl_`, `Mrsl` or `MRSL_`, a namespace no user name
+//! is written in ([`super::body::wgsl_ident`] escapes those into
+//! `mrsl_user_<name>`, a [`Name`] family of its own).
+//!
+//! - A **family** ([`Name`]) is a prefix and what tells its members apart: an
+//!   effect's, input's or output's name, a number (a derivative site, a word,
+//!   a lane's pixel) or a level's suffix. [`Name::of`] and [`Name::within`]
+//!   make a member; templates write the prefix before a placeholder
+//!   (`mrsl_load_{{NAME}}`).
+//! - A **fixed name** is one identifier: the constants below, for the names
+//!   that writers and templates share, and [`FIXED`], which also lists the
+//!   names only templates write (their helpers, entry points and locals).
+//!
+//! The tests below hold both sides to this module: every `mrsl_` identifier
+//! in a template is a fixed name or a family's prefix, and no writer outside
+//! this module spells one in a string literal. A name renamed here and not
+//! in a template (or the reverse) fails them.
+
+use std::fmt::Display;
+
+/// A family of generated names: a prefix, then what tells the members apart.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(super) enum Name {
+    /// `mrsl_eval_<effect>`: an effect's function, shared by every kernel.
+    Eval,
+    /// `mrsl_val_<effect>`: an effect's value alone, without what only decides its refine flag.
+    Val,
+    /// `mrsl_at_<effect>`: an effect's value at another position (derivatives).
+    At,
+    /// `mrsl_r_<effect>`: the refine flag an evaluation of the effect sets.
+    RefineFlag,
+    /// `mrsl_r<k>`: in a resolver, whether coarse effect `k` is evaluated per pixel.
+    Refined,
+    /// `mrsl_flags<w>`: the refine flag word `w` a coarse sample gathers.
+    FlagWord,
+    /// `mrsl_w<w>`: word `w` of the block coarse kernel's record, before it is stored.
+    RecordWord,
+    /// `mrsl_resolve<level>` and a neighbour function's `mrsl_resolve<level>_<effect>`.
+    Resolve,
+    /// `mrsl_resample<level>_<effect>`: a coarse effect resampled at a level.
+    Resample,
+    /// `mrsl_get<level>_<effect>`: a coarse effect's value in a sample's record at a level.
+    Get,
+    /// `mrsl_hget_<effect>`: a coarse effect's value in a pixel's record (record modes).
+    RecordGet,
+    /// `mrsl_hput_<effect>`: a coarse effect's value stored into a pixel's record.
+    RecordPut,
+    /// `mrsl_reconstruct_<effect>`: the checkerboard mode's reconstruction of an effect.
+    Reconstruct,
+    /// `mrsl_cv_<effect>`: the compacted fine pass's values of an effect, per lane.
+    CompactValues,
+    /// `mrsl_todo_<effect>`: the lane's pixels that re-evaluate a coarse effect.
+    Todo,
+    /// `mrsl_v<k>_<effect>`: an effect's value at pixel `k` of a fine kernel's lane.
+    LaneValue,
+    /// `mrsl_pos<k>`: pixel `k` of a fine kernel's lane.
+    LanePos,
+    /// `mrsl_in<k>`: whether pixel `k` of the lane lies inside the image.
+    LaneIn,
+    /// `mrsl_b<k>`: the resolved block of pixel `k` of the lane.
+    LaneBlock,
+    /// `mrsl_inner<k>`: the innermost level pixel `k` of the lane refined to (dynamic mode).
+    LaneInner,
+    /// `mrsl_load_<input>`: a G-buffer channel at a position's pixel.
+    Load,
+    /// `mrsl_gb_<channel>`: a G-buffer channel's binding.
+    GBuffer,
+    /// `mrsl_out_<output>`: an output's binding.
+    Out,
+    /// `mrsl_d<site>`: the operand of a derivative site at a position.
+    Operand,
+    /// `mrsl_ddx_<site>`: a derivative site's difference along x.
+    Ddx,
+    /// `mrsl_ddy_<site>`: a derivative site's difference along y.
+    Ddy,
+    /// `mrsl_select_m<n>`: `select` for `matNxN`.
+    SelectMatrix,
+    /// `mrsl_user_<name>`: a user name escaped out of the generated namespace.
+    User,
+}
+
+impl Name {
+    /// Every family, for the tests that check names against this module.
+    #[cfg_attr(not(test), expect(dead_code, reason = "read by the tests"))]
+    pub(super) const ALL: [Name; 28] = [
+        Name::Eval,
+        Name::Val,
+        Name::At,
+        Name::RefineFlag,
+        Name::Refined,
+        Name::FlagWord,
+        Name::RecordWord,
+        Name::Resolve,
+        Name::Resample,
+        Name::Get,
+        Name::RecordGet,
+        Name::RecordPut,
+        Name::Reconstruct,
+        Name::CompactValues,
+        Name::Todo,
+        Name::LaneValue,
+        Name::LanePos,
+        Name::LaneIn,
+        Name::LaneBlock,
+        Name::LaneInner,
+        Name::Load,
+        Name::GBuffer,
+        Name::Out,
+        Name::Operand,
+        Name::Ddx,
+        Name::Ddy,
+        Name::SelectMatrix,
+        Name::User,
+    ];
+
+    /// What every member's name starts with.
+    pub(super) const fn prefix(self) -> &'static str {
+        match self {
+            Name::Eval => "mrsl_eval_",
+            Name::Val => "mrsl_val_",
+            Name::At => "mrsl_at_",
+            Name::RefineFlag => "mrsl_r_",
+            Name::Refined => "mrsl_r",
+            Name::FlagWord => "mrsl_flags",
+            Name::RecordWord => "mrsl_w",
+            Name::Resolve => "mrsl_resolve",
+            Name::Resample => "mrsl_resample",
+            Name::Get => "mrsl_get",
+            Name::RecordGet => "mrsl_hget_",
+            Name::RecordPut => "mrsl_hput_",
+            Name::Reconstruct => "mrsl_reconstruct_",
+            Name::CompactValues => "mrsl_cv_",
+            Name::Todo => "mrsl_todo_",
+            Name::LaneValue => "mrsl_v",
+            Name::LanePos => "mrsl_pos",
+            Name::LaneIn => "mrsl_in",
+            Name::LaneBlock => "mrsl_b",
+            Name::LaneInner => "mrsl_inner",
+            Name::Load => "mrsl_load_",
+            Name::GBuffer => "mrsl_gb_",
+            Name::Out => "mrsl_out_",
+            Name::Operand => "mrsl_d",
+            Name::Ddx => "mrsl_ddx_",
+            Name::Ddy => "mrsl_ddy_",
+            Name::SelectMatrix => "mrsl_select_m",
+            Name::User => "mrsl_user_",
+        }
+    }
+
+    /// The member named by `part`: `<prefix><part>` (`mrsl_eval_shade`, `mrsl_w3`).
+    pub(super) fn of(self, part: impl Display) -> String {
+        format!("{}{part}", self.prefix())
+    }
+
+    /// The member of `group` named by `part`: `<prefix><group>_<part>` (a
+    /// level's suffix, a lane's pixel, then an effect: `mrsl_resample2_ao`, `mrsl_v1_ao`).
+    pub(super) fn within(self, group: impl Display, part: impl Display) -> String {
+        format!("{}{group}_{part}", self.prefix())
+    }
+}
+
+// ---- Fixed names the writers write ----------------------------------------------
+
+/// The position an invocation or function evaluates at (a coarse sample or a pixel).
+pub(super) const POS: &str = "mrsl_pos";
+/// The first pixel of a fine kernel's lane.
+pub(super) const FIRST: &str = "mrsl_first";
+/// Whether a compacted fine pass's pixel lies inside the image.
+pub(super) const IN: &str = "mrsl_in";
+/// `mrsl_grid()`: the positions of the kernel.
+pub(super) const GRID: &str = "mrsl_grid";
+/// `mrsl_tile_pixel(wg, li)`: the pixel of a lane of a tile.
+pub(super) const TILE_PIXEL: &str = "mrsl_tile_pixel";
+/// The control block (`MrslControl`).
+pub(super) const CONTROL: &str = "mrsl_ctl";
+/// The user uniforms (`MrslUniforms`).
+pub(super) const UNIFORMS: &str = "mrsl_u";
+/// Whether the runtime forces refinement, in a coarse kernel.
+pub(super) const FORCE: &str = "mrsl_force";
+/// The refine flag parameter of `mrsl_eval_<effect>`.
+pub(super) const REFINE: &str = "mrsl_refine";
+/// A coarse invocation's sample (`global_invocation_id`) and the sample grid.
+pub(super) const GID: &str = "mrsl_gid";
+pub(super) const SAMPLES: &str = "mrsl_n";
+/// Where a coarse sample's record starts in an interface buffer.
+pub(super) const RECORD: &str = "mrsl_rec";
+/// The per-pixel entry points' workgroup and lane (`local_invocation_index`).
+pub(super) const WORKGROUP: &str = "mrsl_wg";
+pub(super) const LANE: &str = "mrsl_li";
+/// The per-workgroup statistics counters.
+pub(super) const WORKGROUP_STATS: &str = "mrsl_wg_stats";
+
+/// A pixel's resolved block at a fine kernel's (first) level (`MrslBlock`).
+pub(super) const BLOCK: &str = "mrsl_b";
+/// A pixel's resolved block at the dynamic mode's inner level.
+pub(super) const INNER_BLOCK: &str = "mrsl_b2";
+/// The innermost level a pixel resolved, whose refined effects it counts.
+pub(super) const LAST_BLOCK: &str = "mrsl_last";
+/// The corners of a lane's block (`MrslCorners`), and the function that loads them.
+pub(super) const CORNERS: &str = "mrsl_c";
+pub(super) const LOAD_CORNERS: &str = "mrsl_corners";
+/// `mrsl_is_refined(b, k)`: whether block `b` evaluates coarse effect `k` per pixel.
+pub(super) const IS_REFINED: &str = "mrsl_is_refined";
+/// In the effect-major fine kernel: the lane's pixel being evaluated.
+pub(super) const LANE_PIXEL: &str = "mrsl_k";
+/// The records of the coarse samples (one level, or the dynamic mode's inner level).
+pub(super) const INTERFACE: &str = "mrsl_interface";
+pub(super) const INTERFACE2: &str = "mrsl_interface2";
+/// The records of the dynamic mode's outer level, as its inner coarse kernel reads them.
+pub(super) const PARENT: &str = "mrsl_parent";
+/// The neighbour values of the block coarse kernel (layout `neighbours`).
+pub(super) const NEIGHBOURS: &str = "mrsl_neighbours";
+
+/// The compacted fine pass's lists per coarse effect, their counts, the
+/// pixels' blocks, and a listed pixel.
+pub(super) const COMPACT_LISTS: &str = "mrsl_cq";
+pub(super) const COMPACT_COUNTS: &str = "mrsl_cq_n";
+pub(super) const COMPACT_BLOCKS: &str = "mrsl_cb";
+pub(super) const LISTED: &str = "mrsl_q";
+
+/// A per-pixel record's word, read and written (record modes).
+pub(super) const WORD: &str = "mrsl_word";
+pub(super) const SET_WORD: &str = "mrsl_set_word";
+/// `mrsl_count(start, step, extent)`: a hierarchical lattice's points along an axis.
+pub(super) const COUNT: &str = "mrsl_count";
+
+/// The words of one record, and the coarse kernels' block size.
+pub(super) const STRIDE: &str = "MRSL_STRIDE";
+pub(super) const BLOCK_SIZE: &str = "MRSL_BLOCK";
+/// The structures of a resolved block and of a block's corners.
+pub(super) const BLOCK_STRUCT: &str = "MrslBlock";
+pub(super) const CORNERS_STRUCT: &str = "MrslCorners";
+
+/// Every fixed name: the constants above, and the names only templates
+/// write, by template. A template may use no other `mrsl_` name but a
+/// family's prefix.
+#[cfg_attr(not(test), expect(dead_code, reason = "read by the tests"))]
+pub(super) const FIXED: &[&str] = &[
+    POS,
+    FIRST,
+    IN,
+    GRID,
+    TILE_PIXEL,
+    CONTROL,
+    UNIFORMS,
+    FORCE,
+    REFINE,
+    GID,
+    SAMPLES,
+    RECORD,
+    WORKGROUP,
+    LANE,
+    WORKGROUP_STATS,
+    BLOCK,
+    INNER_BLOCK,
+    LAST_BLOCK,
+    CORNERS,
+    LOAD_CORNERS,
+    IS_REFINED,
+    LANE_PIXEL,
+    INTERFACE,
+    INTERFACE2,
+    PARENT,
+    NEIGHBOURS,
+    COMPACT_LISTS,
+    COMPACT_COUNTS,
+    COMPACT_BLOCKS,
+    LISTED,
+    WORD,
+    SET_WORD,
+    COUNT,
+    STRIDE,
+    BLOCK_SIZE,
+    BLOCK_STRUCT,
+    CORNERS_STRUCT,
+    // resources.wgsl, uniforms.wgsl, stats.wgsl, positions.wgsl: bindings and position helpers
+    "MrslControl",
+    "MrslUniforms",
+    "mrsl_stats",
+    "mrsl_rate",
+    "mrsl_pixel",
+    "mrsl_pair_x",
+    "mrsl_pair_y",
+    // derivative.wgsl, derivative_both.wgsl: the operand here, at the pair's other position
+    "mrsl_here",
+    "mrsl_there",
+    "mrsl_second",
+    "mrsl_difference",
+    // dynamic_gate.wgsl, parent_refined.wgsl, any_refined.wgsl, resolve_inner.wgsl
+    "mrsl_parent_refined",
+    "mrsl_any_refined",
+    // records.wgsl, record_binding.wgsl, hierarchical_*.wgsl, level*.wgsl, shade.wgsl, classify.wgsl
+    "mrsl_values",
+    "mrsl_work",
+    "mrsl_queue",
+    "mrsl_args",
+    "mrsl_work_offset",
+    "mrsl_shade",
+    "mrsl_classify",
+    "mrsl_mask",
+    // checkerboard_*.wgsl, taps.wgsl
+    "mrsl_qx",
+    "mrsl_qy",
+    "mrsl_shaded_quad",
+    "mrsl_taps",
+    "mrsl_ok",
+    "mrsl_alone",
+    "mrsl_shaded",
+    // rate_*.wgsl: the shading-rate image, the tiles, the sample list
+    "mrsl_shading_rate",
+    "mrsl_tile_rate",
+    "mrsl_tile_count",
+    "mrsl_rate_corner",
+    "mrsl_sample_pixel",
+    "mrsl_axis_count",
+    "mrsl_axis_at",
+    "mrsl_cell",
+    "mrsl_cell_of",
+    "mrsl_list",
+    "mrsl_packed",
+];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::BTreeSet;
+    use std::path::Path;
+
+    /// Where a generated name starts: `mrsl_`, `Mrsl` before a capital, `MRSL_`.
+    fn starts_name(text: &str) -> bool {
+        text.starts_with("mrsl_")
+            || text.starts_with("MRSL_")
+            || text.strip_prefix("Mrsl").is_some_and(|rest| rest.starts_with(|c: char| c.is_ascii_uppercase()))
+    }
+
+    fn is_ident(c: char) -> bool {
+        c.is_ascii_alphanumeric() || c == '_'
+    }
+
+    /// The generated names in `text`, each whole (an identifier's run of characters).
+    fn names_in(text: &str) -> Vec<&str> {
+        let mut names = vec![];
+        let mut rest = text;
+        while let Some(start) = rest.find(['m', 'M']) {
+            let before = text.len() - rest.len() + start;
+            let at = &rest[start..];
+            let len = at.find(|c: char| !is_ident(c)).unwrap_or(at.len());
+            let preceded = text[..before].chars().next_back().is_some_and(is_ident);
+            if !preceded && starts_name(at) {
+                names.push(&at[..len]);
+            }
+            rest = &at[len.max(1)..];
+        }
+        names
+    }
+
+    /// The names of `text` that this module does not declare: neither a
+    /// fixed name nor a family's prefix (written before a placeholder or a
+    /// `<part>` of prose).
+    fn undeclared(text: &str) -> BTreeSet<String> {
+        let prefixes: BTreeSet<&str> = Name::ALL.iter().map(|n| n.prefix()).collect();
+        names_in(text).into_iter().filter(|n| !FIXED.contains(n) && !prefixes.contains(n)).map(String::from).collect()
+    }
+
+    fn files(dir: &Path, ext: &str) -> Vec<(String, String)> {
+        let mut files: Vec<(String, String)> = std::fs::read_dir(dir)
+            .expect("the directory exists")
+            .map(|entry| entry.expect("a directory entry").path())
+            .filter(|p| p.extension().is_some_and(|e| e == ext))
+            .map(|p| {
+                let text = std::fs::read_to_string(&p).expect("a readable file");
+                (p.file_name().expect("a file name").to_string_lossy().into_owned(), text)
+            })
+            .collect();
+        files.sort();
+        files
+    }
+
+    fn codegen_dir() -> std::path::PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("src/codegen")
+    }
+
+    #[test]
+    fn templates_use_declared_names() {
+        let templates = files(&codegen_dir().join("templates"), "wgsl");
+        assert!(templates.len() > 50, "the templates are found");
+        let wrong: Vec<String> = templates
+            .iter()
+            .filter_map(|(file, text)| {
+                let names = undeclared(text);
+                (!names.is_empty()).then(|| format!("{file}: {}", names.into_iter().collect::<Vec<_>>().join(", ")))
+            })
+            .collect();
+        assert!(wrong.is_empty(), "templates use names codegen/names.rs does not declare:\n{}", wrong.join("\n"));
+    }
+
+    /// The string literals of Rust source `text`, outside comments.
+    fn string_literals(text: &str) -> Vec<&str> {
+        let mut literals = vec![];
+        let bytes = text.as_bytes();
+        let mut k = 0;
+        while k < bytes.len() {
+            match bytes[k] {
+                b'/' if bytes.get(k + 1) == Some(&b'/') => {
+                    k += text[k..].find('\n').unwrap_or(text.len() - k);
+                }
+                b'\'' if bytes.get(k + 2) == Some(&b'\'') || bytes.get(k + 1) == Some(&b'\\') => {
+                    // A character literal, which may be `'"'`.
+                    k += text[k + 1..].find('\'').map_or(1, |end| end + 2);
+                }
+                b'"' => {
+                    let start = k + 1;
+                    k = start;
+                    while k < bytes.len() && bytes[k] != b'"' {
+                        k += if bytes[k] == b'\\' { 2 } else { 1 };
+                    }
+                    literals.push(&text[start..k.min(text.len())]);
+                    k += 1;
+                }
+                _ => k += 1,
+            }
+        }
+        literals
+    }
+
+    #[test]
+    fn writers_make_names_here() {
+        let wrong: Vec<String> = files(&codegen_dir(), "rs")
+            .iter()
+            .filter(|(file, _)| file != "names.rs")
+            .flat_map(|(file, text)| {
+                string_literals(text)
+                    .into_iter()
+                    .flat_map(names_in)
+                    .map(move |name| format!("{file}: {name}"))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        assert!(
+            wrong.is_empty(),
+            "writers spell generated names; make them in codegen/names.rs:\n{}",
+            wrong.join("\n")
+        );
+    }
+
+    #[test]
+    fn names_are_distinct() {
+        let fixed: BTreeSet<&str> = FIXED.iter().copied().collect();
+        assert_eq!(fixed.len(), FIXED.len(), "a fixed name is declared twice");
+        let prefixes: BTreeSet<&str> = Name::ALL.iter().map(|n| n.prefix()).collect();
+        assert_eq!(prefixes.len(), Name::ALL.len(), "two families share a prefix");
+        assert!(FIXED.iter().chain(&prefixes).all(|n| starts_name(n)), "every name is in the generated namespace");
+        assert_eq!(
+            names_in("let mrsl_b = mrsl_resolve{{S}}(mrsl_pos); // `Mrsl` mrslc xmrsl_a"),
+            ["mrsl_b", "mrsl_resolve", "mrsl_pos"]
+        );
+        assert_eq!(string_literals("f(\"a\\\"b\", '\"'); // \"c\"\n\"d\""), ["a\\\"b", "d"]);
+    }
+}
