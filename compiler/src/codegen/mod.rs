@@ -37,16 +37,17 @@
 //! their entry points. See docs/language.md, "What the kernels do".
 //!
 //! The modules, from shared to specific: [`writer`] (the text, and fixed WGSL
-//! from `templates/*.wgsl`), [`body`] (user statements and expressions),
-//! [`words`] (values as `u32` words), [`effects`] (what every kernel
-//! declares: bindings, loaders, effect functions, derivatives, key tests),
-//! [`pixel`] (per-pixel entry points), [`fine`] (what the fine kernels of
-//! every family share: levels, resolvers as data, refine decisions,
-//! resamplers), then one module per kernel family: [`block`] (coarse, fine,
-//! reference), [`compact`] (the block fine kernel's compacted entry point),
-//! [`dynamic`], [`rate`] (the rate-image mode's coarse and fine kernels),
-//! [`records`] (what the hierarchical and checkerboard modes share),
-//! [`hierarchical`] and [`checkerboard`].
+//! from `templates/*.wgsl`), [`names`] (every generated name, and the tests
+//! that hold the writers and templates to them), [`body`] (user statements
+//! and expressions), [`words`] (values as `u32` words), [`effects`] (what
+//! every kernel declares: bindings, loaders, effect functions, derivatives,
+//! key tests), [`pixel`] (per-pixel entry points), [`fine`] (what the fine
+//! kernels of every family share: levels, resolvers as data, refine
+//! decisions, resamplers), then one module per kernel family: [`block`]
+//! (coarse, fine, reference), [`compact`] (the block fine kernel's compacted
+//! entry point), [`dynamic`], [`rate`] (the rate-image mode's coarse and fine
+//! kernels), [`records`] (what the hierarchical and checkerboard modes
+//! share), [`hierarchical`] and [`checkerboard`].
 
 mod block;
 mod body;

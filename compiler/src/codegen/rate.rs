@@ -123,10 +123,11 @@ impl Writer<'_, '_, '_> {
     pub(super) fn rate_resolve_function(&mut self, r: &Resolver) {
         let [head, corners, refined] = cut(include_str!("templates/rate_resolve.wgsl"), &["CORNERS", "REFINED"]);
         self.template(0, head, &[("SUFFIX", &r.name)]);
+        let samples = CORNER_SAMPLES.len() + OTHER_SAMPLES.len();
         for key in self.keys_of(&r.coarse) {
             let name = key.name;
             let mut tests: Vec<String> =
-                (0..8).map(|s| key.differs(&format!("k_{name}"), &format!("k{s}_{name}"))).collect();
+                (0..samples).map(|s| key.differs(&format!("k_{name}"), &format!("k{s}_{name}"))).collect();
             tests.extend((1..4).map(|s| key.differs(&format!("k0_{name}"), &format!("k{s}_{name}"))));
             self.template(
                 0,
@@ -153,11 +154,11 @@ impl Writer<'_, '_, '_> {
             self.line(1, "}");
         }
         self.template(0, corners, &[]);
-        self.refine_decisions(r, CORNER_SAMPLES.len() + OTHER_SAMPLES.len(), &|w, e| w.discontinuity(e));
+        self.refine_decisions(r, samples, &|w, e| w.discontinuity(e));
         self.template(0, refined, &[]);
     }
 
-    /// `rate_fine_main`: per pixel of a tile in 4x4 blocks. A cell is at
+    /// `rate_fine`, the entry point: per pixel of a tile in 4x4 blocks. A cell is at
     /// most 4x4 pixels, so 4x4 blocks keep a cell's pixels on neighbouring lanes.
     pub(super) fn rate_fine_entry(&mut self) {
         self.tile_pixel_blocks(4, 1);
