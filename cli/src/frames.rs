@@ -10,8 +10,9 @@
 //! reference, and the temporal-stability figure) go to `STEM.frames.json`.
 
 use crate::legend::{self, Legend};
-use crate::render::{BoundScene, PAIRS, RenderArgs, Resources, median, save_output, time_run, to_srgb8};
+use crate::render::{BoundScene, PAIRS, RenderArgs, Resources, median, save_output, time_run};
 use mrsl_abi::ShadingRate;
+use mrsl_lab::color::linear_to_srgb8;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::metrics::Metrics;
 use mrsl_lab::raster::Camera;
@@ -458,7 +459,7 @@ fn save_rates(
     let columns = size.0.div_ceil(tile);
     let image = image::RgbImage::from_fn(size.0, size.1, |x, y| {
         let p = pixels.get((y * size.0 + x) as usize).copied().unwrap_or([0.0; 4]);
-        let dimmed = [0, 1, 2].map(|c| to_srgb8(p[c]) / 2);
+        let dimmed = [0, 1, 2].map(|c| linear_to_srgb8(p[c]) / 2);
         let rate = tiles.get(((y / tile) * columns + x / tile) as usize).copied().unwrap_or(ShadingRate::R1x1);
         image::Rgb(match legend::rate_color(rate) {
             None => dimmed,

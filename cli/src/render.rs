@@ -4,6 +4,7 @@
 use crate::legend::{self, Legend};
 use mrsl::Options;
 use mrsl_lab::camera_path::CameraPath;
+use mrsl_lab::color::linear_to_srgb8;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::mesh_scene::MeshScene;
 use mrsl_lab::scene::Scene;
@@ -534,13 +535,6 @@ fn checker_texture(gpu: &Gpu) -> wgpu::Texture {
     gpu.texture_with_data("checker", (n, n), wgpu::TextureFormat::Rgba8UnormSrgb, &data)
 }
 
-/// Linear [0, 1] to an 8-bit sRGB value (the outputs are linear radiance).
-pub(crate) fn to_srgb8(v: f32) -> u8 {
-    let v = if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 };
-    let s = if v <= 0.0031308 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
-    (s * 255.0 + 0.5) as u8
-}
-
 pub(crate) fn save_output(gpu: &Gpu, texture: &wgpu::Texture, path: &Path) -> Result<(), String> {
     let (w, h) = (texture.width(), texture.height());
     let bytes = gpu.read_texture(texture).map_err(|e| e.to_string())?;
@@ -561,7 +555,11 @@ pub(crate) fn save_output(gpu: &Gpu, texture: &wgpu::Texture, path: &Path) -> Re
     };
     let mut img = image::RgbaImage::new(w, h);
     for (i, p) in pixels.iter().enumerate() {
-        img.put_pixel(i as u32 % w, i as u32 / w, image::Rgba([to_srgb8(p[0]), to_srgb8(p[1]), to_srgb8(p[2]), 255]));
+        img.put_pixel(
+            i as u32 % w,
+            i as u32 / w,
+            image::Rgba([linear_to_srgb8(p[0]), linear_to_srgb8(p[1]), linear_to_srgb8(p[2]), 255]),
+        );
     }
     img.save(path).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }

@@ -28,6 +28,7 @@
 //! `runtime_dir` on none.
 
 pub mod camera_path;
+pub mod color;
 pub mod gbuffer;
 pub mod gpu;
 pub mod image_texture;

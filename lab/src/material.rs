@@ -10,6 +10,7 @@
 //! encoded bytes would darken every minified texture) and renormalising the
 //! vectors of normal maps.
 
+use crate::color::{linear_to_srgb8, srgb_to_linear};
 use std::sync::Arc;
 
 /// How a texture repeats outside [0, 1] (glTF's sampler wrap modes).
@@ -191,19 +192,6 @@ pub enum TexelEncoding {
     Normal,
 }
 
-/// sRGB-encoded byte to linear light (the exact curve of IEC 61966-2-1).
-pub fn srgb_to_linear(byte: u8) -> f32 {
-    let s = byte as f32 / 255.0;
-    if s <= 0.04045 { s / 12.92 } else { ((s + 0.055) / 1.055).powf(2.4) }
-}
-
-/// Linear light in [0, 1] to the nearest sRGB-encoded byte.
-pub fn linear_to_srgb(v: f32) -> u8 {
-    let v = v.clamp(0.0, 1.0);
-    let s = if v <= 0.0031308 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
-    (s * 255.0 + 0.5) as u8
-}
-
 /// Every mip level of `image`, level 0 first, down to 1x1: each level's
 /// texel is the average of the 2x2 texels below it (a 2x1 or 1x2 pair, or
 /// one texel, where a side is already 1; the last row or column of an odd
@@ -223,7 +211,7 @@ pub fn mip_chain(image: &TextureImage, encoding: TexelEncoding) -> Vec<(u32, u32
     let encode = |v: [f32; 4]| -> [u8; 4] {
         let unorm = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
         match encoding {
-            TexelEncoding::Srgb => [linear_to_srgb(v[0]), linear_to_srgb(v[1]), linear_to_srgb(v[2]), unorm(v[3])],
+            TexelEncoding::Srgb => [linear_to_srgb8(v[0]), linear_to_srgb8(v[1]), linear_to_srgb8(v[2]), unorm(v[3])],
             TexelEncoding::Linear => v.map(unorm),
             TexelEncoding::Normal => {
                 let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
@@ -282,14 +270,6 @@ fn span(i: u32, n: u32, source: u32) -> std::ops::Range<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn srgb_round_trips_every_byte() {
-        for b in 0..=255u8 {
-            assert_eq!(linear_to_srgb(srgb_to_linear(b)), b);
-        }
-        assert!((srgb_to_linear(188) - 0.5029).abs() < 1e-3);
-    }
 
     #[test]
     fn a_black_and_white_checker_minifies_to_half_linear_light() {

@@ -56,12 +56,13 @@
 //!
 //! [`flip`] is NVIDIA's LDR-FLIP (Andersson et al., HPG 2020; v1.7) through the `flip-rs` crate, a pure-Rust port
 //! verified against NVIDIA's C++ code. LDR-FLIP expects sRGB-encoded 8-bit images, so both images are first
-//! converted as a display would show them ([`linear_to_srgb8`]): each linear channel clamped to `[0, 1]`, encoded
-//! with the sRGB transfer function, and rounded to the nearest of 256 levels. Values above 1 therefore count as 1
-//! (use HDR-FLIP for HDR comparisons; not exposed here). The viewing condition is FLIP's default, [`DEFAULT_PPD`]
-//! (about 67 pixels per degree: a 0.7 m wide 3840-pixel monitor at 0.7 m); [`flip_with_ppd`] takes another. The
-//! result is the per-pixel error map ([`FlipMap`], values in `[0, 1]`) and its mean, pooled as FLIP's tool does
-//! (in `f32`). `flip-rs` is used without its `parallel` feature, so it runs on one thread.
+//! converted as a display would show them ([`linear_to_srgb8_f64`]: the PNGs' encoding, evaluated in `f64`): each
+//! linear channel clamped to `[0, 1]`, encoded with the sRGB transfer function, and rounded to the nearest of 256
+//! levels. Values above 1 therefore count as 1 (use HDR-FLIP for HDR comparisons; not exposed here). The viewing
+//! condition is FLIP's default, [`DEFAULT_PPD`] (about 67 pixels per degree: a 0.7 m wide 3840-pixel monitor at
+//! 0.7 m); [`flip_with_ppd`] takes another. The result is the per-pixel error map ([`FlipMap`], values in `[0, 1]`)
+//! and its mean, pooled as FLIP's tool does (in `f32`). `flip-rs` is used without its `parallel` feature, so it
+//! runs on one thread.
 //!
 //! # Error image
 //!
@@ -75,6 +76,7 @@
 //!
 //! [`compare`] validates once and returns a serialisable [`Metrics`] with RMSE, PSNR, MSSIM and mean FLIP.
 
+use crate::color::linear_to_srgb8_f64;
 use serde::Serialize;
 
 /// FLIP's default viewing condition in pixels per degree (about 67.02).
@@ -273,14 +275,6 @@ pub fn flip_with_ppd(
     Pair::new(test, reference, width, height)?.flip(ppd)
 }
 
-/// A linear channel as an 8-bit sRGB code: clamp to `[0, 1]`, sRGB transfer function, round to nearest.
-pub fn linear_to_srgb8(v: f32) -> u8 {
-    let v = f64::from(v.clamp(0.0, 1.0));
-    let s = if v <= 0.0031308 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
-    // In [0, 255.5) for v in [0, 1]; `as` saturates (and maps a NaN, which validation excludes, to 0).
-    (s * 255.0 + 0.5) as u8
-}
-
 /// The colour-mapped error image: per pixel `clamp(scale * mean_c |test_c - reference_c|, 0, 1)` through Magma,
 /// as opaque sRGB RGBA8 bytes (`4 * width * height`).
 pub fn error_image(
@@ -349,7 +343,7 @@ impl<'a> Pair<'a> {
     fn flip(&self, ppd: f32) -> Result<FlipMap, MetricsError> {
         let (w, h) = (self.width as usize, self.height as usize);
         let srgb8 = |pixels: &[[f32; 4]]| {
-            let bytes = pixels.iter().flat_map(|p| [p[0], p[1], p[2]].map(linear_to_srgb8)).collect();
+            let bytes = pixels.iter().flat_map(|p| [p[0], p[1], p[2]].map(linear_to_srgb8_f64)).collect();
             flip_rs::RgbImage::new(w, h, bytes).map_err(flip_error)
         };
         let map = flip_rs::ldr_flip(&srgb8(self.reference)?, &srgb8(self.test)?, ppd).map_err(flip_error)?;

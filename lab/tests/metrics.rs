@@ -229,13 +229,13 @@ fn rmse_psnr_closed_forms() {
 
 #[test]
 fn srgb_encoding() {
-    assert_eq!(metrics::linear_to_srgb8(0.0), 0);
-    assert_eq!(metrics::linear_to_srgb8(-3.0), 0);
-    assert_eq!(metrics::linear_to_srgb8(1.0), 255);
-    assert_eq!(metrics::linear_to_srgb8(7.0), 255);
-    assert_eq!(metrics::linear_to_srgb8(0.5), 188); // 1.055 * 0.5^(1/2.4) - 0.055 = 0.7354
-    assert_eq!(metrics::linear_to_srgb8(0.18), 118); // middle grey
-    assert_eq!(metrics::linear_to_srgb8(0.002), 7); // linear segment: 12.92 * 0.002 * 255 = 6.59
+    assert_eq!(mrsl_lab::color::linear_to_srgb8_f64(0.0), 0);
+    assert_eq!(mrsl_lab::color::linear_to_srgb8_f64(-3.0), 0);
+    assert_eq!(mrsl_lab::color::linear_to_srgb8_f64(1.0), 255);
+    assert_eq!(mrsl_lab::color::linear_to_srgb8_f64(7.0), 255);
+    assert_eq!(mrsl_lab::color::linear_to_srgb8_f64(0.5), 188); // 1.055 * 0.5^(1/2.4) - 0.055 = 0.7354
+    assert_eq!(mrsl_lab::color::linear_to_srgb8_f64(0.18), 118); // middle grey
+    assert_eq!(mrsl_lab::color::linear_to_srgb8_f64(0.002), 7); // linear segment: 12.92 * 0.002 * 255 = 6.59
 }
 
 /// Values chosen so that no Magma index falls on a rounding boundary.

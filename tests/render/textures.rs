@@ -7,8 +7,8 @@
 
 use crate::sponza::{base64, floats, temp_dir};
 use crate::{Output, compile, worst_ulps};
+use mrsl_lab::color::srgb_to_linear;
 use mrsl_lab::gpu::Gpu;
-use mrsl_lab::material::srgb_to_linear;
 use mrsl_lab::mesh::{Mesh, MeshWarning};
 use mrsl_lab::mesh_scene::MeshScene;
 use mrsl_lab::raster::{self, Camera};
