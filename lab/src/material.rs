@@ -2,15 +2,10 @@
 //! them: a base colour, roughness and metalness (each a factor, optionally
 //! times a texture), and an optional tangent-space normal map — glTF 2.0's
 //! metallic-roughness model, which OBJ/MTL materials are mapped onto (see
-//! docs/scenes.md, "Materials and textures").
-//!
-//! Textures are decoded here (PNG, JPEG and TGA, through `image`) into 8-bit
-//! RGBA as their files store them; [`mip_chain`] makes their mipmaps on the
-//! CPU, averaging in linear light for sRGB-encoded base colours (averaging the
-//! encoded bytes would darken every minified texture) and renormalising the
-//! vectors of normal maps.
+//! docs/scenes.md, "Materials and textures"). The textures are
+//! [`TextureImage`]s, decoded and given mipmaps by [`crate::image_texture`].
 
-use crate::color::{linear_to_srgb8, srgb_to_linear};
+use crate::image_texture::TextureImage;
 use std::sync::Arc;
 
 /// How a texture repeats outside [0, 1] (glTF's sampler wrap modes).
@@ -20,50 +15,6 @@ pub enum Wrap {
     Repeat,
     MirroredRepeat,
     ClampToEdge,
-}
-
-/// A decoded texture: 8-bit RGBA texels, rows top to bottom, exactly as the
-/// file stores them (sRGB-encoded or linear is decided by the slot it fills).
-#[derive(Clone, PartialEq)]
-pub struct TextureImage {
-    pub width: u32,
-    pub height: u32,
-    /// `4 * width * height` bytes.
-    pub rgba: Vec<u8>,
-    /// Where it came from (a file name or `image N`), for messages.
-    pub source: String,
-}
-
-impl std::fmt::Debug for TextureImage {
-    // The texels would drown any message that prints a mesh.
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "TextureImage({}, {}x{})", self.source, self.width, self.height)
-    }
-}
-
-impl TextureImage {
-    /// Decodes a PNG, JPEG or TGA file's bytes (the format is sniffed from
-    /// the content; `hint`, a file name, settles TGA, which has no signature).
-    pub fn decode(bytes: &[u8], source: &str) -> Result<TextureImage, String> {
-        let format = image::guess_format(bytes).ok().or_else(|| image::ImageFormat::from_path(source).ok());
-        let decoded = match format {
-            Some(format) => image::load_from_memory_with_format(bytes, format),
-            None => image::load_from_memory(bytes),
-        }
-        .map_err(|e| e.to_string())?;
-        let rgba = decoded.to_rgba8();
-        let (width, height) = rgba.dimensions();
-        if width == 0 || height == 0 {
-            return Err("the image is empty".into());
-        }
-        Ok(TextureImage { width, height, rgba: rgba.into_raw(), source: source.to_string() })
-    }
-
-    /// Reads and decodes an image file.
-    pub fn load(path: &std::path::Path) -> Result<TextureImage, String> {
-        let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
-        TextureImage::decode(&bytes, &path.display().to_string())
-    }
 }
 
 /// A surface material (glTF 2.0's metallic-roughness model). Each texture,
@@ -181,137 +132,9 @@ fn texture_file_name(statement: &str) -> &str {
     if statement.starts_with('-') { statement.split_whitespace().last().unwrap_or(statement) } else { statement }
 }
 
-/// How a texture's texels are encoded, which decides how its mipmaps are averaged.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum TexelEncoding {
-    /// sRGB-encoded RGB, linear alpha (base colour).
-    Srgb,
-    /// Linear values (metallic-roughness).
-    Linear,
-    /// Unit vectors encoded as `n * 0.5 + 0.5` (normal maps): averaged, then renormalised.
-    Normal,
-}
-
-/// Every mip level of `image`, level 0 first, down to 1x1: each level's
-/// texel is the average of the 2x2 texels below it (a 2x1 or 1x2 pair, or
-/// one texel, where a side is already 1; the last row or column of an odd
-/// side is folded into its neighbour's average). RGBA bytes per level.
-pub fn mip_chain(image: &TextureImage, encoding: TexelEncoding) -> Vec<(u32, u32, Vec<u8>)> {
-    let decode = |t: &[u8]| -> [f32; 4] {
-        match encoding {
-            TexelEncoding::Srgb => {
-                [srgb_to_linear(t[0]), srgb_to_linear(t[1]), srgb_to_linear(t[2]), t[3] as f32 / 255.0]
-            }
-            TexelEncoding::Linear => std::array::from_fn(|c| t[c] as f32 / 255.0),
-            TexelEncoding::Normal => {
-                std::array::from_fn(|c| if c < 3 { t[c] as f32 / 255.0 * 2.0 - 1.0 } else { t[c] as f32 / 255.0 })
-            }
-        }
-    };
-    let encode = |v: [f32; 4]| -> [u8; 4] {
-        let unorm = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
-        match encoding {
-            TexelEncoding::Srgb => [linear_to_srgb8(v[0]), linear_to_srgb8(v[1]), linear_to_srgb8(v[2]), unorm(v[3])],
-            TexelEncoding::Linear => v.map(unorm),
-            TexelEncoding::Normal => {
-                let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-                let n = if l > 1e-6 { [v[0] / l, v[1] / l, v[2] / l] } else { [0.0, 0.0, 1.0] };
-                [unorm(n[0] * 0.5 + 0.5), unorm(n[1] * 0.5 + 0.5), unorm(n[2] * 0.5 + 0.5), unorm(v[3])]
-            }
-        }
-    };
-    let (mut w, mut h) = (image.width, image.height);
-    let mut level: Vec<[f32; 4]> = image.rgba.chunks_exact(4).map(decode).collect();
-    let mut out = vec![(w, h, image.rgba.clone())];
-    while w > 1 || h > 1 {
-        let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
-        let mut next = Vec::with_capacity((nw * nh) as usize);
-        for y in 0..nh {
-            // Source rows and columns of this texel: two each, three for the
-            // last of an odd side (so no source texel is dropped).
-            let rows = span(y, nh, h);
-            for x in 0..nw {
-                let cols = span(x, nw, w);
-                let mut sum = [0.0f32; 4];
-                let mut count = 0.0;
-                for sy in rows.clone() {
-                    for sx in cols.clone() {
-                        let t = level[(sy * w + sx) as usize];
-                        for c in 0..4 {
-                            sum[c] += t[c];
-                        }
-                        count += 1.0;
-                    }
-                }
-                next.push(sum.map(|s| s / count));
-            }
-        }
-        // Each level is encoded from the one above's full-precision values,
-        // so rounding does not accumulate down the chain.
-        let bytes: Vec<u8> = next.iter().flat_map(|&v| encode(v)).collect();
-        out.push((nw, nh, bytes));
-        level = next;
-        (w, h) = (nw, nh);
-    }
-    out
-}
-
-/// The source texels along one axis that texel `i` of a level `n` wide
-/// averages, from a level `source` wide.
-fn span(i: u32, n: u32, source: u32) -> std::ops::Range<u32> {
-    if source == 1 {
-        return 0..1;
-    }
-    let start = 2 * i;
-    let end = if i + 1 == n { source } else { start + 2 };
-    start..end
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn a_black_and_white_checker_minifies_to_half_linear_light() {
-        let n = 8u32;
-        let rgba: Vec<u8> = (0..n * n)
-            .flat_map(|i| {
-                let v = if (i % n + i / n).is_multiple_of(2) { 255 } else { 0 };
-                [v, v, v, 255]
-            })
-            .collect();
-        let image = TextureImage { width: n, height: n, rgba, source: "checker".into() };
-        let chain = mip_chain(&image, TexelEncoding::Srgb);
-        assert_eq!(chain.iter().map(|l| (l.0, l.1)).collect::<Vec<_>>(), [(8, 8), (4, 4), (2, 2), (1, 1)]);
-        // Half the light: sRGB 188, not the 128 that averaging bytes gives.
-        assert!(chain[1].2.chunks_exact(4).all(|t| t == [188, 188, 188, 255]), "{:?}", &chain[1].2[..8]);
-        assert_eq!(&chain[3].2, &[188, 188, 188, 255]);
-    }
-
-    #[test]
-    fn odd_sides_keep_every_texel_and_normals_stay_unit() {
-        // 3x1: one level of 1x1 averaging all three texels.
-        let image = TextureImage {
-            width: 3,
-            height: 1,
-            rgba: vec![0, 0, 0, 0, 30, 0, 0, 0, 60, 0, 0, 0],
-            source: "row".into(),
-        };
-        let chain = mip_chain(&image, TexelEncoding::Linear);
-        assert_eq!(chain.len(), 2);
-        assert_eq!(chain[1].2, vec![30, 0, 0, 0]);
-        // Two normals tilted apart average to +z, renormalised.
-        let a = [(0.6f32 * 0.5 + 0.5) * 255.0, 127.5, (0.8f32 * 0.5 + 0.5) * 255.0].map(|v| v.round() as u8);
-        let b = [(-0.6f32 * 0.5 + 0.5) * 255.0, 127.5, (0.8f32 * 0.5 + 0.5) * 255.0].map(|v| v.round() as u8);
-        let image = TextureImage {
-            width: 2,
-            height: 1,
-            rgba: vec![a[0], a[1], a[2], 255, b[0], b[1], b[2], 255],
-            source: "normals".into(),
-        };
-        let top = &mip_chain(&image, TexelEncoding::Normal)[1].2;
-        assert!((top[0] as i32 - 128).abs() <= 1 && top[2] == 255, "{top:?}");
-    }
 
     #[test]
     fn mtl_statements_map_onto_the_pbr_model() {

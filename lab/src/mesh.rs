@@ -22,7 +22,8 @@ use std::io::{BufRead, Read};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-use crate::material::{Material, TextureImage, Wrap};
+use crate::image_texture::TextureImage;
+use crate::material::{Material, Wrap};
 
 /// Default crease angle (degrees) for computed normals: faces meeting at a
 /// sharper angle keep their own normal, so boxes stay boxes while Sponza's

@@ -17,7 +17,7 @@
 //!
 //! Each material is drawn with its own bind group: its factors and its
 //! textures, sampled with trilinear filtering from mipmaps made on the CPU
-//! ([`crate::material::mip_chain`]); the level of detail comes from the
+//! ([`crate::image_texture::mip_chain`]); the level of detail comes from the
 //! derivatives of uv across each 2x2 pixel quad, as in any geometry pass.
 //! Base colour textures are `Rgba8UnormSrgb`, so the sampler decodes sRGB to
 //! linear before filtering; metallic-roughness and normal maps are linear.
@@ -62,7 +62,8 @@
 
 use crate::gbuffer::{BACKGROUND, ChannelData, GBuffer};
 use crate::gpu::Gpu;
-use crate::material::{Material, TexelEncoding, TextureImage, Wrap, mip_chain};
+use crate::image_texture::{ImageTexture, TexelEncoding, TextureImage};
+use crate::material::{Material, Wrap};
 use crate::mesh::{Bounds, Mesh, MeshError, cross, dot, normalize, sub};
 use wgpu::util::DeviceExt;
 
@@ -841,46 +842,17 @@ impl TextureCache {
             std::collections::hash_map::Entry::Occupied(e) => return Ok(e.into_mut()),
             std::collections::hash_map::Entry::Vacant(e) => e,
         };
-        {
-            let limit = gpu.device.limits().max_texture_dimension_2d;
-            if image.width > limit || image.height > limit {
-                return Err(RasterError::TextureTooLarge {
-                    image: image.source.clone(),
-                    width: image.width,
-                    height: image.height,
-                    limit,
-                });
-            }
-            let levels = mip_chain(image, encoding);
-            let format = match encoding {
-                TexelEncoding::Srgb => wgpu::TextureFormat::Rgba8UnormSrgb,
-                _ => wgpu::TextureFormat::Rgba8Unorm,
-            };
-            let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(&image.source),
-                size: wgpu::Extent3d { width: image.width, height: image.height, depth_or_array_layers: 1 },
-                mip_level_count: levels.len() as u32,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
+        let limit = gpu.device.limits().max_texture_dimension_2d;
+        if image.width > limit || image.height > limit {
+            return Err(RasterError::TextureTooLarge {
+                image: image.source.clone(),
+                width: image.width,
+                height: image.height,
+                limit,
             });
-            for (level, (w, h, bytes)) in levels.iter().enumerate() {
-                gpu.queue.write_texture(
-                    wgpu::TexelCopyTextureInfo {
-                        texture: &texture,
-                        mip_level: level as u32,
-                        origin: wgpu::Origin3d::ZERO,
-                        aspect: wgpu::TextureAspect::All,
-                    },
-                    bytes,
-                    wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * w), rows_per_image: Some(*h) },
-                    wgpu::Extent3d { width: *w, height: *h, depth_or_array_layers: 1 },
-                );
-            }
-            Ok(entry.insert(texture.create_view(&Default::default())))
         }
+        let texture = ImageTexture::new(image, encoding).upload(gpu, &image.source);
+        Ok(entry.insert(texture.create_view(&Default::default())))
     }
 
     fn sampler(&mut self, gpu: &Gpu, wrap: [Wrap; 2]) -> wgpu::Sampler {
