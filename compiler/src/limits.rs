@@ -2,11 +2,14 @@
 //! WGSL compilers take, and every recursive pass of this compiler within its
 //! stack.
 //!
-//! naga, which validates every kernel (and which wgpu runs when a shader is
-//! created), gives up when its parser recurses 200 times: a statement, an
-//! expression and each parenthesised or argument sub-expression count one
-//! level, so no part of a kernel may stand deeper than [`MAX_WGSL_LEVEL`].
-//! WGSL itself allows [`MAX_BRACE_LEVEL`] levels of braces in a function.
+//! The WGSL front ends count levels of nesting as they parse: a statement,
+//! an expression and each parenthesised or argument sub-expression count
+//! one level. naga (which validates every kernel, and which wgpu runs when
+//! a shader is created) gives up at level 200; Tint (Dawn's, so Chrome's)
+//! at level 129, and it allows 126 levels of braces in a function where the
+//! WGSL specification says 127. So no part of a kernel may stand deeper
+//! than [`MAX_WGSL_LEVEL`] or open more than [`MAX_BRACE_LEVEL`] braces:
+//! the strictest of them (`tests/tint` checks every kernel with Tint).
 //! The code generator adds levels of its own (parentheses around every
 //! operator, `select(...)` for `?:`, the braces and `return` of the function
 //! it writes a body into, splats), so the limits are checked here, on the
@@ -39,19 +42,22 @@ use crate::syntax::ast::*;
 use crate::types::{Scalar, Type};
 use std::collections::{HashMap, HashSet};
 
-/// The deepest level naga's WGSL parser accepts: it fails with "Parser
-/// recursion limit exceeded" when its counter reaches 200.
-pub const MAX_WGSL_LEVEL: u32 = 199;
+/// The deepest level both WGSL parsers accept: Tint fails with "maximum
+/// parser recursive depth reached" past level 128 (naga, with "Parser
+/// recursion limit exceeded", past 199).
+pub const MAX_WGSL_LEVEL: u32 = 128;
 
-/// WGSL: "maximum nesting depth of brace-enclosed statements in a function:
-/// 127". The function's own braces are level 1.
-pub const MAX_BRACE_LEVEL: u32 = 127;
+/// The most levels of braces in a function, its own braces being level 1:
+/// Tint's limit ("statement nesting depth / chaining length exceeds limit of
+/// 127" at level 127), one below the WGSL specification's 127.
+pub const MAX_BRACE_LEVEL: u32 = 126;
 
 /// The most nodes on any path through one expression, field accesses
-/// included (which WGSL nests at no cost). Twice [`MAX_WGSL_LEVEL`], so that
-/// it only ever rejects chains of field accesses no program needs, and low
-/// enough that the recursive passes stay small on a 2 MiB stack.
-pub const MAX_EXPR_DEPTH: u32 = 2 * MAX_WGSL_LEVEL;
+/// included (which the parsers nest at no cost, up to Tint's expression
+/// depth of 512). Low enough that the compiler's recursive passes stay small
+/// on a 2 MiB stack, high enough that it only ever rejects chains of field
+/// accesses no program needs.
+pub const MAX_EXPR_DEPTH: u32 = 398;
 
 /// The most expression nodes a derivative operand may expand to once the
 /// definitions of the locals it reads are inlined: each use of a local copies
@@ -263,8 +269,10 @@ fn reach<'e>(
         // A child written `cost` levels below its parent (see codegen::body).
         let mut child = |x: &'e Expr, cost: u32| stack.push((x, level.saturating_add(cost), depth + 1));
         match &e.kind {
-            // `-(x)`, `!(x)`, `~(x)`, and `(x)` for unary `+`.
-            ExprKind::Unary(_, a) => child(a, 1),
+            // `-(x)`, `!(x)`, `~(x)`: Tint counts the operator and the
+            // parenthesis, two levels (naga one); `(x)` for unary `+`.
+            ExprKind::Unary(UnaryOp::Pos, a) => child(a, 1),
+            ExprKind::Unary(_, a) => child(a, 2),
             // `(a op b)`; a shift amount may be converted, `(a << u32(b))`.
             ExprKind::Binary(op, a, b) => {
                 child(a, 1);
@@ -329,7 +337,7 @@ fn call_extra(e: &Expr) -> u32 {
     }
 }
 
-const LEVEL_NOTE: &str = "naga, the WGSL compiler behind wgpu, accepts at most 199 levels of nesting; in the generated \
+const LEVEL_NOTE: &str = "the WGSL compilers accept at most 128 levels of nesting (Tint, Chrome's; naga, wgpu's, 199); in the generated \
      code every operator is parenthesised and every call argument, `?:` operand (written `select(...)`) and index \
      is one level deeper than its expression, and the statements around the expression count as well (see \
      docs/language.md, section 14)";
@@ -367,8 +375,8 @@ fn too_many_braces(s: &Stmt, keyword: &str, level: u32) -> Diagnostic {
     Diagnostic::error("E0603", "blocks nested too deeply")
         .with_label(Label::primary(span, format!("this {what} opens brace level {level} of the generated WGSL")))
         .with_note(
-            "WGSL allows at most 127 levels of braces in a function; the generated function's own braces are \
-             level 1, an effect body is written inside a block at level 2, and each `if`, `else`, `for` and \
+            "WGSL compilers allow at most 126 levels of braces in a function (Tint, Chrome's; the WGSL \
+             specification says 127); the generated function's own braces are level 1, an effect body is written inside a block at level 2, and each `if`, `else`, `for` and \
              `{ }` opens one more level (an `else if` nests inside its `else`)",
         )
         .with_note("combine conditions with `&&`, return early, or move the inner part into a function")
