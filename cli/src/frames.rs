@@ -12,10 +12,10 @@
 use crate::legend::{self, Legend};
 use crate::render::{BoundScene, PAIRS, RenderArgs, Resources, median, save_output, time_run};
 use mrsl_abi::ShadingRate;
+use mrsl_lab::camera::Camera;
 use mrsl_lab::color::linear_to_srgb8;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::metrics::Metrics;
-use mrsl_lab::raster::Camera;
 use mrsl_lab::uniforms::{Offered, Verdict};
 use mrsl_runtime::rate_source::{RateInputs, RateOptions, RateSource, rate_fraction, read_rate_image};
 use mrsl_runtime::{DispatchOptions, Mode, Shader};

@@ -8,7 +8,7 @@
 //! at the parameter t = i / (n − 1), so fewer frames move farther per frame
 //! (and have larger motion vectors).
 
-use crate::raster::Camera;
+use crate::camera::Camera;
 
 /// One keyframe of a [`CameraPath::Keyframes`] path: where the eye is and
 /// what it looks at. Up and field of view come from the scene's camera.

@@ -1,4 +1,5 @@
-//! Device acquisition for tools and tests, and texture upload/readback helpers.
+//! Device acquisition for tools and tests, and texture upload/readback helpers
+//! (the read-back itself is the runtime's).
 
 /// Why no device could be had, or a readback failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -99,51 +100,17 @@ impl Gpu {
         )
     }
 
-    /// Reads a texture back as rows of raw texel bytes, tightly packed.
+    /// Reads a texture back as rows of raw texel bytes, tightly packed
+    /// (the runtime's read-back, [`mrsl_runtime::gpu::read_texture`]).
     pub fn read_texture(&self, texture: &wgpu::Texture) -> Result<Vec<u8>, Error> {
-        let bytes_per_pixel = texture.format().block_copy_size(None).unwrap_or(4);
-        let (width, height) = (texture.width(), texture.height());
-        let row = width * bytes_per_pixel;
-        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("mrsl readback"),
-            size: padded as u64 * height as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        encoder.copy_texture_to_buffer(
-            texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded),
-                    rows_per_image: Some(height),
-                },
-            },
-            texture.size(),
-        );
-        self.queue.submit([encoder.finish()]);
-        let slice = buffer.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Readback(e.to_string()))?;
-        rx.recv().map_err(|e| Error::Readback(e.to_string()))?.map_err(|e| Error::Readback(e.to_string()))?;
-        let view = slice.get_mapped_range().map_err(|e| Error::Readback(e.to_string()))?;
-        let mut out = Vec::with_capacity((row * height) as usize);
-        for y in 0..height as usize {
-            out.extend_from_slice(&view[y * padded as usize..y * padded as usize + row as usize]);
-        }
-        Ok(out)
+        mrsl_runtime::gpu::read_texture(&self.device, &self.queue, texture).map_err(|e| match e {
+            mrsl_runtime::Error::Readback(message) => Error::Readback(message),
+            other => Error::Readback(other.to_string()),
+        })
     }
 
     /// Reads an `rgba32float` texture as RGBA pixels.
     pub fn read_rgba32f(&self, texture: &wgpu::Texture) -> Result<Vec<[f32; 4]>, Error> {
-        let bytes = self.read_texture(texture)?;
-        let floats: Vec<f32> = bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
-        Ok(floats.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect())
+        Ok(bytemuck::pod_collect_to_vec(&self.read_texture(texture)?))
     }
 }

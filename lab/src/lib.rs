@@ -6,27 +6,31 @@
 //! - [`gbuffer`]: G-buffers in CPU memory (a leaf module).
 //! - [`scene`]: the built-in scenes: CPU test patterns and a ray-cast demo,
 //!   and the Dabrovic Sponza rasterised on the GPU.
-//! - [`material`]: surface materials (factors, textures, mipmaps).
+//! - [`color`]: the sRGB transfer function.
+//! - [`image_texture`]: images decoded, mipmapped and uploaded (for the
+//!   materials and for the images scene files bind to `texture2d` uniforms).
+//! - [`material`]: surface materials (factors and textures).
 //! - [`mesh`], [`raster`]: OBJ/glTF loading and the G-buffer rasteriser
 //!   (with motion vectors from the previous frame's camera).
-//! - [`camera_path`]: cameras along a path, for sequences of frames.
+//! - [`camera`], [`camera_path`]: the pinhole camera, and cameras along a
+//!   path, for sequences of frames.
 //! - [`rig`], [`mesh_scene`]: the light rig (point lights, a sun with a
 //!   shadow map) and a mesh on the GPU with its camera and rig.
-//! - [`scene_file`]: TOML scene files, and [`image_texture`]: the images
-//!   they bind to `texture2d` uniforms.
+//! - [`scene_file`]: TOML scene files.
 //! - [`uniforms`]: binding what a scene provides to a program's uniforms by
 //!   name and type.
+//! - [`shading_rate`]: shading-rate images made on the CPU.
 //! - [`runtime_dir`]: a private `XDG_RUNTIME_DIR` where there is none, so
 //!   that Mesa's Vulkan drivers print no error line.
 //! - [`metrics`]: RMSE, PSNR, MSSIM and FLIP against a reference image.
 //!
-//! Module dependencies run one way: `gbuffer` ← `material` ← `mesh` ←
-//! `raster` ← `rig` ← `mesh_scene` ← `scene` ← `scene_file`, and `raster`
-//! ← `camera_path` ← `scene`, with `gpu`
-//! beneath them all; `uniforms` (used from `rig` on) and `image_texture`
-//! (used by `scene_file`) depend on no other module but `gpu`, and
-//! `runtime_dir` on none.
+//! Module dependencies run one way: `color` ← `image_texture` ← `material`
+//! ← `mesh` ← `camera` ← `raster` ← `rig` ← `mesh_scene` ← `scene` ←
+//! `scene_file`, and `camera` ← `camera_path` ← `scene`, with `gpu` and
+//! `gbuffer` beneath them all; `uniforms` (used from `rig` on) depends on no
+//! other module, `metrics` on `color` alone, and `runtime_dir` on none.
 
+pub mod camera;
 pub mod camera_path;
 pub mod color;
 pub mod gbuffer;

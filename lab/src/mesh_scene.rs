@@ -2,9 +2,10 @@
 //! camera (one per frame of a camera path), the rig's shadow map (rendered
 //! once, on first use) and the uniforms a program takes from the scene.
 
+use crate::camera::Camera;
 use crate::gpu::Gpu;
 use crate::mesh::{Mesh, MeshWarning};
-use crate::raster::{Camera, GpuMesh, RasterError, Rasterizer};
+use crate::raster::{GpuMesh, RasterError, Rasterizer};
 use crate::rig::{DEFAULT_LIGHTS, DEFAULT_SHADOW_MAP_SIZE, LightRig, RigError};
 use crate::uniforms::{Applied, Offered};
 use mrsl_runtime::Shader;

@@ -60,11 +60,12 @@
 //! velocity` never see it (the runtime ignores channels a program does not
 //! read).
 
+use crate::camera::{Camera, CameraError};
 use crate::gbuffer::{BACKGROUND, ChannelData, GBuffer};
 use crate::gpu::Gpu;
 use crate::image_texture::{ImageTexture, TexelEncoding, TextureImage};
 use crate::material::{Material, Wrap};
-use crate::mesh::{Bounds, Mesh, MeshError, cross, dot, normalize, sub};
+use crate::mesh::{Bounds, Mesh, MeshError, dot, sub};
 use wgpu::util::DeviceExt;
 
 /// Channel names and formats, in the order [`Rasterizer::render`] returns them
@@ -102,76 +103,10 @@ pub enum RasterError {
     TooLarge { what: &'static str, bytes: u64, limit: u64 },
     #[error("texture {image} is {width}x{height}, larger than the device's {limit}-texel limit")]
     TextureTooLarge { image: String, width: u32, height: u32, limit: u32 },
-    #[error("bad camera: {0}")]
-    BadCamera(String),
+    #[error(transparent)]
+    BadCamera(#[from] CameraError),
     #[error(transparent)]
     Gpu(#[from] crate::gpu::GpuError),
-}
-
-/// A camera's unit view direction, right axis and up axis.
-pub type Basis = ([f32; 3], [f32; 3], [f32; 3]);
-
-/// A pinhole camera. Right-handed world, `up` is a hint (it need not be
-/// orthogonal to the view direction); image rows run top to bottom, and
-/// pixel `(x, y)` sees along the ray through its centre `(x + 0.5, y + 0.5)`,
-/// exactly as the CPU demo scene's camera.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Camera {
-    pub eye: [f32; 3],
-    pub target: [f32; 3],
-    pub up: [f32; 3],
-    /// Vertical field of view in degrees.
-    pub fov_y_degrees: f32,
-}
-
-impl Camera {
-    /// A camera with the world's +y as up.
-    pub fn look_at(eye: [f32; 3], target: [f32; 3], fov_y_degrees: f32) -> Camera {
-        Camera { eye, target, up: [0.0, 1.0, 0.0], fov_y_degrees }
-    }
-
-    /// A camera that sees all of `bounds` from the front (+z), a little to
-    /// the right and above, for an image of the given aspect ratio (width /
-    /// height): the bounding sphere fits in both fields of view.
-    pub fn frame(bounds: &Bounds, fov_y_degrees: f32, aspect: f32) -> Camera {
-        let center = bounds.center();
-        let radius = (0.5 * bounds.diagonal()).max(1e-6);
-        let half_y = (fov_y_degrees.to_radians() / 2.0).clamp(1e-3, 1.55);
-        let half_x = (half_y.tan() * aspect.max(1e-3)).atan();
-        let distance = radius / half_y.min(half_x).sin();
-        let dir = normalize([0.35, 0.3, 1.0]);
-        let eye = [0, 1, 2].map(|k| center[k] + distance * dir[k]);
-        Camera::look_at(eye, center, fov_y_degrees)
-    }
-
-    /// The unit view direction and the camera's unit right and up axes.
-    pub fn basis(&self) -> Result<Basis, RasterError> {
-        let forward = normalize(sub(self.target, self.eye));
-        if dot(forward, forward) == 0.0 {
-            return Err(RasterError::BadCamera("the eye and the target are the same point".into()));
-        }
-        let right = normalize(cross(forward, self.up));
-        if dot(right, right) == 0.0 || !right.iter().all(|v| v.is_finite()) {
-            return Err(RasterError::BadCamera("`up` is parallel to the view direction".into()));
-        }
-        if !(self.fov_y_degrees > 0.0 && self.fov_y_degrees < 180.0) {
-            return Err(RasterError::BadCamera(format!(
-                "the field of view must be between 0 and 180 degrees, not {}",
-                self.fov_y_degrees
-            )));
-        }
-        Ok((forward, right, cross(right, forward)))
-    }
-
-    /// The unit direction of the ray through the centre of pixel `(x, y)`.
-    pub fn ray(&self, x: u32, y: u32, size: (u32, u32)) -> Result<[f32; 3], RasterError> {
-        let (forward, right, up) = self.basis()?;
-        let tan_half = (self.fov_y_degrees.to_radians() / 2.0).tan();
-        let aspect = size.0 as f32 / size.1 as f32;
-        let sx = (2.0 * (x as f32 + 0.5) / size.0 as f32 - 1.0) * tan_half * aspect;
-        let sy = (1.0 - 2.0 * (y as f32 + 0.5) / size.1 as f32) * tan_half;
-        Ok(normalize([0, 1, 2].map(|k| forward[k] + sx * right[k] + sy * up[k])))
-    }
 }
 
 /// Distance of the background from the eye: 50 (the demo scene's) or twice
@@ -223,174 +158,8 @@ struct Globals {
     size: [f32; 4],
 }
 
-const SHADER: &str = r#"
-struct Globals {
-    view_proj: mat4x4<f32>,
-    previous_view_proj: mat4x4<f32>,
-    eye: vec4<f32>,
-    right: vec4<f32>,
-    up: vec4<f32>,
-    forward: vec4<f32>,
-    size: vec4<f32>,
-};
-@group(0) @binding(0) var<uniform> g: Globals;
-
-struct Material {
-    base_color: vec4<f32>,
-    // x: roughness, y: metallic, z: normal scale, w: alpha cutoff (negative: none)
-    params: vec4<f32>,
-    // x: 1 where the normal map applies; y: 1 to sample at (u, 1 - v) (OBJ)
-    flags: vec4<u32>,
-};
-@group(1) @binding(0) var<uniform> material: Material;
-@group(1) @binding(1) var base_color_map: texture_2d<f32>;
-@group(1) @binding(2) var metallic_roughness_map: texture_2d<f32>;
-@group(1) @binding(3) var normal_map: texture_2d<f32>;
-@group(1) @binding(4) var material_sampler: sampler;
-
-struct VsOut {
-    @builtin(position) @invariant clip: vec4<f32>,
-    @location(0) world: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
-    @location(3) @interpolate(flat) material: u32,
-    @location(4) tangent: vec4<f32>,
-    @location(5) color: vec4<f32>,
-};
-
-struct Pass1 {
-    @location(0) position: vec4<f32>,
-    @location(1) normal: vec4<f32>,
-};
-
-struct Pass2 {
-    @location(0) uv: vec2<f32>,
-    @location(1) material: u32,
-    @location(2) depth: f32,
-    @location(3) velocity: vec2<f32>,
-};
-
-struct Pass3 {
-    @location(0) albedo: vec4<f32>,
-    @location(1) roughness: f32,
-    @location(2) metallic: f32,
-};
-
-@vertex
-fn vs_mesh(@location(0) p: vec3<f32>, @location(1) n: vec3<f32>, @location(2) uv: vec2<f32>,
-           @location(3) material_id: u32, @location(4) tangent: vec4<f32>, @location(5) color: vec4<f32>) -> VsOut {
-    var out: VsOut;
-    out.clip = g.view_proj * vec4<f32>(p, 1.0);
-    out.world = p;
-    out.normal = n;
-    out.uv = uv;
-    out.material = material_id;
-    out.tangent = tangent;
-    out.color = color;
-    return out;
-}
-
-// Every pass samples the base colour first (in uniform control flow, so
-// that the quad's uv derivatives pick the mip level) and discards the same
-// masked fragments.
-fn texture_uv(v: VsOut) -> vec2<f32> {
-    return select(v.uv, vec2<f32>(v.uv.x, 1.0 - v.uv.y), material.flags.y != 0u);
-}
-
-fn base_color(v: VsOut) -> vec4<f32> {
-    return material.base_color * v.color * textureSample(base_color_map, material_sampler, texture_uv(v));
-}
-
-fn alpha_test(alpha: f32) {
-    if (material.params.w >= 0.0 && alpha < material.params.w) {
-        discard;
-    }
-}
-
-@fragment
-fn fs_mesh1(v: VsOut, @builtin(front_facing) front: bool) -> Pass1 {
-    let albedo = base_color(v);
-    let mapped = textureSample(normal_map, material_sampler, texture_uv(v)).xyz * 2.0 - 1.0;
-    alpha_test(albedo.a);
-    var n = v.normal;
-    if (dot(n, n) > 0.0) {
-        n = normalize(n);
-        // The tangent frame: the tangent made orthogonal to the normal, the
-        // bitangent's handedness from w. A vertex without a tangent (zero)
-        // keeps the interpolated normal.
-        let t = v.tangent.xyz - n * dot(n, v.tangent.xyz);
-        if (material.flags.x != 0u && dot(t, t) > 1e-12) {
-            let tu = normalize(t);
-            let b = cross(n, tu) * select(-1.0, 1.0, v.tangent.w >= 0.0);
-            let p = (mapped.x * material.params.z) * tu + (mapped.y * material.params.z) * b + mapped.z * n;
-            if (dot(p, p) > 0.0) {
-                n = normalize(p);
-            }
-        }
-    }
-    if (!front) {
-        n = -n;
-    }
-    return Pass1(vec4<f32>(v.world, 0.0), vec4<f32>(n, 0.0));
-}
-
-// A world point's position in pixels under a view-projection matrix, or
-// nothing when it lies behind that camera.
-fn project(m: mat4x4<f32>, p: vec3<f32>) -> vec3<f32> {
-    let clip = m * vec4<f32>(p, 1.0);
-    if (clip.w <= 0.0) {
-        return vec3<f32>(0.0);
-    }
-    let ndc = clip.xy / clip.w;
-    return vec3<f32>((ndc.x * 0.5 + 0.5) * g.size.x, (0.5 - ndc.y * 0.5) * g.size.y, 1.0);
-}
-
-@fragment
-fn fs_mesh2(v: VsOut) -> Pass2 {
-    alpha_test(base_color(v).a);
-    let now = project(g.view_proj, v.world);
-    let before = project(g.previous_view_proj, v.world);
-    let velocity = select(vec2<f32>(0.0), now.xy - before.xy, now.z > 0.0 && before.z > 0.0);
-    return Pass2(v.uv, v.material, distance(v.world, g.eye.xyz), velocity);
-}
-
-@fragment
-fn fs_mesh3(v: VsOut) -> Pass3 {
-    let albedo = base_color(v);
-    let mr = textureSample(metallic_roughness_map, material_sampler, texture_uv(v));
-    alpha_test(albedo.a);
-    return Pass3(albedo, clamp(material.params.x * mr.g, 0.0, 1.0), clamp(material.params.y * mr.b, 0.0, 1.0));
-}
-
-// A full-screen triangle at depth 0 (infinitely far with reversed depth).
-@vertex
-fn vs_background(@builtin(vertex_index) i: u32) -> @builtin(position) @invariant vec4<f32> {
-    let corner = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4<f32>(corner * 2.0 - 1.0, 0.0, 1.0);
-}
-
-fn view_ray(frag: vec2<f32>) -> vec3<f32> {
-    let sx = (2.0 * frag.x / g.size.x - 1.0) * g.right.w;
-    let sy = (1.0 - 2.0 * frag.y / g.size.y) * g.up.w;
-    return normalize(g.forward.xyz + sx * g.right.xyz + sy * g.up.xyz);
-}
-
-@fragment
-fn fs_background1(@builtin(position) frag: vec4<f32>) -> Pass1 {
-    let d = view_ray(frag.xy);
-    return Pass1(vec4<f32>(g.eye.xyz + g.eye.w * d, 0.0), vec4<f32>(-d, 0.0));
-}
-
-@fragment
-fn fs_background2(@builtin(position) frag: vec4<f32>) -> Pass2 {
-    return Pass2(vec2<f32>(0.0, 0.0), BACKGROUND_ID, g.eye.w, vec2<f32>(0.0));
-}
-
-@fragment
-fn fs_background3() -> Pass3 {
-    return Pass3(vec4<f32>(0.0), 1.0, 0.0);
-}
-"#;
+/// The passes' shaders; `BACKGROUND_ID` is replaced by [`BACKGROUND`].
+const SHADER: &str = include_str!("raster.wgsl");
 
 /// A mesh in GPU buffers, its triangles grouped by material, with each
 /// material's bind group (factors and textures).
@@ -420,13 +189,6 @@ pub struct Rasterizer {
     white_srgb: wgpu::TextureView,
     white_linear: wgpu::TextureView,
     flat_normal: wgpu::TextureView,
-}
-
-fn describe(error: &wgpu::Error) -> String {
-    match error {
-        wgpu::Error::Validation { description, .. } => description.clone(),
-        other => other.to_string(),
-    }
 }
 
 impl Rasterizer {
@@ -564,7 +326,7 @@ impl Rasterizer {
         let white_linear = pixel("mrsl white", wgpu::TextureFormat::Rgba8Unorm, [255; 4]);
         let flat_normal = pixel("mrsl flat normal", wgpu::TextureFormat::Rgba8Unorm, [128, 128, 255, 255]);
         if let Some(error) = pollster::block_on(scope.pop()) {
-            return Err(RasterError::Pipeline(describe(&error)));
+            return Err(RasterError::Pipeline(mrsl_runtime::gpu::describe(&error)));
         }
         Ok(Rasterizer { globals_layout, material_layout, mesh, background, white_srgb, white_linear, flat_normal })
     }
@@ -627,7 +389,7 @@ impl Rasterizer {
             usage: wgpu::BufferUsages::INDEX,
         });
         if let Some(error) = pollster::block_on(scope.pop()) {
-            return Err(RasterError::Render(describe(&error)));
+            return Err(RasterError::Render(mrsl_runtime::gpu::describe(&error)));
         }
         Ok(GpuMesh { vertices: Some(vertices), indices: Some(indices), draws, bind_groups, bounds: mesh.bounds() })
     }
@@ -803,7 +565,7 @@ impl Rasterizer {
         }
         gpu.queue.submit([encoder.finish()]);
         if let Some(error) = pollster::block_on(scope.pop()) {
-            return Err(RasterError::Render(describe(&error)));
+            return Err(RasterError::Render(mrsl_runtime::gpu::describe(&error)));
         }
         Ok(channels)
     }

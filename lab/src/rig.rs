@@ -27,9 +27,10 @@
 //! `r = f16(d)`, `g = f16(d - r)` — about 22 bits of precision instead of
 //! half's 11, which keeps the shadow bias at millimetres on Sponza.
 
+use crate::camera::{Camera, CameraError};
 use crate::gpu::Gpu;
 use crate::mesh::{Bounds, length, normalize, sub};
-use crate::raster::{Camera, GpuMesh, RasterError, Rasterizer};
+use crate::raster::{GpuMesh, RasterError, Rasterizer};
 use crate::uniforms::{Applied, Offered, UniformTypeError};
 use mrsl_abi::{Scalar, ValueType};
 use mrsl_runtime::Shader;
@@ -124,7 +125,7 @@ impl LightRig {
     /// The sun's world → clip matrix, column-major (16 values): `clip.xy /
     /// clip.w` is the pixel convention of [`Camera::ray`] on a square image,
     /// `clip.w` the depth along the view direction.
-    pub fn sun_view_proj(&self) -> Result<[f32; 16], RasterError> {
+    pub fn sun_view_proj(&self) -> Result<[f32; 16], CameraError> {
         let camera = &self.sun.camera;
         let (forward, right, up) = camera.basis()?;
         let tan_half = (camera.fov_y_degrees.to_radians() / 2.0).tan();
@@ -237,7 +238,7 @@ impl LightRig {
 pub enum RigError {
     /// The sun's camera is degenerate.
     #[error("the light rig cannot be used: {0}")]
-    Camera(#[from] RasterError),
+    Camera(#[from] CameraError),
     /// The shader refused a value.
     #[error(transparent)]
     Uniform(#[from] mrsl_runtime::Error),

@@ -13,12 +13,13 @@
 //! [`crate::raster`]: build it with [`Scene::render_on`] or
 //! [`Scene::textures_on`]. See docs/scenes.md.
 
+use crate::camera::Camera;
 use crate::camera_path::CameraPath;
 pub use crate::gbuffer::{BACKGROUND, ChannelData, GBuffer};
 use crate::gpu::Gpu;
 use crate::mesh::MeshError;
 use crate::mesh_scene::MeshScene;
-use crate::raster::{Camera, RasterError};
+use crate::raster::RasterError;
 
 // Sponza's default camera (see `Scene::sponza_camera`).
 const SPONZA_EYE: [f32; 3] = [-11.5, 2.2, -0.3];

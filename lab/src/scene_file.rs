@@ -30,13 +30,14 @@
 //! a warning ([`SceneBinding::applied`]), or is an error when the program
 //! has no default for it; a name the program does not declare is an error.
 
+use crate::camera::Camera;
 use crate::camera_path::{CameraPath, Keyframe};
 use crate::gbuffer::GBuffer;
 use crate::gpu::Gpu;
 use crate::image_texture::{ColorSpace, ImageError, ImageTexture};
 use crate::mesh::{DEFAULT_CREASE_ANGLE, Mesh, MeshError};
 use crate::mesh_scene::MeshScene;
-use crate::raster::{Camera, RasterError};
+use crate::raster::RasterError;
 use crate::scene::Scene;
 use crate::uniforms::{Applied, Offered, UniformTypeError, Verdict};
 use mrsl_runtime::Shader;

@@ -7,6 +7,7 @@
 use crate::gpu::Gpu;
 use mrsl_abi::ShadingRate;
 use mrsl_abi::shading_rate::rate_image_size;
+use mrsl_runtime::rate_source::upload_rate_image;
 
 /// A rate per tile for `tiles` tiles (row-major), scrambled so that every
 /// rate soon borders every other one, horizontally and vertically (over 20 x
@@ -23,12 +24,16 @@ pub fn pattern(tiles: (u32, u32)) -> Vec<ShadingRate> {
 }
 
 /// Uploads `rates` (row-major, `rate_image_size(size, tile)` of them) as an
-/// `R8Uint` shading-rate image for a `size` image with `tile`-pixel tiles.
+/// `R8Uint` shading-rate image for a `size` image with `tile`-pixel tiles
+/// (through the runtime's [`upload_rate_image`]).
+///
+/// # Panics
+///
+/// When `rates` does not hold one rate per tile (a bug in the caller: tests
+/// and tools make the rates for the size they pass).
 pub fn upload(gpu: &Gpu, size: (u32, u32), tile: u32, rates: &[ShadingRate]) -> wgpu::Texture {
-    let tiles = rate_image_size(size, tile);
-    assert_eq!(rates.len() as u64, u64::from(tiles.0) * u64::from(tiles.1), "one rate per tile");
-    let codes: Vec<u8> = rates.iter().map(|r| r.code()).collect();
-    gpu.texture_with_data("mrsl shading-rate image", tiles, wgpu::TextureFormat::R8Uint, &codes)
+    upload_rate_image(&gpu.device, &gpu.queue, rate_image_size(size, tile), rates)
+        .unwrap_or_else(|e| panic!("one rate per tile: {e}"))
 }
 
 /// The [`pattern`] image for a `size` image with `tile`-pixel tiles.

@@ -5,11 +5,12 @@
 
 use crate::compile;
 use mrsl_abi::shading_rate::DEFAULT_RATE_TILE;
+use mrsl_lab::camera::Camera;
 use mrsl_lab::camera_path::{CameraPath, Keyframe};
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::mesh::Mesh;
 use mrsl_lab::mesh_scene::MeshScene;
-use mrsl_lab::raster::{self, Camera};
+use mrsl_lab::raster;
 use mrsl_lab::scene::{BACKGROUND, ChannelData};
 use mrsl_runtime::rate_source::{
     RateInputs, RateOptions, RateSource, create_rate_image, rate_fraction, read_rate_image,

@@ -3,9 +3,10 @@
 //! scene files) checked on small inputs with known answers.
 
 use crate::{Output, compile, psnr_of as psnr};
+use mrsl_lab::camera::Camera;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::mesh::{Mesh, MeshError};
-use mrsl_lab::raster::{self, Camera, RasterError};
+use mrsl_lab::raster::{self, RasterError};
 use mrsl_lab::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
 use mrsl_lab::scene_file::{MeshSource, SceneFile, SceneFileError, UniformValue};
 use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader};

@@ -7,11 +7,12 @@
 
 use crate::sponza::{base64, floats, temp_dir};
 use crate::{Output, compile, worst_ulps};
+use mrsl_lab::camera::Camera;
 use mrsl_lab::color::srgb_to_linear;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::mesh::{Mesh, MeshWarning};
 use mrsl_lab::mesh_scene::MeshScene;
-use mrsl_lab::raster::{self, Camera};
+use mrsl_lab::raster;
 use mrsl_lab::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
 use mrsl_runtime::{Bindings, DispatchOptions, Error, Mode, Shader};
 
