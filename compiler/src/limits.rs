@@ -52,6 +52,11 @@ pub const MAX_WGSL_LEVEL: u32 = 128;
 /// 127" at level 127), one below the WGSL specification's 127.
 pub const MAX_BRACE_LEVEL: u32 = 126;
 
+/// The most parameters a function may declare: WGSL's limit, which Tint
+/// enforces (naga does not). A user function is written with its own
+/// parameters alone; the effects' functions pack what would exceed it.
+pub const MAX_PARAMETERS: usize = 255;
+
 /// The most nodes on any path through one expression, field accesses
 /// included (which the parsers nest at no cost, up to Tint's expression
 /// depth of 512). Low enough that the compiler's recursive passes stay small
@@ -107,7 +112,12 @@ pub fn nesting(program: &Program) -> Vec<Diagnostic> {
                 walk.roots.extend(d.array_len.iter().chain(&d.default).map(Root::folded));
             }
             Item::Const(d) => walk.roots.push(Root { expr: &d.value, level: CONST_LEVEL, depth: 0, operand: false }),
-            Item::Function(f) => walk.statements(&f.body.stmts, FUNCTION_STATEMENTS),
+            Item::Function(f) => {
+                if let Some(first_excess) = f.params.get(MAX_PARAMETERS) {
+                    walk.diagnostics.push(too_many_parameters(f, first_excess));
+                }
+                walk.statements(&f.body.stmts, FUNCTION_STATEMENTS)
+            }
             Item::Effect(e) => {
                 walk.attributes(&e.attrs);
                 match &e.body {
@@ -367,6 +377,21 @@ fn too_long(root: &Root, reach: Reach) -> Diagnostic {
             "an expression may nest at most {MAX_EXPR_DEPTH} operations, calls, indexings and field accesses"
         ))
         .with_note("split the expression with locals, e.g. `float3 part = ...;`")
+}
+
+fn too_many_parameters(f: &FunctionDecl, first_excess: &Param) -> Diagnostic {
+    Diagnostic::error("E0605", "function with too many parameters")
+        .with_label(Label::primary(
+            first_excess.name.span,
+            format!("parameter {} of `{}`", MAX_PARAMETERS + 1, f.name.name),
+        ))
+        .with_note(format!(
+            "WGSL allows at most {MAX_PARAMETERS} parameters in a function (Tint, Chrome's compiler, refuses more); \
+             `{}` declares {}",
+            f.name.name,
+            f.params.len()
+        ))
+        .with_note("pass fewer values: compute some inside the function, or split it into several")
 }
 
 fn too_many_braces(s: &Stmt, keyword: &str, level: u32) -> Diagnostic {

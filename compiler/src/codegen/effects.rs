@@ -16,6 +16,14 @@ use crate::syntax::{visit_expr, visit_stmt_exprs};
 use mrsl_abi::{CONTROL_FIELDS, KernelKind};
 use std::collections::{BTreeSet, HashMap, HashSet};
 
+/// The most parameters a WGSL function may declare (the specification's
+/// limit, which Tint enforces and naga does not).
+const MAX_PARAMETERS: usize = 255;
+
+/// The members of one structure of packed dependencies: within WGSL's
+/// limit of 1023 members per structure.
+const ARGS_PER_STRUCT: usize = 1000;
+
 /// A discontinuity key: an input that, where its values at two positions
 /// differ, keeps them from sharing coarse values.
 pub(super) struct Key<'c> {
@@ -206,6 +214,35 @@ impl<'b> Writer<'_, '_, 'b> {
         self.checked().effects[e.index()].deps.iter().map(|(d, _)| *d).collect()
     }
 
+    /// The dependencies of `e` in the parts its functions take them in: one
+    /// parameter each (one part of one), or, where that would pass more
+    /// parameters than WGSL allows, packed into structures of at most
+    /// [`ARGS_PER_STRUCT`] members ([`Self::args_structs`]).
+    fn dependency_parts(&self, e: EffectId) -> Option<Vec<Vec<EffectId>>> {
+        let deps = self.deps_params(e);
+        // The position and the refine flag come first.
+        (deps.len() + 2 > MAX_PARAMETERS).then(|| deps.chunks(ARGS_PER_STRUCT).map(<[EffectId]>::to_vec).collect())
+    }
+
+    /// `MrslArgs<k>_<effect>` of every effect this kernel evaluates whose
+    /// dependencies are too many to pass one parameter each.
+    pub(super) fn args_structs(&mut self) {
+        let c = self.checked();
+        for e in self.kernel_effects() {
+            let Some(parts) = self.dependency_parts(e) else { continue };
+            let name = &c.effects[e.index()].name;
+            self.line(0, format!("// `{name}` reads more effects than a function may take parameters"));
+            for (k, part) in parts.iter().enumerate() {
+                self.line(0, format!("struct {} {{", Name::Args.within(k, name)));
+                for &d in part {
+                    self.line(1, format!("{}: {},", self.effect_name(d), c.effects[d.index()].ty.wgsl()));
+                }
+                self.line(0, "}");
+            }
+            self.line(0, "");
+        }
+    }
+
     /// The signature of `mrsl_eval_<effect>`, or of `mrsl_val_<effect>`
     /// (`value_only`), which has no refine flag.
     fn eval_signature(&self, e: EffectId, value_only: bool) -> String {
@@ -215,8 +252,17 @@ impl<'b> Writer<'_, '_, 'b> {
         if info.has_refine && !value_only {
             params.push(format!("{REFINE}: ptr<function, bool>"));
         }
-        for d in self.deps_params(e) {
-            params.push(format!("{}: {}", self.effect_name(d), c.effects[d.index()].ty.wgsl()));
+        match self.dependency_parts(e) {
+            None => {
+                for d in self.deps_params(e) {
+                    params.push(format!("{}: {}", self.effect_name(d), c.effects[d.index()].ty.wgsl()));
+                }
+            }
+            Some(parts) => {
+                for k in 0..parts.len() {
+                    params.push(format!("{}: {}", Name::ArgsParam.of(k), Name::Args.within(k, &info.name)));
+                }
+            }
         }
         let function = if value_only { Name::Val } else { Name::Eval };
         format!("fn {}({}) -> {}", function.of(&info.name), params.join(", "), info.ty.wgsl())
@@ -317,6 +363,12 @@ impl<'b> Writer<'_, '_, 'b> {
         }
         let sig = self.eval_signature(e, value_only);
         self.line(0, format!("{sig} {{"));
+        for (k, part) in self.dependency_parts(e).unwrap_or_default().iter().enumerate() {
+            for &d in part {
+                let dep = self.effect_name(d);
+                self.line(1, format!("let {dep} = {}.{dep};", Name::ArgsParam.of(k)));
+            }
+        }
         for i in self.inputs_read(decl, skipped) {
             let name = &c.inputs[i].name;
             self.line(1, format!("let {} = {}({POS});", wgsl_ident(name), Name::Load.of(name)));
@@ -551,7 +603,14 @@ impl<'b> Writer<'_, '_, 'b> {
             }
             Name::Eval
         };
-        args.extend(self.deps_params(e).into_iter().map(|d| format!("{prefix}{}", self.effect_name(d))));
+        let value = |d: &EffectId| format!("{prefix}{}", self.effect_name(*d));
+        match self.dependency_parts(e) {
+            None => args.extend(self.deps_params(e).iter().map(value)),
+            Some(parts) => args.extend(parts.iter().enumerate().map(|(k, part)| {
+                let values: Vec<String> = part.iter().map(value).collect();
+                format!("{}({})", Name::Args.within(k, &info.name), values.join(", "))
+            })),
+        }
         self.line(
             indent,
             format!("{declare}{prefix}{} = {}({});", self.effect_name(e), function.of(&info.name), args.join(", ")),

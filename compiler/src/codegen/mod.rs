@@ -253,6 +253,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             let f = FunctionId(k as u32);
             self.cached(Piece::Function(f), |w| w.function(f));
         }
+        self.args_structs();
         let value_only = self.value_only_effects();
         let keeps_flags = self.keeps_refine_flags();
         for e in self.kernel_effects() {

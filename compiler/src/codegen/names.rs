@@ -79,12 +79,17 @@ pub(super) enum Name {
     SelectMatrix,
     /// `mrsl_user_<name>`: a user name escaped out of the generated namespace.
     User,
+    /// `MrslArgs<k>_<effect>`: part `k` of an effect's dependencies, packed
+    /// into a structure where they would be too many parameters.
+    Args,
+    /// `mrsl_args<k>`: the parameter that holds part `k` of the dependencies.
+    ArgsParam,
 }
 
 impl Name {
     /// Every family, for the tests that check names against this module.
     #[cfg_attr(not(test), expect(dead_code, reason = "read by the tests"))]
-    pub(super) const ALL: [Name; 28] = [
+    pub(super) const ALL: [Name; 30] = [
         Name::Eval,
         Name::Val,
         Name::At,
@@ -113,6 +118,8 @@ impl Name {
         Name::Ddy,
         Name::SelectMatrix,
         Name::User,
+        Name::Args,
+        Name::ArgsParam,
     ];
 
     /// What every member's name starts with.
@@ -146,6 +153,8 @@ impl Name {
             Name::Ddy => "mrsl_ddy_",
             Name::SelectMatrix => "mrsl_select_m",
             Name::User => "mrsl_user_",
+            Name::Args => "MrslArgs",
+            Name::ArgsParam => "mrsl_args",
         }
     }
 

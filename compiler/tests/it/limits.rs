@@ -262,3 +262,33 @@ fn at_the_limits() {
     assert_eq!(on_stack(small, || mrsl::check(&doubling)), vec![], "a derivative of 2558 operations");
     assert_rejected("a derivative of 5118 operations", &derivative_chain(10, "{prev} * {prev}"), &["E0604"]);
 }
+
+/// A function may declare 255 parameters (WGSL's limit); an effect that
+/// reads more effects than that passes them packed into structures, so no
+/// generated function declares more either.
+#[test]
+fn parameters_stay_within_wgsl_s_limit() {
+    let function = |n: usize| {
+        let params: Vec<String> = (0..n).map(|k| format!("float p{k}")).collect();
+        let args = vec!["normal.x"; n].join(", ");
+        format!("{HEADER}float f({}) {{ return p0; }}\nfine out float o = f({args});\n", params.join(", "))
+    };
+    assert_compiles("a function of 255 parameters", &function(255));
+    assert_rejected("a function of 256 parameters", &function(256), &["E0605"]);
+    let n = 1100;
+    let mut source = String::from(HEADER);
+    for k in 0..n {
+        source.push_str(&format!("coarse effect float e{k} = normal.x * {k}.0;\n"));
+    }
+    let reads: String = (0..n).map(|k| format!("    o += e{k};\n")).collect();
+    source.push_str(&format!("fine out float o {{\n    o = 0.0;\n{reads}}}\n"));
+    // One mode's kernels: validating eleven kernels of 1,100 functions each would take minutes in a debug build.
+    let options = Options::for_modes(&[mrsl::Mode::Coarse4x4]);
+    let program = mrsl::compile(&source, &options).expect("a program reading 1,100 effects compiles");
+    for kernel in &program.kernels {
+        let widest = kernel.wgsl.lines().filter(|l| l.starts_with("fn ")).map(|l| l.matches(": ").count()).max();
+        assert!(widest.unwrap_or(0) <= 256, "{}: a function with {widest:?} typed names", kernel.kind);
+    }
+    let fine = program.kernel(mrsl::KernelKind::Fine, 4).unwrap();
+    assert!(fine.wgsl.contains("struct MrslArgs1_o {"), "1,100 dependencies take two structures");
+}
