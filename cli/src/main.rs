@@ -245,28 +245,14 @@ fn main() -> ExitCode {
     // SAFETY: no other thread exists yet: nothing has run but `main`'s start.
     unsafe { mrsl_lab::runtime_dir::ensure_xdg_runtime_dir() };
     let cli = Cli::parse();
-    locate_sponza();
+    // The kit does not search for Sponza by itself (see mrsl_lab::fixtures).
+    mrsl_lab::fixtures::locate_sponza();
     match run(&cli) {
         Ok(code) => code,
         Err(message) => {
             eprintln!("error: {message}");
             ExitCode::from(2)
         }
-    }
-}
-
-/// Tells the evaluation kit where cargo unpacked the Dabrovic Sponza (the
-/// `obj-rs` 0.7.4 package in `$CARGO_HOME`, by default `~/.cargo`), unless
-/// `$MRSL_SPONZA` names the file; the kit does not search by itself.
-fn locate_sponza() {
-    if std::env::var_os("MRSL_SPONZA").is_some() {
-        return;
-    }
-    let cargo_home = std::env::var_os("CARGO_HOME")
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|home| PathBuf::from(home).join(".cargo")));
-    if let Some(path) = cargo_home.and_then(|home| mrsl_lab::mesh::find_sponza_in_cargo_home(&home)) {
-        mrsl_lab::mesh::set_sponza_path(path);
     }
 }
 

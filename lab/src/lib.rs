@@ -10,8 +10,10 @@
 //! - [`image_texture`]: images decoded, mipmapped and uploaded (for the
 //!   materials and for the images scene files bind to `texture2d` uniforms).
 //! - [`material`]: surface materials (factors and textures).
-//! - [`mesh`], [`raster`]: OBJ/glTF loading and the G-buffer rasteriser
-//!   (with motion vectors from the previous frame's camera).
+//! - [`mesh`], [`raster`]: OBJ/glTF loading (normals, tangents, MTL) and
+//!   the G-buffer rasteriser (with motion vectors from the previous frame's
+//!   camera); [`fixtures`]: the test models (Sponza, the dungeon), found and
+//!   loaded once.
 //! - [`camera`], [`camera_path`]: the pinhole camera, and cameras along a
 //!   path, for sequences of frames.
 //! - [`rig`], [`mesh_scene`]: the light rig (point lights, a sun with a
@@ -24,15 +26,19 @@
 //!   that Mesa's Vulkan drivers print no error line.
 //! - [`metrics`]: RMSE, PSNR, MSSIM and FLIP against a reference image.
 //!
+//! The vector maths is glam's, but for `vector::normalize` (see there why).
+//!
 //! Module dependencies run one way: `color` ← `image_texture` ← `material`
-//! ← `mesh` ← `camera` ← `raster` ← `rig` ← `mesh_scene` ← `scene` ←
-//! `scene_file`, and `camera` ← `camera_path` ← `scene`, with `gpu` and
-//! `gbuffer` beneath them all; `uniforms` (used from `rig` on) depends on no
-//! other module, `metrics` on `color` alone, and `runtime_dir` on none.
+//! ← `mesh` ← `fixtures`, `mesh` ← `camera` ← `raster` ← `rig` ←
+//! `mesh_scene` ← `scene` ← `scene_file`, `fixtures` ← `scene`, and
+//! `camera` ← `camera_path` ← `scene`, with `gpu`, `gbuffer` and `vector`
+//! beneath them all; `uniforms` (used from `rig` on) depends on no other
+//! module, `metrics` on `color` alone, and `runtime_dir` on none.
 
 pub mod camera;
 pub mod camera_path;
 pub mod color;
+pub mod fixtures;
 pub mod gbuffer;
 pub mod gpu;
 pub mod image_texture;
@@ -47,3 +53,4 @@ pub mod scene;
 pub mod scene_file;
 pub mod shading_rate;
 pub mod uniforms;
+mod vector;

@@ -65,7 +65,8 @@ use crate::gbuffer::{BACKGROUND, ChannelData, GBuffer};
 use crate::gpu::Gpu;
 use crate::image_texture::{ImageTexture, TexelEncoding, TextureImage};
 use crate::material::{Material, Wrap};
-use crate::mesh::{Bounds, Mesh, MeshError, dot, sub};
+use crate::mesh::{Bounds, Mesh, MeshError};
+use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 /// Channel names and formats, in the order [`Rasterizer::render`] returns them
@@ -113,7 +114,7 @@ pub enum RasterError {
 /// the distance to the farthest corner of `bounds`, whichever is larger.
 pub fn background_distance(bounds: Option<&Bounds>, camera: &Camera) -> f32 {
     let farthest = bounds
-        .map(|b| b.corners().iter().map(|c| crate::mesh::length(sub(*c, camera.eye))).fold(0.0f32, f32::max))
+        .map(|b| b.corners().iter().map(|&c| Vec3::from(c).distance(Vec3::from(camera.eye))).fold(0.0f32, f32::max))
         .unwrap_or(0.0);
     (2.0 * farthest).max(50.0)
 }
@@ -474,9 +475,9 @@ impl Rasterizer {
         let aspect = width as f32 / height as f32;
         let far = background_distance(mesh.bounds.as_ref(), camera);
         let near = mesh.bounds.map(|b| 1e-4 * b.diagonal()).unwrap_or(1e-3).max(1e-6);
-        let view_proj = view_projection(camera, aspect, near)?;
+        let view_proj = camera.view_projection(aspect, near)?.to_cols_array_2d();
         let previous_view_proj = match previous {
-            Some(previous) => view_projection(previous, aspect, near)?,
+            Some(previous) => previous.view_projection(aspect, near)?.to_cols_array_2d(),
             None => view_proj,
         };
         let globals = Globals {
@@ -569,18 +570,6 @@ impl Rasterizer {
         }
         Ok(channels)
     }
-}
-
-/// The column-major view-projection matrix of `camera`: reversed depth
-/// with an infinite far plane, clip = (x f / aspect, y f, near, −z_view).
-fn view_projection(camera: &Camera, aspect: f32, near: f32) -> Result<[[f32; 4]; 4], RasterError> {
-    let (forward, right, up) = camera.basis()?;
-    let f = 1.0 / (camera.fov_y_degrees.to_radians() / 2.0).tan();
-    let row = |axis: [f32; 3], scale: f32| {
-        [axis[0] * scale, axis[1] * scale, axis[2] * scale, -dot(axis, camera.eye) * scale]
-    };
-    let rows = [row(right, f / aspect), row(up, f), [0.0, 0.0, 0.0, near], row(forward, 1.0)];
-    Ok(std::array::from_fn(|col| std::array::from_fn(|r| rows[r][col])))
 }
 
 /// Textures uploaded for one mesh (each image once per encoding, keyed by

@@ -29,9 +29,11 @@
 
 use crate::camera::{Camera, CameraError};
 use crate::gpu::Gpu;
-use crate::mesh::{Bounds, length, normalize, sub};
+use crate::mesh::Bounds;
 use crate::raster::{GpuMesh, RasterError, Rasterizer};
 use crate::uniforms::{Applied, Offered, UniformTypeError};
+use crate::vector::normalize;
+use glam::Vec3;
 use mrsl_abi::{Scalar, ValueType};
 use mrsl_runtime::Shader;
 
@@ -112,13 +114,13 @@ impl LightRig {
                 }
             })
             .collect();
-        let center = bounds.center();
+        let center = Vec3::from(bounds.center());
         let radius = (0.5 * bounds.diagonal()).max(1e-3);
         let distance = 3.0 * bounds.diagonal().max(1e-3);
-        let dir = normalize([0.3, 1.0, 0.2]);
-        let eye = [0, 1, 2].map(|k| center[k] + distance * dir[k]);
+        let eye = center + distance * normalize(Vec3::new(0.3, 1.0, 0.2));
         let fov = 2.0 * (radius / distance).asin().to_degrees() * 1.02;
-        let sun = Sun { camera: Camera::look_at(eye, center, fov), color: [3.0, 2.85, 2.6], size: 0.03 * distance };
+        let camera = Camera::look_at(eye.to_array(), center.to_array(), fov);
+        let sun = Sun { camera, color: [3.0, 2.85, 2.6], size: 0.03 * distance };
         LightRig { lights, sun }
     }
 
@@ -126,15 +128,8 @@ impl LightRig {
     /// clip.w` is the pixel convention of [`Camera::ray`] on a square image,
     /// `clip.w` the depth along the view direction.
     pub fn sun_view_proj(&self) -> Result<[f32; 16], CameraError> {
-        let camera = &self.sun.camera;
-        let (forward, right, up) = camera.basis()?;
-        let tan_half = (camera.fov_y_degrees.to_radians() / 2.0).tan();
-        let row = |axis: [f32; 3], scale: f32| {
-            let d = crate::mesh::dot(axis, camera.eye);
-            [axis[0] * scale, axis[1] * scale, axis[2] * scale, -d * scale]
-        };
-        let rows = [row(right, 1.0 / tan_half), row(up, 1.0 / tan_half), [0.0; 4], row(forward, 1.0)];
-        Ok(std::array::from_fn(|k| rows[k % 4][k / 4]))
+        // A square image, and no near plane: clip.z is 0, unused.
+        Ok(self.sun.camera.view_projection(1.0, 0.0)?.to_cols_array())
     }
 
     /// Sets the rig's uniforms that the shader's program declares (names
@@ -229,7 +224,7 @@ impl LightRig {
 
     /// Distance from `p` to the sun (what the shadow map stores for the nearest surface).
     pub fn sun_distance(&self, p: [f32; 3]) -> f32 {
-        length(sub(p, self.sun.camera.eye))
+        Vec3::from(p).distance(Vec3::from(self.sun.camera.eye))
     }
 }
 

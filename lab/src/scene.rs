@@ -20,6 +20,7 @@ use crate::gpu::Gpu;
 use crate::mesh::MeshError;
 use crate::mesh_scene::MeshScene;
 use crate::raster::RasterError;
+use glam::Vec3;
 
 // Sponza's default camera (see `Scene::sponza_camera`).
 const SPONZA_EYE: [f32; 3] = [-11.5, 2.2, -0.3];
@@ -137,11 +138,11 @@ impl Scene {
     pub fn mesh_scene(self, gpu: &Gpu) -> Result<Option<MeshScene>, SceneError> {
         match self {
             Scene::Sponza => {
-                let mesh = crate::mesh::sponza_shared()?;
+                let mesh = crate::fixtures::sponza_shared()?;
                 Ok(Some(MeshScene::new(gpu, &mesh, Scene::sponza_camera())?))
             }
             Scene::Dungeon => {
-                let mesh = crate::mesh::dungeon_shared()?;
+                let mesh = crate::fixtures::dungeon_shared()?;
                 Ok(Some(MeshScene::new(gpu, &mesh, Scene::dungeon_camera())?))
             }
             _ => Ok(None),
@@ -228,9 +229,10 @@ impl GBuffer {
     }
 }
 
-fn normalize(v: [f32; 3]) -> [f32; 3] {
-    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt().max(1e-20);
-    [v[0] / l, v[1] / l, v[2] / l]
+/// `v` over its length, at least 1e-20 (the CPU scenes' convention: a zero
+/// vector stays zero, and no division by zero).
+fn normalize(v: Vec3) -> Vec3 {
+    v / v.length().max(1e-20)
 }
 
 /// A surface facing the camera, described per pixel by `f(u, v) -> (material, position, normal)`.
@@ -241,7 +243,7 @@ fn surface(width: u32, height: u32, f: impl Fn(f32, f32) -> (u32, [f32; 3], [f32
             let (u, v) = ((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32);
             let (material, position, normal) = f(u, v);
             let depth = 5.0 - position[2];
-            b.push(position, normalize(normal), [u, v], material, depth, GREY);
+            b.push(position, normalize(Vec3::from(normal)).to_array(), [u, v], material, depth, GREY);
         }
     }
     b.finish()
@@ -328,78 +330,58 @@ impl Builder {
 /// Ray-casts spheres on a ground plane from the demo program's default camera
 /// (at (0, 1.5, 5), looking at (0, 0.5, 0), 50 degree vertical field of view).
 fn demo(width: u32, height: u32) -> GBuffer {
-    let eye = [0.0f32, 1.5, 5.0];
-    let target = [0.0f32, 0.5, 0.0];
-    let forward = normalize([target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]]);
-    let right = normalize([-forward[2], 0.0, forward[0]]);
-    let up = [
-        right[1] * forward[2] - right[2] * forward[1],
-        right[2] * forward[0] - right[0] * forward[2],
-        right[0] * forward[1] - right[1] * forward[0],
-    ];
+    let eye = Vec3::new(0.0, 1.5, 5.0);
+    let target = Vec3::new(0.0, 0.5, 0.0);
+    let forward = normalize(target - eye);
+    let right = normalize(Vec3::new(-forward.z, 0.0, forward.x));
+    let up = right.cross(forward);
     let tan_half = (50.0f32.to_radians() / 2.0).tan();
     let aspect = width as f32 / height as f32;
     // (center, radius, material)
     let spheres = [
-        ([-1.3f32, 0.7, 0.0], 0.7f32, 1u32),
-        ([0.5, 0.5, 0.9], 0.5, 2),
-        ([1.6, 0.9, -1.2], 0.9, 3),
-        ([-0.2, 0.35, -1.6], 0.35, 4),
+        (Vec3::new(-1.3, 0.7, 0.0), 0.7f32, 1u32),
+        (Vec3::new(0.5, 0.5, 0.9), 0.5, 2),
+        (Vec3::new(1.6, 0.9, -1.2), 0.9, 3),
+        (Vec3::new(-0.2, 0.35, -1.6), 0.35, 4),
     ];
     let mut b = Builder::new(width, height);
     for y in 0..height {
         for x in 0..width {
             let sx = (2.0 * (x as f32 + 0.5) / width as f32 - 1.0) * tan_half * aspect;
             let sy = (1.0 - 2.0 * (y as f32 + 0.5) / height as f32) * tan_half;
-            let dir = normalize([
-                forward[0] + sx * right[0] + sy * up[0],
-                forward[1] + sx * right[1] + sy * up[1],
-                forward[2] + sx * right[2] + sy * up[2],
-            ]);
-            let mut best: Option<(f32, [f32; 3], [f32; 2], u32)> = None;
+            let dir = normalize(forward + sx * right + sy * up);
+            let mut best: Option<(f32, Vec3, [f32; 2], u32)> = None;
             // Ground plane y = 0, within |x|, |z| < 6.
-            if dir[1] < -1e-6 {
-                let t = -eye[1] / dir[1];
-                let p = [eye[0] + t * dir[0], 0.0, eye[2] + t * dir[2]];
+            if dir.y < -1e-6 {
+                let t = -eye.y / dir.y;
+                let p = [eye.x + t * dir.x, 0.0, eye.z + t * dir.z];
                 if p[0].abs() < 6.0 && p[2].abs() < 6.0 {
-                    best = Some((t, [0.0, 1.0, 0.0], [p[0] * 0.25 + 0.5, p[2] * 0.25 + 0.5], 0));
+                    best = Some((t, Vec3::Y, [p[0] * 0.25 + 0.5, p[2] * 0.25 + 0.5], 0));
                 }
             }
             for (center, radius, material) in spheres {
-                let oc = [eye[0] - center[0], eye[1] - center[1], eye[2] - center[2]];
-                let bq = oc[0] * dir[0] + oc[1] * dir[1] + oc[2] * dir[2];
-                let cq = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2] - radius * radius;
+                let oc = eye - center;
+                let bq = oc.dot(dir);
+                let cq = oc.dot(oc) - radius * radius;
                 let disc = bq * bq - cq;
                 if disc < 0.0 {
                     continue;
                 }
                 let t = -bq - disc.sqrt();
                 if t > 1e-4 && best.is_none_or(|(bt, ..)| t < bt) {
-                    let p = [eye[0] + t * dir[0], eye[1] + t * dir[1], eye[2] + t * dir[2]];
-                    let n = normalize([p[0] - center[0], p[1] - center[1], p[2] - center[2]]);
-                    let uv = [0.5 + n[2].atan2(n[0]) / std::f32::consts::TAU, 0.5 - n[1].asin() / std::f32::consts::PI];
+                    let n = normalize(eye + t * dir - center);
+                    let uv = [0.5 + n.z.atan2(n.x) / std::f32::consts::TAU, 0.5 - n.y.asin() / std::f32::consts::PI];
                     best = Some((t, n, uv, material));
                 }
             }
             match best {
-                Some((t, n, uv, material)) => b.push(
-                    [eye[0] + t * dir[0], eye[1] + t * dir[1], eye[2] + t * dir[2]],
-                    n,
-                    uv,
-                    material,
-                    t,
-                    demo_surface(material, uv),
-                ),
+                Some((t, n, uv, material)) => {
+                    b.push((eye + t * dir).to_array(), n.to_array(), uv, material, t, demo_surface(material, uv))
+                }
                 None => {
                     let t = 50.0;
-                    b.push(
-                        [eye[0] + t * dir[0], eye[1] + t * dir[1], eye[2] + t * dir[2]],
-                        [-dir[0], -dir[1], -dir[2]],
-                        [0.0, 0.0],
-                        BACKGROUND,
-                        t,
-                        BACKGROUND_SURFACE,
-                    )
+                    let position = (eye + t * dir).to_array();
+                    b.push(position, (-dir).to_array(), [0.0, 0.0], BACKGROUND, t, BACKGROUND_SURFACE)
                 }
             }
         }

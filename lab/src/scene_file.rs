@@ -327,11 +327,11 @@ impl SceneFile {
         match &self.mesh {
             MeshSource::Sponza => {
                 if self.crease_angle.is_some_and(|a| a != DEFAULT_CREASE_ANGLE) {
-                    let mut mesh = Mesh::sponza().map_err(wrap)?;
+                    let mut mesh = crate::fixtures::sponza().map_err(wrap)?;
                     mesh.compute_normals(self.crease_angle.unwrap_or(DEFAULT_CREASE_ANGLE));
                     Ok(Arc::new(mesh))
                 } else {
-                    crate::mesh::sponza_shared().map_err(wrap)
+                    crate::fixtures::sponza_shared().map_err(wrap)
                 }
             }
             MeshSource::File(file) => {

@@ -11,7 +11,7 @@ use std::sync::OnceLock;
 /// the evaluation kit where cargo unpacked the Sponza model.
 pub fn gpu(gpu_tests: usize) -> Option<&'static Gpu> {
     static GPU: OnceLock<Option<Gpu>> = OnceLock::new();
-    locate_sponza();
+    mrsl_lab::fixtures::locate_sponza();
     let gpu = GPU.get_or_init(|| match Gpu::new() {
         Ok(gpu) => {
             println!("render tests on {}", describe_adapter(&gpu.adapter_info));
@@ -33,7 +33,7 @@ pub fn gpu(gpu_tests: usize) -> Option<&'static Gpu> {
 /// missing adapter is a failure wherever it runs.
 pub fn gpu_or_fail() -> &'static Gpu {
     static GPU: OnceLock<Gpu> = OnceLock::new();
-    locate_sponza();
+    mrsl_lab::fixtures::locate_sponza();
     GPU.get_or_init(|| {
         let gpu = Gpu::new().unwrap_or_else(|e| panic!("the requested driver gives no adapter: {e}"));
         println!("render tests on {}", describe_adapter(&gpu.adapter_info));
@@ -46,20 +46,6 @@ fn describe_adapter(info: &wgpu::AdapterInfo) -> String {
     match info.driver_info.as_str() {
         "" => format!("{} ({:?})", info.name, info.backend),
         driver => format!("{} ({driver}, {:?})", info.name, info.backend),
-    }
-}
-
-/// The Sponza model's path, as cargo unpacked the `obj-rs` 0.7.4 package
-/// (a dependency of the evaluation kit), unless `$MRSL_SPONZA` names it.
-fn locate_sponza() {
-    if std::env::var_os("MRSL_SPONZA").is_some() {
-        return;
-    }
-    let cargo_home = std::env::var_os("CARGO_HOME")
-        .map(std::path::PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|home| std::path::PathBuf::from(home).join(".cargo")));
-    if let Some(path) = cargo_home.and_then(|home| mrsl_lab::mesh::find_sponza_in_cargo_home(&home)) {
-        mrsl_lab::mesh::set_sponza_path(path);
     }
 }
 

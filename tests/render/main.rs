@@ -135,7 +135,7 @@ fn main() {
         return second_driver_subset(&args);
     }
     let gpu = harness::gpu(GPU_TESTS.len() + rate_source::GPU_TESTS.len() + DUNGEON_TESTS.len());
-    let dungeon = mrsl_lab::mesh::dungeon_path();
+    let dungeon = mrsl_lab::fixtures::dungeon_path();
     if let (Some(_), Err(e)) = (gpu, &dungeon) {
         println!("SKIPPING {} render test(s) over the dungeon (reported as ignored below): {e}", DUNGEON_TESTS.len());
     }

@@ -127,9 +127,9 @@ pub fn sponza_coarse_modes_stay_close_to_the_reference(gpu: &Gpu) {
 /// (up to 78-gons) are triangulated, 35 materials numbered in the order the
 /// file first uses them, all used, unit normals everywhere.
 pub fn sponza_loads_with_its_35_materials() {
-    let path = mrsl_lab::mesh::sponza_path().unwrap();
+    let path = mrsl_lab::fixtures::sponza_path().unwrap();
     assert!(path.ends_with("obj-rs-0.7.4/tests/fixtures/sponza.obj"), "{}", path.display());
-    let mesh = mrsl_lab::mesh::sponza_shared().unwrap();
+    let mesh = mrsl_lab::fixtures::sponza_shared().unwrap();
     mesh.validate().unwrap();
     assert_eq!(mesh.triangle_count(), 76_154);
     assert_eq!(mesh.material_names.len(), 35);
