@@ -67,10 +67,23 @@ impl Layout {
         serde_json::to_string_pretty(self).expect("a layout always serialises")
     }
 
-    /// Number of statistics counters: one per coarse effect, plus the dynamic
-    /// mode's count of shaded 2x2 samples.
+    /// Number of statistics counters: one per coarse effect, the dynamic
+    /// mode's count of shaded 2x2 samples, and with a background rule the
+    /// background pixels and the background coarse samples.
     pub fn stats_counters(&self) -> usize {
-        self.stats.counters.len() + 1
+        self.stats.counters.len() + if self.has_background() { 3 } else { 1 }
+    }
+
+    /// Whether a channel has a background rule ([`Background`]).
+    pub fn has_background(&self) -> bool {
+        self.channels.iter().any(|c| c.background.is_some())
+    }
+
+    /// The statistics counter of the background pixels, and of the
+    /// background coarse samples, with a background rule.
+    pub fn background_counters(&self) -> Option<(usize, usize)> {
+        let k = self.stats.counters.len();
+        self.has_background().then_some((k + 1, k + 2))
     }
 }
 
@@ -214,16 +227,39 @@ pub struct Channel {
     pub sample_type: SampleType,
     /// Discontinuity key comparison, if this channel is a key.
     pub key: Option<KeyCompare>,
+    /// Which of the channel's values mark background pixels (where nothing
+    /// was drawn), if the channel says (absent from the JSON otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub background: Option<Background>,
 }
 
 /// How a discontinuity-key channel is compared between samples.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum KeyCompare {
     /// Any difference is a discontinuity.
     Exact,
     /// `distance(a, b) > threshold` is a discontinuity.
     Threshold { threshold: f64 },
+    /// A position key compared against the surface: a discontinuity where
+    /// the offset between the two samples leaves either one's tangent plane
+    /// (the plane through it across its `normal` channel) by more than
+    /// `threshold` of the offset's length, `|dot(b - a, n)| > threshold *
+    /// |b - a|`. A ratio, so it means the same at any scale.
+    Surface { normal: String, threshold: f64 },
+}
+
+/// The background rule of a channel: the pixels where its value equals
+/// `value` (`@background(value)`), or differs from it (`@foreground(value)`),
+/// are background. There, every coarse effect reads as the zero of its
+/// type, in every kernel; coarse effects are neither evaluated nor refined
+/// nor resampled from there; fine effects and outputs are evaluated as
+/// everywhere.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Background {
+    Equal { value: f64 },
+    NotEqual { value: f64 },
 }
 
 /// The coarse-to-fine interface of the block modes: a record per coarse

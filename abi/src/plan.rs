@@ -393,6 +393,17 @@ pub struct Counts {
     pub evaluations: Evaluations,
     /// Per-level work-list lengths, if the mode has work lists.
     pub work_lists: Option<WorkListCounts>,
+    /// With a background rule: the statistics counters of the background
+    /// pixels and of the background coarse samples (where the mode has samples).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub background: Option<BackgroundCounts>,
+}
+
+/// The statistics counters that count what the background rule skipped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct BackgroundCounts {
+    pub pixels: usize,
+    pub samples: Option<usize>,
 }
 
 /// Where the number of shaded coarse samples comes from.

@@ -146,7 +146,12 @@ fn idle_keys(checked: &Checked, order: &[EffectId], keys: &[Vec<InputId>]) -> Ve
         }) else {
             continue;
         };
-        let attr = decl.attrs.iter().find(|a| a.name.name == "key").map(|a| a.span).unwrap_or(decl.name.span);
+        let attr = decl
+            .attrs
+            .iter()
+            .find(|a| matches!(a.name.name.as_str(), "key" | "surface_key"))
+            .map(|a| a.span)
+            .unwrap_or(decl.name.span);
         out.push(
             Diagnostic::warning("W0002", format!("the discontinuity key `{}` refines nothing", info.name))
                 .with_label(Label::primary(attr, format!("no coarse effect reads `{}`", info.name)))
@@ -155,8 +160,8 @@ fn idle_keys(checked: &Checked, order: &[EffectId], keys: &[Vec<InputId>]) -> Ve
                      other effects; fine effects are evaluated per pixel anyway",
                 )
                 .with_note(format!(
-                    "remove `@key`, or key the channels the coarse effects read (e.g. `@key(0.5) in float3 position;` \
-                     and `@key(0.4) in float3 normal;` for geometric edges) instead of `{}`",
+                    "remove the key, or key the channels the coarse effects read (e.g. `@surface_key(normal, 0.25) in \
+                     float3 position;` and `@key(0.4) in float3 normal;` for geometric edges) instead of `{}`",
                     info.name
                 )),
         );
@@ -165,12 +170,21 @@ fn idle_keys(checked: &Checked, order: &[EffectId], keys: &[Vec<InputId>]) -> Ve
 }
 
 /// The discontinuity keys each effect of `order` reads, directly or through
-/// the effects it reads; `order` has dependencies first, so each effect's
-/// dependencies are complete when it is reached.
+/// the effects it reads, and for a coarse effect the background channels,
+/// whose edges every coarse effect keeps to its side; `order` has
+/// dependencies first, so each effect's dependencies are complete when it
+/// is reached.
 fn keys_read(checked: &Checked, order: &[EffectId]) -> Vec<Vec<InputId>> {
+    let background: Vec<InputId> = (0..checked.inputs.len() as u32)
+        .map(InputId)
+        .filter(|i| checked.inputs[i.index()].background.is_some())
+        .collect();
     let mut keys: Vec<BTreeSet<InputId>> = vec![BTreeSet::new(); checked.effects.len()];
     for &e in order {
         let mut read = BTreeSet::new();
+        if checked.effects[e.index()].rate == Rate::Coarse {
+            read.extend(background.iter().copied());
+        }
         let mut note = |x: &crate::syntax::ast::Expr| {
             if let Some(Symbol::Input(i)) = checked.symbols.get(&x.id)
                 && checked.inputs[i.index()].key.is_some()

@@ -125,7 +125,8 @@ pub fn build(
                 binding: i as u32,
                 format,
                 sample_type,
-                key: input.key,
+                key: input.key.clone(),
+                background: input.background,
             }
         })
         .collect();

@@ -9,8 +9,8 @@ use mrsl_abi::geometry::{
     WORK_LIST_WORKGROUP,
 };
 use mrsl_abi::plan::{
-    BindingType, Counts, Dispatch, Evaluations, Extent, ModePlan, Pass, PassBinding, Plan, ResourceDesc, ResourceId,
-    SampleCount, Shape, Stage, Step, WorkListCounts, Workgroups,
+    BackgroundCounts, BindingType, Counts, Dispatch, Evaluations, Extent, ModePlan, Pass, PassBinding, Plan,
+    ResourceDesc, ResourceId, SampleCount, Shape, Stage, Step, WorkListCounts, Workgroups,
 };
 use mrsl_abi::{KernelKind, KernelRef, Layout, Mode, TextureFormat, entry};
 
@@ -32,7 +32,12 @@ fn mode_plan(layout: &Layout, mode: Mode) -> ModePlan {
         Mode::Reference => {
             let reference = KernelRef::new(KernelKind::Reference, None);
             steps.push(pass(layout, "mrsl reference", Stage::Fine, reference, vec![tiles(entry::REFERENCE)]));
-            Counts { samples: SampleCount::None, evaluations: Evaluations::EveryPixel, work_lists: None }
+            Counts {
+                samples: SampleCount::None,
+                evaluations: Evaluations::EveryPixel,
+                work_lists: None,
+                background: None,
+            }
         }
         Mode::Coarse2x2 | Mode::Coarse4x4 | Mode::Dynamic => block_steps(layout, mode, &mut steps),
         Mode::Hierarchical => hierarchical_steps(layout, &mut steps),
@@ -40,11 +45,17 @@ fn mode_plan(layout: &Layout, mode: Mode) -> ModePlan {
             let kernel = KernelRef::new(KernelKind::Checkerboard, None);
             let shade = dispatch(entry::CB_SHADE, Workgroups::CheckerboardQuads);
             steps.push(pass(layout, "mrsl checkerboard", Stage::Fine, kernel, vec![shade, tiles(entry::CB_FINAL)]));
-            Counts { samples: SampleCount::None, evaluations: Evaluations::Counted, work_lists: None }
+            Counts { samples: SampleCount::None, evaluations: Evaluations::Counted, work_lists: None, background: None }
         }
         Mode::RateImage => rate_image_steps(layout, &mut steps),
     };
     steps.push(Step::Readback { resource: ResourceId::Statistics, bytes: None });
+    let mut counts = counts;
+    // The reference counts nothing; the others count the background they skip.
+    if let (Some((pixels, samples)), false) = (layout.background_counters(), mode == Mode::Reference) {
+        let sampled = !matches!(counts.samples, SampleCount::None);
+        counts.background = Some(BackgroundCounts { pixels, samples: sampled.then_some(samples) });
+    }
     ModePlan { mode, kernels: mode.kernels().to_vec(), steps, counts }
 }
 
@@ -75,6 +86,7 @@ fn block_steps(layout: &Layout, mode: Mode, steps: &mut Vec<Step>) -> Counts {
         samples: SampleCount::Grid { block, counter },
         evaluations: Evaluations::SamplesAndCounted,
         work_lists: None,
+        background: None,
     }
 }
 
@@ -117,6 +129,7 @@ fn hierarchical_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
             levels: (1..=HIERARCHICAL_LEVELS.len() as u32).collect(),
             lanes: WORK_LIST_WORKGROUP,
         }),
+        background: None,
     }
 }
 
@@ -151,6 +164,7 @@ fn rate_image_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
         samples: SampleCount::Listed { resource: ResourceId::SampleCount, word: 0 },
         evaluations: Evaluations::SamplesAndCounted,
         work_lists: None,
+        background: None,
     }
 }
 
@@ -211,6 +225,12 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
         ],
         KernelKind::RateFine => vec![buffer(interface, R::RateRecords, true), shading_rate],
     };
+    // With a background rule the coarse kernels count the background samples.
+    let counts_background =
+        matches!(kernel.kind, KernelKind::Coarse | KernelKind::RateCoarse) && layout.has_background();
+    if counts_background {
+        bindings.push(buffer(layout.stats.binding, R::Statistics, false));
+    }
     if !kernel.kind.is_coarse() {
         bindings.extend(
             layout

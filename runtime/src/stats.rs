@@ -56,6 +56,12 @@ pub struct Stats {
     pub work_lists: Vec<u64>,
     /// Hierarchical mode: queued pixels / lanes dispatched to shade them.
     pub lane_utilisation: Option<f64>,
+    /// With a background rule: the pixels it made background (their coarse
+    /// effects neither evaluated nor resampled: they read as zero).
+    pub background_pixels: u64,
+    /// With a background rule: the coarse samples that fell on the
+    /// background (not evaluated; subtracted from the coarse evaluations).
+    pub background_samples: u64,
 }
 
 impl Stats {
@@ -80,20 +86,25 @@ impl Stats {
             // The rate-image mode shades the samples its tiles listed (read back from its counter).
             SampleCount::Listed { .. } => listed_samples,
         };
+        let background_pixels = counts.background.map_or(0, |b| counter(b.pixels));
+        let background_samples = counts.background.and_then(|b| b.samples).map_or(0, counter);
         let mut effects = vec![];
         for e in layout.effects.iter().filter(|e| e.live) {
             let counted = || layout.stats.counters.iter().position(|c| *c == e.name).map(counter).unwrap_or(0);
+            let evaluated_samples = samples - background_samples.min(samples);
             let (coarse_evaluations, pixel_evaluations) = match (counts.evaluations, e.rate) {
                 (Evaluations::Counted, Rate::Coarse) => (0, counted()),
-                (Evaluations::SamplesAndCounted, Rate::Coarse) => (samples, counted()),
+                (Evaluations::SamplesAndCounted, Rate::Coarse) => (evaluated_samples, counted()),
                 _ => (0, pixels),
             };
+            // A background pixel neither evaluates nor resamples its coarse effects.
+            let skipped = if e.rate == Rate::Coarse { background_pixels } else { 0 };
             effects.push(EffectStats {
                 name: e.name.clone(),
                 rate: e.rate,
                 coarse_evaluations,
                 pixel_evaluations,
-                resampled: pixels - pixel_evaluations.min(pixels),
+                resampled: pixels - (pixel_evaluations + skipped).min(pixels),
                 shaded_fraction: (coarse_evaluations + pixel_evaluations) as f64 / pixels as f64,
             });
         }
@@ -118,6 +129,8 @@ impl Stats {
             timings,
             work_lists: vec![],
             lane_utilisation: None,
+            background_pixels,
+            background_samples,
         }
     }
 
@@ -151,6 +164,12 @@ impl Stats {
                 e.pixel_evaluations,
                 e.resampled,
                 100.0 * e.shaded_fraction
+            ));
+        }
+        if self.background_pixels > 0 || self.background_samples > 0 {
+            out.push_str(&format!(
+                "  background: {} pixels, {} coarse samples (coarse effects read as zero there)\n",
+                self.background_pixels, self.background_samples
             ));
         }
         if !self.work_lists.is_empty() {

@@ -5,8 +5,8 @@
 
 use super::formats::{default_output_format, formats_for, output_format_fits};
 use super::{
-    Checker, ConstId, ConstInfo, ConstValue, EffectId, EffectInfo, FunctionId, FunctionInfo, Global, InputId,
-    InputInfo, KeyCompare, UniformId, UniformInfo, UniformKind, err,
+    Background, Checker, ConstId, ConstInfo, ConstValue, EffectId, EffectInfo, FunctionId, FunctionInfo, Global,
+    InputId, InputInfo, KeyCompare, UniformId, UniformInfo, UniformKind, err,
 };
 use crate::builtins::Builtin;
 use crate::diagnostic::{Diagnostic, Label};
@@ -50,7 +50,7 @@ impl Checker<'_> {
             match item {
                 Item::Input(d) => {
                     let ty = self.resolve_type(&d.ty);
-                    self.out.inputs.push(InputInfo { name: d.name.name.clone(), ty, key: None });
+                    self.out.inputs.push(InputInfo { name: d.name.name.clone(), ty, key: None, background: None });
                 }
                 Item::Uniform(d) => {
                     let ty = self.resolve_type(&d.ty);
@@ -172,9 +172,110 @@ impl Checker<'_> {
                     }
                     self.out.inputs[id.index()].key = key;
                 }
-                other => self.unknown_attribute(attr, other, &["key"]),
+                "surface_key" => {
+                    if let Some(key) = self.surface_key(attr, &ty) {
+                        self.out.inputs[id.index()].key = Some(key);
+                    }
+                }
+                "background" | "foreground" => {
+                    let rule = self.background_rule(attr, &ty);
+                    self.out.inputs[id.index()].background = rule;
+                }
+                other => self.unknown_attribute(attr, other, &["key", "surface_key", "background", "foreground"]),
             }
         }
+    }
+
+    /// `@surface_key(normal, t)` on a `float3` position channel: the offset
+    /// between two samples leaving either one's tangent plane by more than
+    /// `t` of its length is a discontinuity (`KeyCompare::Surface`).
+    fn surface_key(&mut self, attr: &Attribute, ty: &Type) -> Option<KeyCompare> {
+        let float3 = Type::Vector(Scalar::Float, 3);
+        let [normal, threshold] = attr.args.as_slice() else {
+            self.error(
+                err(
+                    "E0111",
+                    "`@surface_key` takes the normal channel and a threshold",
+                    attr.span,
+                    "expected two arguments",
+                )
+                .with_note("e.g. `@surface_key(normal, 0.25) in float3 position;`"),
+            );
+            return None;
+        };
+        if *ty != float3 && !ty.is_error() {
+            self.error(err("E0111", "a surface key must be a `float3` position channel", attr.span, "not a `float3`"));
+            return None;
+        }
+        let normal_input = match &normal.kind {
+            ExprKind::Name(name) => self.out.inputs.iter().find(|i| i.name == *name),
+            _ => None,
+        };
+        let normal_name = match normal_input {
+            Some(input) if input.ty == float3 => input.name.clone(),
+            _ => {
+                self.error(err(
+                    "E0111",
+                    "the first argument of `@surface_key` must name a `float3` normal channel",
+                    normal.span,
+                    "not a `float3` channel",
+                ));
+                return None;
+            }
+        };
+        match self.const_eval(threshold) {
+            Some(v) if v.values.len() == 1 && (0.0..=1.0).contains(&v.values[0]) => {
+                Some(KeyCompare::Surface { normal: normal_name, threshold: v.values[0] })
+            }
+            _ => {
+                self.error(
+                    err(
+                        "E0111",
+                        "a surface key's threshold must be a number from 0 to 1",
+                        threshold.span,
+                        "expected a number",
+                    )
+                    .with_note(
+                        "it is the sine of the angle at which the offset between two samples leaves the surface",
+                    ),
+                );
+                None
+            }
+        }
+    }
+
+    /// `@background(v)` (pixels where the channel is `v`) or `@foreground(v)`
+    /// (where it is not) on a scalar channel.
+    fn background_rule(&mut self, attr: &Attribute, ty: &Type) -> Option<Background> {
+        let which = attr.name.name.as_str();
+        let [value] = attr.args.as_slice() else {
+            self.error(err("E0111", format!("`@{which}` takes one value"), attr.span, "expected one argument"));
+            return None;
+        };
+        if ty.components() != 1 && !ty.is_error() {
+            self.error(err("E0111", format!("`@{which}` must be on a scalar channel"), attr.span, "not a scalar"));
+            return None;
+        }
+        let Some(v) = self.const_eval(value).filter(|v| v.values.len() == 1) else {
+            self.error(err("E0111", format!("`@{which}` takes a constant"), value.span, "not a constant"));
+            return None;
+        };
+        let v = v.values[0];
+        let fits = match ty.scalar() {
+            Some(Scalar::Uint) => v >= 0.0 && v <= f64::from(u32::MAX) && v.fract() == 0.0,
+            Some(Scalar::Int) => v >= f64::from(i32::MIN) && v <= f64::from(i32::MAX) && v.fract() == 0.0,
+            _ => v.is_finite(),
+        };
+        if !fits && !ty.is_error() {
+            self.error(err(
+                "E0111",
+                format!("`@{which}` value does not fit the channel's type `{ty}`"),
+                value.span,
+                "out of range",
+            ));
+            return None;
+        }
+        Some(if which == "background" { Background::Equal { value: v } } else { Background::NotEqual { value: v } })
     }
 
     fn unknown_attribute(&mut self, attr: &Attribute, name: &str, known: &[&str]) {

@@ -72,7 +72,7 @@ pub enum Callee {
 }
 
 /// How a discontinuity-key channel is compared (part of the layout contract).
-pub use mrsl_abi::KeyCompare;
+pub use mrsl_abi::{Background, KeyCompare};
 
 /// A G-buffer input (`in`).
 #[derive(Debug, Clone)]
@@ -80,6 +80,8 @@ pub struct InputInfo {
     pub name: String,
     pub ty: Type,
     pub key: Option<KeyCompare>,
+    /// `@background(v)` or `@foreground(v)`: which values mark background pixels.
+    pub background: Option<Background>,
 }
 
 /// What a uniform binds to: a value in the uniform block, or a resource.

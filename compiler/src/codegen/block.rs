@@ -11,7 +11,9 @@
 use super::Writer;
 use super::effects::{Evaluation, Key};
 use super::fine::{CORNER_SAMPLES, Corners, LANES, Level, Resolver};
-use super::names::{BLOCK_STRUCT, CORNERS_STRUCT, GID, INTERFACE, NEIGHBOURS, Name, POS, RECORD, SAMPLES, STRIDE};
+use super::names::{
+    BACKGROUND, BLOCK_STRUCT, CORNERS_STRUCT, GID, INTERFACE, NEIGHBOURS, Name, POS, RECORD, SAMPLES, STATS, STRIDE,
+};
 use super::words::{pack_words, test_bit, unpack_with};
 use super::writer::{cut, fill};
 use crate::check::{EffectId, InputId};
@@ -191,6 +193,10 @@ impl Writer<'_, '_, '_> {
                 self.line(1, format!("var {} = 0u;", Name::RecordWord.of(w)));
             }
         }
+        if let Some((_, samples)) = self.i.layout.background_counters() {
+            let on = super::pixel::statistics_enabled();
+            self.line(1, format!("if ({on} && {BACKGROUND}({POS})) {{ atomicAdd(&{STATS}[{samples}], 1u); }}"));
+        }
         self.coarse_values();
         self.record_flags();
         self.record_slots();
@@ -346,7 +352,7 @@ impl Writer<'_, '_, '_> {
         for key in &keys {
             let name = key.name;
             for (corner, at) in CORNERS.iter().zip(CORNER_PIXELS) {
-                self.line(1, format!("c.{corner}_{name} = {}({at});", Name::Load.of(name)));
+                self.line(1, format!("c.{corner}_{name} = {};", key.load(at)));
             }
         }
         // A texel holds four words of a record: one load per corner and texel.
@@ -462,6 +468,7 @@ impl Writer<'_, '_, '_> {
         self.corner_flag_words(r);
         self.template(0, corners, &[]);
         self.refine_decisions(r, CORNER_SAMPLES.len(), &|w, e| w.edge_discontinuity(e));
+        self.background_decision();
         self.template(0, refined, &[]);
     }
 
@@ -476,7 +483,7 @@ impl Writer<'_, '_, '_> {
             .zip(CORNER_PIXELS)
             .map(|(corner, pixel)| match r.corners {
                 Corners::Preloaded => format!("c.{corner}_{name}"),
-                Corners::Loaded => format!("{}({pixel})", Name::Load.of(name)),
+                Corners::Loaded => key.load(pixel),
             })
             .collect();
         self.template(
@@ -484,6 +491,7 @@ impl Writer<'_, '_, '_> {
             include_str!("templates/resolve_key.wgsl"),
             &[
                 ("NAME", &name),
+                ("LOAD", &key.loader()),
                 ("K00", &at[0]),
                 ("K10", &at[1]),
                 ("K01", &at[2]),
@@ -499,7 +507,7 @@ impl Writer<'_, '_, '_> {
         self.resolve_function(&r);
         for s in self.resamplers(level, &|w, e| w.edge_weights_of(e)) {
             if r.corners == Corners::Loaded {
-                self.template(0, include_str!("templates/resample.wgsl"), &s.values());
+                self.resampler_template(include_str!("templates/resample.wgsl"), &s.values(), &s.wgsl_type);
                 continue;
             }
             let corner = |lane: &str| unpack_with(s.ty, |k| format!("c.w{}.{lane}", s.offset + k));
@@ -516,7 +524,7 @@ impl Writer<'_, '_, '_> {
                 ("FILTER", &s.filter),
                 ("VALUE", &s.value),
             ];
-            self.template(0, include_str!("templates/resample_corners.wgsl"), values);
+            self.resampler_template(include_str!("templates/resample_corners.wgsl"), values, &ty);
         }
     }
 

@@ -8,7 +8,7 @@
 
 use super::Writer;
 use super::effects::Evaluation;
-use super::names::{Name, POS, WORKGROUP_STATS};
+use super::names::{ALONE, BACKGROUND_HERE, Name, POS, SHADED, WORKGROUP_STATS};
 use super::records::{axis_neighbours, neighbours};
 use super::writer::cut;
 use crate::types::{Scalar, Type};
@@ -57,10 +57,7 @@ impl Writer<'_, '_, '_> {
         let tap_tests: Vec<String> = self
             .keys_of(&coarse)
             .iter()
-            .map(|key| {
-                let load = |at: &str| format!("{}({at})", Name::Load.of(key.name));
-                format!("ok[k] = ok[k] && ({});", key.matches(&load("taps[k]"), &load("p")))
-            })
+            .map(|key| format!("ok[k] = ok[k] && ({});", key.matches(&key.load("taps[k]"), &key.load("p"))))
             .collect();
         self.neighbour_pairs("taps", &tap_tests, note, ["pair_x", "pair_y"]);
         self.template(0, end, &[]);
@@ -82,22 +79,49 @@ impl Writer<'_, '_, '_> {
         let coarse = coarse.len();
         let [head, stats, end] = cut(include_str!("templates/checkerboard_final.wgsl"), &["STATS", "COUNTS"]);
         let [value, evaluated] = cut(include_str!("templates/checkerboard_value.wgsl"), &["EVALUATE"]);
+        // The background rule: a background pixel takes zeros and is not counted (but as background).
+        let background = self.has_background().then(|| self.background_here(POS));
+        let (bg_line, evaluated_test, mask_y, zero) = match &background {
+            Some(test) => (
+                format!("\n        let {BACKGROUND_HERE} = {test};"),
+                format!("!{BACKGROUND_HERE} && ({SHADED} || {ALONE})"),
+                format!("select(0u, 0xffffffffu, {BACKGROUND_HERE})"),
+                format!("if ({BACKGROUND_HERE}) {{}} else "),
+            ),
+            None => (String::new(), format!("{SHADED} || {ALONE}"), "0u".into(), String::new()),
+        };
         self.record_final(
             |w, _| {
-                w.template(0, head, &[]);
+                w.template(0, head, &[("BACKGROUND", &bg_line)]);
                 if coarse > 0 {
                     let all = if coarse >= 32 { u32::MAX } else { (1u32 << coarse) - 1 };
-                    w.template(0, stats, &[("ALL", &all), ("STATISTICS_ON", &super::pixel::statistics_enabled())]);
+                    w.template(
+                        0,
+                        stats,
+                        &[
+                            ("ALL", &all),
+                            ("STATISTICS_ON", &super::pixel::statistics_enabled()),
+                            ("EVALUATED", &evaluated_test),
+                            ("MASK_Y", &mask_y),
+                        ],
+                    );
                     for k in 0..coarse {
                         w.line(4, format!("atomicAdd(&{WORKGROUP_STATS}[{k}], 1u);"));
                     }
-                    w.template(0, end, &[]);
+                    let count = match &background {
+                        Some(_) => format!(
+                            "\n            if ({BACKGROUND_HERE}) {{ atomicAdd(&{WORKGROUP_STATS}[{coarse}], 1u); }}"
+                        ),
+                        None => String::new(),
+                    };
+                    w.template(0, end, &[("BACKGROUND_COUNT", &count)]);
                 }
             },
             |w, e, indent| {
                 let info = &w.checked().effects[e.index()];
                 let (var, ty) = (w.effect_name(e), info.ty.wgsl());
-                let values: [(&str, &dyn Display); 3] = [("VAR", &var), ("TYPE", &ty), ("NAME", &info.name)];
+                let values: [(&str, &dyn Display); 4] =
+                    [("VAR", &var), ("TYPE", &ty), ("NAME", &info.name), ("ZERO", &zero)];
                 w.template(indent, value, &values);
                 w.evaluate(e, indent + 1, "", Evaluation::Kernel);
                 w.template(indent, evaluated, &values);

@@ -101,10 +101,12 @@ impl Writer<'_, '_, '_> {
         self.resolve_preamble(2, "");
         self.line(2, format!("{COMPACT_BLOCKS}[{LANE}] = {BLOCK};"));
         self.statistics_on(2);
-        self.template(3, include_str!("templates/rate.wgsl"), &[("LAST", &BLOCK), ("FROM_INNER", &"0u")]);
+        let mask_y = self.mask_y(BLOCK, "0u");
+        self.template(3, include_str!("templates/rate.wgsl"), &[("LAST", &BLOCK), ("FROM_INNER", &mask_y)]);
         for j in 0..k {
             self.count_refined(j, &format!("{IS_REFINED}({LAST_BLOCK}, {j}u)"));
         }
+        self.count_background(BLOCK);
         self.line(2, "}");
         for &e in &coarse {
             let j = self.coarse_index[&e];
@@ -152,7 +154,8 @@ impl Writer<'_, '_, '_> {
             0,
             include_str!("templates/stats_flush.wgsl"),
             &[
-                ("COUNTERS", &k),
+                ("COUNTERS", &self.workgroup_counters()),
+                ("TARGET", &self.counter_target()),
                 ("WORKGROUP", &PIXEL_WORKGROUP),
                 ("STATISTICS_ON", &super::pixel::statistics_enabled()),
             ],

@@ -75,7 +75,12 @@ impl Writer<'_, '_, '_> {
             self.template(
                 0,
                 include_str!("templates/parent_key.wgsl"),
-                &[("NAME", &key.name), ("BLOCK", &block), ("TESTS", &corners_differ(&key, "").join(" || "))],
+                &[
+                    ("NAME", &key.name),
+                    ("LOAD", &key.loader()),
+                    ("BLOCK", &block),
+                    ("TESTS", &corners_differ(&key, "").join(" || ")),
+                ],
             );
         }
         self.template(0, keys, &[]);

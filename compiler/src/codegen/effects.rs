@@ -6,13 +6,14 @@
 //! entry points of every family use.
 
 use super::body::{Mode, float_literal, local_name, wgsl_ident};
-use super::names::{BLOCK_SIZE, CONTROL, FORCE, NEIGHBOURS, Name, POS, REFINE};
+use super::names::{BACKGROUND, BLOCK_SIZE, CONTROL, FORCE, NEIGHBOURS, Name, POS, REFINE};
 use super::words::{bit, unpack_with};
 use super::writer::cut;
 use super::{Derivatives, Writer};
-use crate::check::{EffectId, InputId, KeyCompare, Symbol};
+use crate::check::{Background, EffectId, InputId, KeyCompare, Symbol};
 use crate::syntax::ast::*;
 use crate::syntax::{visit_expr, visit_stmt_exprs};
+use crate::types::Scalar;
 use mrsl_abi::{CONTROL_FIELDS, KernelKind};
 use std::collections::{BTreeSet, HashMap, HashSet};
 
@@ -25,13 +26,18 @@ const MAX_PARAMETERS: usize = 255;
 const ARGS_PER_STRUCT: usize = 1000;
 
 /// A discontinuity key: an input that, where its values at two positions
-/// differ, keeps them from sharing coarse values.
+/// differ, keeps them from sharing coarse values. A channel with a
+/// background rule is a key too: the background and what was drawn never
+/// share coarse values.
 pub(super) struct Key<'c> {
     pub(super) name: &'c str,
-    /// The channel's WGSL type.
+    /// The WGSL type of the key's value at a position ([`Key::load`]): the
+    /// channel's type, or for a surface key the position and normal together.
     pub(super) ty: String,
-    compare: KeyCompare,
-    scalar: bool,
+    compare: Option<KeyCompare>,
+    background: Option<Background>,
+    scalar: Scalar,
+    components: u32,
 }
 
 impl Key<'_> {
@@ -47,16 +53,71 @@ impl Key<'_> {
         self.compare(a, b, false)
     }
 
-    /// The one comparison of key values: exact (`any` over vector components)
-    /// or by distance against the key's threshold, in either sense.
+    /// The function that gives the key's value at a position: the
+    /// channel's loader, or a surface key's (position and normal together).
+    pub(super) fn loader(&self) -> String {
+        match self.compare {
+            Some(KeyCompare::Surface { .. }) => Name::SurfaceKey.of(self.name),
+            _ => Name::Load.of(self.name),
+        }
+    }
+
+    /// The key's value at `pos`.
+    pub(super) fn load(&self, pos: &str) -> String {
+        format!("{}({pos})", self.loader())
+    }
+
+    /// The one comparison of key values: exact (`any` over vector
+    /// components), by distance against the key's threshold, or against
+    /// the surface; and, for a background channel, whether one value is
+    /// background and the other not. In either sense.
     fn compare(&self, a: &str, b: &str, differs: bool) -> String {
         let (equal, reduce, close) = if differs { ("!=", "any", ">") } else { ("==", "all", "<=") };
-        let test = match self.compare {
-            KeyCompare::Exact if self.scalar => format!("{a} {equal} {b}"),
-            KeyCompare::Exact => return format!("{reduce}({a} {equal} {b})"),
-            KeyCompare::Threshold { threshold } => format!("distance({a}, {b}) {close} {}", float_literal(threshold)),
+        // Each test, and whether it is a call (an operand of `||` as it stands).
+        let mut tests: Vec<(String, bool)> = vec![];
+        match &self.compare {
+            None => {}
+            Some(KeyCompare::Exact) if self.components == 1 => tests.push((format!("{a} {equal} {b}"), false)),
+            Some(KeyCompare::Exact) => tests.push((format!("{reduce}({a} {equal} {b})"), true)),
+            Some(KeyCompare::Threshold { threshold }) => {
+                tests.push((format!("distance({a}, {b}) {close} {}", float_literal(*threshold)), false))
+            }
+            Some(KeyCompare::Surface { .. }) => {
+                let edge = format!("{}({a}, {b})", Name::SurfaceEdge.of(self.name));
+                tests.push(if differs { (edge, true) } else { (format!("!{edge}"), true) })
+            }
+        }
+        if let Some(rule) = self.background {
+            let (a, b) = (self.is_background(rule, a), self.is_background(rule, b));
+            tests.push((format!("{a} {equal} {b}"), false));
+        }
+        match (tests.as_slice(), differs) {
+            ([(one, call)], true) if *call => one.clone(),
+            ([(one, _)], true) => format!("({one})"),
+            ([(one, _)], false) => one.clone(),
+            (_, true) => format!("({})", tests.iter().map(|(t, _)| t.as_str()).collect::<Vec<_>>().join(" || ")),
+            (_, false) => tests.iter().map(|(t, _)| format!("({t})")).collect::<Vec<_>>().join(" && "),
+        }
+    }
+
+    /// Whether the channel says the pixel at `pos` is background.
+    pub(super) fn background_at(&self, pos: &str) -> String {
+        let rule = self.background.expect("a background channel");
+        self.is_background(rule, &format!("{}({pos})", Name::Load.of(self.name)))
+    }
+
+    /// `(value == V)`, or `(value != V)` for `@foreground(V)`.
+    fn is_background(&self, rule: Background, value: &str) -> String {
+        let (op, v) = match rule {
+            Background::Equal { value } => ("==", value),
+            Background::NotEqual { value } => ("!=", value),
         };
-        if differs { format!("({test})") } else { test }
+        let literal = match self.scalar {
+            Scalar::Uint => format!("{}u", v as u64),
+            Scalar::Int => format!("i32({})", v as i64),
+            _ => float_literal(v),
+        };
+        format!("({value} {op} {literal})")
     }
 }
 
@@ -77,16 +138,26 @@ impl<'b> Writer<'_, '_, 'b> {
     /// directly or through other effects: `EffectGraph::keys`), in
     /// declaration order. A key no coarse effect reads is never loaded.
     pub(super) fn keys_of(&self, effects: &[EffectId]) -> Vec<Key<'b>> {
-        let c = self.checked();
         let read: BTreeSet<InputId> =
             effects.iter().flat_map(|e| self.i.graph.keys[e.index()].iter().copied()).collect();
-        read.into_iter()
-            .map(|i| {
-                let x = &c.inputs[i.index()];
-                let compare = x.key.expect("EffectGraph::keys holds key channels only");
-                Key { name: &x.name, ty: x.ty.wgsl(), compare, scalar: x.ty.components() == 1 }
-            })
-            .collect()
+        read.into_iter().map(|i| self.key(i)).collect()
+    }
+
+    /// The key of channel `i` (a discontinuity key, a background channel or both).
+    fn key(&self, i: InputId) -> Key<'b> {
+        let x = &self.checked().inputs[i.index()];
+        let ty = match x.key {
+            Some(KeyCompare::Surface { .. }) => Name::SurfaceStruct.of(&x.name),
+            _ => x.ty.wgsl(),
+        };
+        Key {
+            name: &x.name,
+            ty,
+            compare: x.key.clone(),
+            background: x.background,
+            scalar: x.ty.scalar().unwrap_or(Scalar::Float),
+            components: x.ty.components(),
+        }
     }
 
     /// `disc || disc_<key>...`: true where effect `e` is refined by a
@@ -156,6 +227,9 @@ impl<'b> Writer<'_, '_, 'b> {
         }
         if self.counts_stats() {
             self.stats_bindings();
+        } else if matches!(self.kind, KernelKind::Coarse | KernelKind::RateCoarse) && self.has_background() {
+            // The coarse kernels count the background samples.
+            self.stats_buffer();
         }
         if !self.kind.is_coarse() {
             for o in &l.outputs {
@@ -208,6 +282,53 @@ impl<'b> Writer<'_, '_, 'b> {
                 &[("NAME", &input.name), ("TYPE", &input.ty.wgsl()), ("SWIZZLE", &swizzle)],
             );
         }
+    }
+
+    /// For every surface key, its value (`MrslSurface_<channel>`: the
+    /// position and its normal), the function that loads it and the
+    /// function that tests two of them for an edge; and `mrsl_background`
+    /// where the program has a background rule.
+    pub(super) fn key_functions(&mut self) {
+        let c = self.checked();
+        for input in &c.inputs {
+            let Some(KeyCompare::Surface { normal, threshold }) = &input.key else { continue };
+            let (ty, load) = (Name::SurfaceStruct.of(&input.name), Name::Load.of(&input.name));
+            self.template(
+                0,
+                include_str!("templates/surface_key.wgsl"),
+                &[
+                    ("NAME", &input.name),
+                    ("TYPE", &ty),
+                    ("KEY", &Name::SurfaceKey.of(&input.name)),
+                    ("EDGE", &Name::SurfaceEdge.of(&input.name)),
+                    ("LOAD_POSITION", &load),
+                    ("LOAD_NORMAL", &Name::Load.of(normal)),
+                    ("THRESHOLD", &float_literal(*threshold)),
+                ],
+            );
+        }
+        let tests: Vec<String> = (0..c.inputs.len() as u32)
+            .map(InputId)
+            .filter(|i| c.inputs[i.index()].background.is_some())
+            .map(|i| {
+                let key = self.key(i);
+                key.background_at("pos")
+            })
+            .collect();
+        if !tests.is_empty() {
+            self.template(0, include_str!("templates/background.wgsl"), &[("TESTS", &tests.join(" || "))]);
+        }
+    }
+
+    /// WGSL: the background rule holds at `pos` and refinement is not forced
+    /// (forced, a background pixel is evaluated, and reads as zero).
+    pub(super) fn background_here(&self, pos: &str) -> String {
+        format!("({BACKGROUND}({pos}) && {CONTROL}.force_refine == 0u)")
+    }
+
+    /// Whether the program has a background rule (`@background`, `@foreground`).
+    pub(super) fn has_background(&self) -> bool {
+        self.checked().inputs.iter().any(|i| i.background.is_some())
     }
 
     pub(super) fn deps_params(&self, e: EffectId) -> Vec<EffectId> {
@@ -363,6 +484,10 @@ impl<'b> Writer<'_, '_, 'b> {
         }
         let sig = self.eval_signature(e, value_only);
         self.line(0, format!("{sig} {{"));
+        if info.rate == Rate::Coarse && self.has_background() {
+            // The background rule: a coarse effect reads as zero where nothing was drawn.
+            self.line(1, format!("if ({BACKGROUND}({POS})) {{ return {}(); }}", info.ty.wgsl()));
+        }
         for (k, part) in self.dependency_parts(e).unwrap_or_default().iter().enumerate() {
             for &d in part {
                 let dep = self.effect_name(d);

@@ -10,7 +10,9 @@
 
 use super::Writer;
 use super::effects::Evaluation;
-use super::names::{BLOCK, CORNERS, INNER_BLOCK, INTERFACE, IS_REFINED, LAST_BLOCK, LOAD_CORNERS, Name, POS};
+use super::names::{
+    BACKGROUND, BLOCK, CONTROL, CORNERS, INNER_BLOCK, INTERFACE, IS_REFINED, LAST_BLOCK, LOAD_CORNERS, Name, POS,
+};
 use super::pixel::Scope;
 use super::words::{bit, test_bit, unpack_words};
 use super::writer::cut;
@@ -95,7 +97,7 @@ pub(super) struct Resampler<'c> {
     pub(super) ty: &'c Type,
     /// The first word of the effect's slot in a record.
     pub(super) offset: u32,
-    wgsl_type: String,
+    pub(super) wgsl_type: String,
     stride: u32,
     unpack: String,
     /// How the corners' values `v0`..`v3` are blended: `bilinear` or `nearest corner`.
@@ -170,6 +172,9 @@ impl<'b> Writer<'_, '_, 'b> {
         // Separate words, not an array: llvmpipe spills dynamically indexed
         // arrays in structs to memory, which made every lookup a memory access.
         fields(self);
+        if self.has_background() {
+            self.line(1, "background: bool, // nothing was drawn at the pixel: its coarse effects read as zero");
+        }
         for w in 0..mask_words {
             self.line(1, format!("refined{w}: u32, // bit k: coarse effect 32 * {w} + k is evaluated per pixel"));
         }
@@ -241,6 +246,30 @@ impl<'b> Writer<'_, '_, 'b> {
             self.line(1, format!("let {refined} = {value}; // `{}`", self.checked().effects[e.index()].name));
             self.line(1, format!("if ({refined}) {{ b.refined{word} |= {mask}u; }}"));
         }
+    }
+
+    /// In a resolver, after the refine decisions: the background rule. Where
+    /// nothing was drawn (and refinement is not forced, where every effect is
+    /// evaluated and reads as zero as it does in the reference), the pixel
+    /// re-evaluates nothing and its resamplers return zero.
+    pub(super) fn background_decision(&mut self) {
+        if !self.has_background() {
+            return;
+        }
+        self.line(1, format!("b.background = {BACKGROUND}(pos) && {CONTROL}.force_refine == 0u;"));
+        let clear: Vec<String> = (0..self.mask_words()).map(|w| format!("b.refined{w} = 0u;")).collect();
+        self.line(1, format!("if (b.background) {{ {} }}", clear.join(" ")));
+    }
+
+    /// A resampler from `template`, whose `{{#GUARD}}` hole, after the
+    /// signature, returns zero at a background pixel (the background rule).
+    pub(super) fn resampler_template(&mut self, template: &str, values: &super::writer::Values, ty: &str) {
+        let [head, tail] = cut(template, &["GUARD"]);
+        self.template(0, head, values);
+        if self.has_background() {
+            self.line(1, format!("if (b.background) {{ return {ty}(); }}"));
+        }
+        self.template(0, tail, values);
     }
 
     /// Whether coarse effect `e` is needed coarsely, as WGSL over the
@@ -434,10 +463,12 @@ impl<'b> Writer<'_, '_, 'b> {
                     (BLOCK, "0u".to_string())
                 };
                 w.statistics_on(2);
-                w.template(3, include_str!("templates/rate.wgsl"), &[("LAST", &last), ("FROM_INNER", &from_inner)]);
+                let mask_y = w.mask_y(last, &from_inner);
+                w.template(3, include_str!("templates/rate.wgsl"), &[("LAST", &last), ("FROM_INNER", &mask_y)]);
                 for k in 0..coarse {
                     w.count_refined(k, &format!("{IS_REFINED}({LAST_BLOCK}, {k}u)"));
                 }
+                w.count_background(LAST_BLOCK);
                 w.line(2, "}");
             },
             |w, e, indent| w.effect_chain(&[e], indent, Evaluation::Kernel),

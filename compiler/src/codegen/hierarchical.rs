@@ -138,14 +138,24 @@ impl Writer<'_, '_, '_> {
                     return;
                 }
                 let [head, end] = cut(include_str!("templates/hierarchical_final.wgsl"), &["COUNTS"]);
+                let background = w.background_here(POS);
+                let mask_y =
+                    if w.has_background() { format!("select(0u, 0xffffffffu, {background})") } else { "0u".into() };
                 w.template(
                     0,
                     head,
-                    &[("FLAG_WORDS", &flag_words), ("STATISTICS_ON", &super::pixel::statistics_enabled())],
+                    &[
+                        ("FLAG_WORDS", &flag_words),
+                        ("STATISTICS_ON", &super::pixel::statistics_enabled()),
+                        ("MASK_Y", &mask_y),
+                    ],
                 );
                 for k in 0..coarse {
                     let (word, mask) = bit(k as u32);
                     w.count_refined(k, &format!("({WORD}({POS}, {}u) & {mask}u) != 0u", flag_words + word));
+                }
+                if w.has_background() {
+                    w.count_refined(coarse, &background);
                 }
                 w.template(0, end, &[]);
             },
@@ -207,7 +217,6 @@ impl Writer<'_, '_, '_> {
 
     /// Level 0: every pixel of its lattice is shaded.
     fn level0(&mut self) {
-        let h = &self.i.layout.hierarchical;
         let coarse = self.coarse_live().len() as u32;
         let [head, tail] = cut(include_str!("templates/level0.wgsl"), &["MASKS"]);
         self.template(
@@ -220,6 +229,8 @@ impl Writer<'_, '_, '_> {
                 ("PIXEL", &lattice_pixel(HIERARCHICAL_LEVEL0)),
             ],
         );
+        self.background_record(1);
+        let h = &self.i.layout.hierarchical;
         for w in 0..h.mask_words {
             let bits = coarse.saturating_sub(w * 32).min(32);
             let mask = if bits == 32 { u32::MAX } else { (1u32 << bits) - 1 };
@@ -237,12 +248,14 @@ impl Writer<'_, '_, '_> {
         let [head, note, pairs, keys, end] =
             cut(include_str!("templates/classify.wgsl"), &["IN_IMAGE", "PAIRS", "KEYS", "EFFECTS"]);
         self.template(0, head, &[]);
+        self.background_record(1);
         self.neighbour_pairs("n", &[], note, ["pair_a", "pair_b"]);
         self.template(0, pairs, &[]);
         for key in self.keys_of(&self.coarse_live()) {
             let name = key.name;
-            let differs = key.differs(&format!("k_{name}"), &format!("{}(q[k])", Name::Load.of(name)));
-            self.template(0, include_str!("templates/classify_key.wgsl"), &[("NAME", &name), ("DIFFERS", &differs)]);
+            let differs = key.differs(&format!("k_{name}"), &key.load("q[k]"));
+            let values: &super::writer::Values = &[("NAME", &name), ("LOAD", &key.loader()), ("DIFFERS", &differs)];
+            self.template(0, include_str!("templates/classify_key.wgsl"), values);
         }
         self.template(0, keys, &[]);
         for w in 0..mw {

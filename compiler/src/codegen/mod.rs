@@ -249,6 +249,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         self.matrix_selects();
         self.position_helpers();
         self.input_loaders();
+        self.key_functions();
         for k in 0..c.functions.len() {
             let f = FunctionId(k as u32);
             self.cached(Piece::Function(f), |w| w.function(f));

@@ -84,12 +84,18 @@ pub(super) enum Name {
     Args,
     /// `mrsl_args<k>`: the parameter that holds part `k` of the dependencies.
     ArgsParam,
+    /// `MrslSurface_<channel>`: a surface key's value, a position and its normal.
+    SurfaceStruct,
+    /// `mrsl_surface_key_<channel>`: a surface key's value at a position.
+    SurfaceKey,
+    /// `mrsl_surface_edge_<channel>`: whether two surface key values lie on different surfaces.
+    SurfaceEdge,
 }
 
 impl Name {
     /// Every family, for the tests that check names against this module.
     #[cfg_attr(not(test), expect(dead_code, reason = "read by the tests"))]
-    pub(super) const ALL: [Name; 30] = [
+    pub(super) const ALL: [Name; 33] = [
         Name::Eval,
         Name::Val,
         Name::At,
@@ -120,6 +126,9 @@ impl Name {
         Name::User,
         Name::Args,
         Name::ArgsParam,
+        Name::SurfaceStruct,
+        Name::SurfaceKey,
+        Name::SurfaceEdge,
     ];
 
     /// What every member's name starts with.
@@ -155,6 +164,9 @@ impl Name {
             Name::User => "mrsl_user_",
             Name::Args => "MrslArgs",
             Name::ArgsParam => "mrsl_args",
+            Name::SurfaceStruct => "MrslSurface_",
+            Name::SurfaceKey => "mrsl_surface_key_",
+            Name::SurfaceEdge => "mrsl_surface_edge_",
         }
     }
 
@@ -174,6 +186,8 @@ impl Name {
 
 /// The position an invocation or function evaluates at (a coarse sample or a pixel).
 pub(super) const POS: &str = "mrsl_pos";
+/// `mrsl_background(pos)`: whether nothing was drawn at a position (the background rule).
+pub(super) const BACKGROUND: &str = "mrsl_background";
 /// The first pixel of a fine kernel's lane.
 pub(super) const FIRST: &str = "mrsl_first";
 /// Whether a compacted fine pass's pixel lies inside the image.
@@ -200,6 +214,13 @@ pub(super) const WORKGROUP: &str = "mrsl_wg";
 pub(super) const LANE: &str = "mrsl_li";
 /// The per-workgroup statistics counters.
 pub(super) const WORKGROUP_STATS: &str = "mrsl_wg_stats";
+/// The statistics counters (layout `stats`).
+pub(super) const STATS: &str = "mrsl_stats";
+/// The checkerboard final pass: whether the pixel's quad was shaded, whether
+/// no tap could reconstruct it, and whether the background rule holds there.
+pub(super) const SHADED: &str = "mrsl_shaded";
+pub(super) const ALONE: &str = "mrsl_alone";
+pub(super) const BACKGROUND_HERE: &str = "mrsl_bg";
 
 /// A pixel's resolved block at a fine kernel's (first) level (`MrslBlock`).
 pub(super) const BLOCK: &str = "mrsl_b";
@@ -248,6 +269,7 @@ pub(super) const CORNERS_STRUCT: &str = "MrslCorners";
 #[cfg_attr(not(test), expect(dead_code, reason = "read by the tests"))]
 pub(super) const FIXED: &[&str] = &[
     POS,
+    BACKGROUND,
     FIRST,
     IN,
     GRID,
@@ -262,6 +284,10 @@ pub(super) const FIXED: &[&str] = &[
     WORKGROUP,
     LANE,
     WORKGROUP_STATS,
+    STATS,
+    SHADED,
+    ALONE,
+    BACKGROUND_HERE,
     BLOCK,
     INNER_BLOCK,
     LAST_BLOCK,
@@ -287,7 +313,6 @@ pub(super) const FIXED: &[&str] = &[
     // resources.wgsl, uniforms.wgsl, stats.wgsl, positions.wgsl: bindings and position helpers
     "MrslControl",
     "MrslUniforms",
-    "mrsl_stats",
     "mrsl_rate",
     "mrsl_pixel",
     "mrsl_pair_x",
@@ -315,8 +340,6 @@ pub(super) const FIXED: &[&str] = &[
     "mrsl_shaded_quad",
     "mrsl_taps",
     "mrsl_ok",
-    "mrsl_alone",
-    "mrsl_shaded",
     // rate_*.wgsl: the shading-rate image, the tiles, the sample list
     "mrsl_shading_rate",
     "mrsl_tile_rate",

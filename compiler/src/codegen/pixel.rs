@@ -52,7 +52,7 @@ impl Writer<'_, '_, '_> {
             0,
             tail,
             &[
-                ("COUNTERS", &self.coarse_live().len()),
+                ("COUNTERS", &self.workgroup_counters()),
                 ("RATE_GROUP", &l.refine_mask.group),
                 ("RATE_BINDING", &l.refine_mask.binding),
             ],
@@ -160,7 +160,12 @@ impl Writer<'_, '_, '_> {
             self.template(
                 0,
                 include_str!("templates/stats_flush.wgsl"),
-                &[("COUNTERS", &self.coarse_live().len()), ("WORKGROUP", &x), ("STATISTICS_ON", &statistics_enabled())],
+                &[
+                    ("COUNTERS", &self.workgroup_counters()),
+                    ("TARGET", &self.counter_target()),
+                    ("WORKGROUP", &x),
+                    ("STATISTICS_ON", &statistics_enabled()),
+                ],
             );
         }
         self.line(0, "}");
@@ -183,6 +188,40 @@ impl Writer<'_, '_, '_> {
             }
         }
         self.output_stores(&order, indent);
+    }
+
+    /// The per-workgroup counters: one per coarse effect, and with a
+    /// background rule one more, the background pixels.
+    pub(super) fn workgroup_counters(&self) -> usize {
+        self.coarse_live().len() + usize::from(self.has_background())
+    }
+
+    /// Where workgroup counter `k` goes in the statistics buffer: counter `k`
+    /// for a coarse effect; the background pixels after the dynamic mode's
+    /// count of 2x2 samples (layout `stats`).
+    pub(super) fn counter_target(&self) -> String {
+        let k = self.coarse_live().len();
+        if self.has_background() { format!("select(k, k + 1u, k == {k}u)") } else { "k".to_string() }
+    }
+
+    /// Counts the pixel as background, and writes the refine mask's mark of
+    /// one (x 0, y all ones), where `block` says so (inside a
+    /// `statistics_on` block).
+    pub(super) fn count_background(&mut self, block: &str) {
+        if self.has_background() {
+            let k = self.coarse_live().len();
+            self.line(3, format!("if ({block}.background) {{ atomicAdd(&{WORKGROUP_STATS}[{k}], 1u); }}"));
+        }
+    }
+
+    /// What the refine mask's `.y` holds: `inner` (the dynamic mode's 2x2
+    /// level), or all ones at a background pixel.
+    pub(super) fn mask_y(&self, block: &str, inner: &str) -> String {
+        if self.has_background() {
+            format!("select({inner}, 0xffffffffu, {block}.background)")
+        } else {
+            inner.to_string()
+        }
     }
 
     /// Counts coarse effect `k` as re-evaluated by this pixel where `condition`

@@ -92,11 +92,15 @@ impl Writer<'_, '_, '_> {
         let r = self.resolver(&level, None);
         self.rate_resolve_function(&r);
         let c = self.checked();
-        let [head, tail] = cut(include_str!("templates/rate_resample.wgsl"), &["CORNERS"]);
+        let [head, guard, tail] = cut(include_str!("templates/rate_resample.wgsl"), &["GUARD", "CORNERS"]);
         // A cell's corners are not renormalised across keys' edges: its effects are refined there.
         for s in self.resamplers(&level, &|_, _| "b.weights".to_string()) {
             let values = s.values();
             self.template(0, head, &values);
+            if self.has_background() {
+                self.line(1, format!("if (b.background) {{ return {}(); }}", s.wgsl_type));
+            }
+            self.template(0, guard, &values);
             // A corner on a border may blend two border samples.
             let get = Name::Get.within(level.suffix, s.name);
             for (k, lane) in LANES.iter().enumerate() {
@@ -132,7 +136,7 @@ impl Writer<'_, '_, '_> {
             self.template(
                 0,
                 include_str!("templates/rate_resolve_key.wgsl"),
-                &[("NAME", &name), ("TESTS", &tests.join(" || "))],
+                &[("NAME", &name), ("LOAD", &key.loader()), ("TESTS", &tests.join(" || "))],
             );
         }
         self.corner_flag_words(r);
@@ -155,6 +159,7 @@ impl Writer<'_, '_, '_> {
         }
         self.template(0, corners, &[]);
         self.refine_decisions(r, samples, &|w, e| w.discontinuity(e));
+        self.background_decision();
         self.template(0, refined, &[]);
     }
 

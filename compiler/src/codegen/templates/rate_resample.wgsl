@@ -3,6 +3,7 @@ fn mrsl_get{{SUFFIX}}_{{NAME}}(s: u32) -> {{TYPE}} {
     return {{UNPACK}};
 }
 fn mrsl_resample{{SUFFIX}}_{{NAME}}(b: MrslBlock) -> {{TYPE}} {
+{{#GUARD}}
 {{#CORNERS}}
     // {{FILTER}}
     return {{VALUE}};

@@ -1,5 +1,5 @@
     // discontinuity key `{{NAME}}`
-    let k_{{NAME}} = mrsl_load_{{NAME}}(pos);
+    let k_{{NAME}} = {{LOAD}}(pos);
     let k00_{{NAME}} = {{K00}};
     let k10_{{NAME}} = {{K10}};
     let k01_{{NAME}} = {{K01}};
