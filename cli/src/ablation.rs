@@ -13,15 +13,15 @@
 //! out and says so. The variants only drop work: their images are wrong by
 //! design and are never compared.
 
-use crate::bench::WORKLOAD_PROGRAM;
-use crate::render::{Resources, bind_scene, compile_program};
+use crate::setup::{Resources, WORKLOAD_PROGRAM, bind_scene, compile_program};
+use crate::timing::{median, time_run};
+use anyhow::{Context, Result, anyhow, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use mrsl_abi::{CompiledProgram, KernelKind};
 use mrsl_lab::gpu::Gpu;
 use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader};
 use std::fmt::Write as _;
 use std::path::PathBuf;
-use std::time::Instant;
 
 pub struct AblationArgs {
     pub program: Option<PathBuf>,
@@ -217,34 +217,69 @@ fn apply(variant: &Variant, wgsl: &str) -> Option<String> {
     variant.edits.iter().try_fold(wgsl.to_string(), |w, edit| edit(&w))
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    match v.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => v[n / 2],
-        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-    }
-}
+/// The full kernel, the compacted one and the variants that apply, each
+/// as a whole program: (name, what it removes, program).
+type Programs = Vec<(&'static str, &'static str, CompiledProgram)>;
 
 /// Runs the ablation; returns the files written.
-pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>, String> {
+pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>> {
     let block = match args.mode {
         Mode::Coarse2x2 => 2,
         Mode::Coarse4x4 => 4,
-        other => return Err(format!("--ablation takes a block mode (coarse2x2 or coarse4x4), not {other}")),
+        other => bail!("--ablation takes a block mode (coarse2x2 or coarse4x4), not {other}"),
     };
     let modes = [Mode::Reference, args.mode];
     let (name, program) = compile_program(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &modes)?;
-    let full: &CompiledProgram = &program;
-    let fine = full.kernel(KernelKind::Fine, block).ok_or("the program has no fine kernel")?;
-    let mut programs: Vec<(&str, &str, CompiledProgram)> = vec![("full", "nothing", full.clone())];
-    // The same program compiled with the fine pass compacted (`Options::compact`).
+    let (programs, skipped) = variants(args, &name, &program, block)?;
+    let gpu = Gpu::new()?;
+    let device_name = format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
+    eprintln!("ablation: {name}, {} fine kernel, on {device_name}, {}x{}", args.mode, args.size.0, args.size.1);
+    let mut scene = bind_scene(&gpu, &args.scene, Some(args.size))?;
+    let mut shaders = vec![];
+    let mut textures = vec![];
+    for (k, (_, _, p)) in programs.iter().enumerate() {
+        let mut shader = Shader::new(&gpu.device, p)?;
+        let prepared = scene.prepare(&gpu, &mut shader).map_err(|e| anyhow!("{}: {e}", args.scene))?;
+        // The variants declare the uniforms of the first: its warnings are theirs, printed once.
+        textures = if k == 0 { prepared.warn() } else { prepared.textures };
+        shaders.push(shader);
+    }
+    let resources = Resources::new(&gpu, &program, scene.size, textures, mrsl_abi::shading_rate::DEFAULT_RATE_TILE)?;
+    let bindings: Bindings = resources.bindings(&program, &scene.channels);
+    // Entry 0 is the reference (run with the full program's shader), then
+    // the full kernel, then the variants.
+    let runs: Vec<(usize, Mode)> =
+        std::iter::once((0, Mode::Reference)).chain((0..programs.len()).map(|k| (k, args.mode))).collect();
+    let times = time_rounds(args.runs.max(1), &runs, |k, mode| {
+        time_run(&gpu, &mut shaders[k], &bindings, DispatchOptions::new(mode))
+    })?;
+    let md = markdown(args, &name, &device_name, &programs, &skipped, &times);
+    std::fs::create_dir_all(&args.out_dir).map_err(|e| anyhow!("cannot create {}: {e}", args.out_dir.display()))?;
+    let path = args.out_dir.join("ablation.md");
+    crate::output::write(&path, &md)?;
+    println!("{md}");
+    Ok(vec![path])
+}
+
+/// The full program, the same compiled with the fine pass compacted
+/// (`Options::compact`), and one program per variant whose edits apply;
+/// the names of those whose edits do not.
+fn variants(
+    args: &AblationArgs,
+    name: &str,
+    program: &mrsl::Program,
+    block: u32,
+) -> Result<(Programs, Vec<&'static str>)> {
+    let full: &CompiledProgram = program;
+    let fine = full.kernel(KernelKind::Fine, block).context("the program has no fine kernel")?;
+    let mut programs: Programs = vec![("full", "nothing", full.clone())];
     let source = match &args.program {
         Some(path) => crate::read_source(path)?,
         None => WORKLOAD_PROGRAM.to_string(),
     };
-    let options = mrsl::Options { compact: true, file_name: name.clone(), ..mrsl::Options::for_modes(&modes) };
-    let compacted = mrsl::compile(&source, &options).map_err(|d| mrsl::render_all(&d, &name, &source))?;
+    let modes = [Mode::Reference, args.mode];
+    let options = mrsl::Options { compact: true, file_name: name.to_string(), ..mrsl::Options::for_modes(&modes) };
+    let compacted = mrsl::compile(&source, &options).map_err(|d| anyhow!(mrsl::render_all(&d, name, &source)))?;
     programs.push((
         "compacted (added)",
         "nothing; adds the workgroup compaction: refined pixels re-evaluate together on consecutive lanes",
@@ -263,43 +298,21 @@ pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>, String> {
             None => skipped.push(v.name),
         }
     }
-    let gpu = Gpu::new().map_err(|e| e.to_string())?;
-    let device_name = format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
-    eprintln!("ablation: {name}, {} fine kernel, on {device_name}, {}x{}", args.mode, args.size.0, args.size.1);
-    let mut scene = bind_scene(&gpu, &args.scene, Some(args.size))?;
-    let mut shaders = vec![];
-    let mut textures = vec![];
-    for (k, (_, _, p)) in programs.iter().enumerate() {
-        let mut shader = Shader::new(&gpu.device, p).map_err(|e| e.to_string())?;
-        let prepared = scene.prepare(&gpu, &mut shader).map_err(|e| format!("{}: {e}", args.scene))?;
-        // The variants declare the uniforms of the first: its warnings are theirs, printed once.
-        textures = if k == 0 { prepared.warn() } else { prepared.textures };
-        shaders.push(shader);
-    }
-    let resources = Resources::new(&gpu, &program, scene.size, textures, mrsl_abi::shading_rate::DEFAULT_RATE_TILE)?;
-    let bindings: Bindings = resources.bindings(&program, &scene.channels);
-    // Entry 0 is the reference (run with the full program's shader), then
-    // the full kernel, then the variants.
-    let runs: Vec<(usize, Mode)> =
-        std::iter::once((0, Mode::Reference)).chain((0..programs.len()).map(|k| (k, args.mode))).collect();
-    let mut time = |k: usize, mode: Mode| -> Result<f64, String> {
-        let start = Instant::now();
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        shaders[k]
-            .encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, DispatchOptions::new(mode))
-            .map_err(|e| e.to_string())?;
-        gpu.queue.submit([encoder.finish()]);
-        gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| e.to_string())?;
-        Ok(start.elapsed().as_secs_f64() * 1e3)
-    };
-    for &(k, mode) in &runs {
+    Ok((programs, skipped))
+}
+
+/// Times every entry of `runs` once to warm up, then in `rounds`
+/// interleaved rounds whose order rotates each round; the times per entry.
+fn time_rounds(
+    rounds: usize,
+    runs: &[(usize, Mode)],
+    mut time: impl FnMut(usize, Mode) -> Result<f64>,
+) -> Result<Vec<Vec<f64>>> {
+    for &(k, mode) in runs {
         time(k, mode)?;
     }
-    let rounds = args.runs.max(1);
     let bar = ProgressBar::new(rounds as u64).with_style(
-        ProgressStyle::with_template("ablation [{bar:30}] {pos}/{len} rounds ({elapsed})")
-            .map_err(|e| e.to_string())?
-            .progress_chars("=> "),
+        ProgressStyle::with_template("ablation [{bar:30}] {pos}/{len} rounds ({elapsed})")?.progress_chars("=> "),
     );
     let mut times: Vec<Vec<f64>> = vec![vec![]; runs.len()];
     for round in 0..rounds {
@@ -314,7 +327,21 @@ pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>, String> {
         bar.inc(1);
     }
     bar.finish();
-    // Per round: each entry's time over the full kernel's time (entry 1).
+    Ok(times)
+}
+
+/// The ablation report: per entry of `times` (the reference, then
+/// `programs`), its median time and its median ratio to the full kernel's
+/// time in the same round.
+fn markdown(
+    args: &AblationArgs,
+    name: &str,
+    device_name: &str,
+    programs: &Programs,
+    skipped: &[&str],
+    times: &[Vec<f64>],
+) -> String {
+    let rounds = times[1].len();
     let ratio = |at: usize| median((0..rounds).map(|r| times[at][r] / times[1][r]).collect());
     let full_ms = median(times[1].clone());
     let mut md = String::new();
@@ -342,11 +369,7 @@ pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>, String> {
     if !skipped.is_empty() {
         let _ = writeln!(md, "\nNot applicable to this program's kernel: {}.", skipped.join(", "));
     }
-    std::fs::create_dir_all(&args.out_dir).map_err(|e| format!("cannot create {}: {e}", args.out_dir.display()))?;
-    let path = args.out_dir.join("ablation.md");
-    std::fs::write(&path, &md).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    println!("{md}");
-    Ok(vec![path])
+    md
 }
 
 #[cfg(test)]

@@ -3,20 +3,20 @@
 //! reference, runs the dynamic-threshold controller along a camera path,
 //! and writes the markdown report, the CSV files and the plots.
 
-use crate::render::{BoundScene, Resources, bind_scene, compile_program};
+use crate::output::save_image;
 use crate::report::{self, ControllerFrame, Point};
+use crate::setup::{BoundScene, Resources, WORKLOAD_PROGRAM, bind_scene, compile_program};
+use crate::timing::{median, paired, time_run};
+use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use mrsl_abi::shading_rate::DEFAULT_RATE_TILE;
 use mrsl_lab::camera_path::CameraPath;
 use mrsl_lab::gpu::Gpu;
+use mrsl_lab::metrics::Metrics;
 use mrsl_runtime::controller::{Target, ThresholdController};
 use mrsl_runtime::rate_source::{Preset, RateOptions};
 use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader, Stats};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
-
-/// The default workload (examples/sponza_lights.mrsl).
-pub const WORKLOAD_PROGRAM: &str = include_str!("../../examples/sponza_lights.mrsl");
 
 pub struct BenchArgs {
     pub program: Option<PathBuf>,
@@ -40,15 +40,6 @@ pub struct BenchArgs {
 /// own similarity test is the knob (as in the paper).
 const KNOB_OFF: f64 = 1e30;
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    match v.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => v[n / 2],
-        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-    }
-}
-
 /// A shader on a device, measured `runs` times per configuration.
 struct Bench<'a> {
     gpu: &'a Gpu,
@@ -70,85 +61,55 @@ struct Measured {
 }
 
 impl Bench<'_> {
-    /// One run of `options`, from encoding to idle: its wall time in ms.
-    fn time_once(&mut self, bindings: &Bindings, options: DispatchOptions) -> Result<f64, String> {
-        let device = &self.gpu.device;
-        let start = Instant::now();
-        let mut encoder = device.create_command_encoder(&Default::default());
-        self.shader.encode(device, &self.gpu.queue, &mut encoder, bindings, options).map_err(|e| e.to_string())?;
-        self.gpu.queue.submit([encoder.finish()]);
-        device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| e.to_string())?;
-        Ok(start.elapsed().as_secs_f64() * 1e3)
-    }
-
     /// Runs `options` once to warm up, then `runs` times, each run paired
-    /// with a run of `reference` (when given) in alternating order (reference
-    /// first, then second, ...), so that a slow moment of a shared machine
-    /// weighs on both members of a pair: the time that counts is the median
-    /// of the per-pair ratios, not a ratio of medians taken at different
-    /// moments. The statistics come from the last run of `options`.
+    /// with a run of `reference` (when given, [`paired`]): the time that
+    /// counts is the median of the per-pair ratios, not a ratio of medians
+    /// taken at different moments. The statistics come from one more run of
+    /// `options` after them.
     fn measure(
         &mut self,
         bindings: &Bindings,
         options: DispatchOptions,
         reference: Option<DispatchOptions>,
-    ) -> Result<Measured, String> {
-        let device = &self.gpu.device;
-        let mut walls = vec![];
-        let mut ratios = vec![];
-        let mut gpus = vec![];
-        let mut coarse = vec![];
-        let mut fine = vec![];
+    ) -> Result<Measured> {
+        let gpu = self.gpu;
         // Timed runs carry no instrumentation; the statistics come from the untimed run after them.
         let timed = options.uninstrumented();
         let reference = reference.map(DispatchOptions::uninstrumented);
-        self.time_once(bindings, timed)?;
+        time_run(gpu, &mut self.shader, bindings, timed)?;
         if let Some(r) = reference {
-            self.time_once(bindings, r)?;
+            time_run(gpu, &mut self.shader, bindings, r)?;
         }
-        for run in 0..self.runs {
-            let (wall, paired) = match reference {
-                Some(r) if run % 2 == 0 => {
-                    let t_ref = self.time_once(bindings, r)?;
-                    (self.time_once(bindings, timed)?, t_ref)
-                }
-                Some(r) => {
-                    let t = self.time_once(bindings, timed)?;
-                    (t, self.time_once(bindings, r)?)
-                }
-                None => {
-                    let t = self.time_once(bindings, timed)?;
-                    (t, t)
-                }
-            };
-            walls.push(wall);
-            ratios.push(wall / paired);
-        }
+        let (mut walls, ratios) = match reference {
+            Some(r) => {
+                let p = paired(self.runs, timed, r, |o| time_run(gpu, &mut self.shader, bindings, o))?;
+                (p.walls, p.ratios)
+            }
+            None => {
+                let walls = (0..self.runs).map(|_| time_run(gpu, &mut self.shader, bindings, timed));
+                (walls.collect::<Result<Vec<f64>>>()?, vec![])
+            }
+        };
         // The statistics (and the timestamps) of one more run of `options`
         // alone: the reference runs in between overwrote them.
-        let wall = self.time_once(bindings, options)?;
-        let stats = self.shader.read_stats(device).map_err(|e| e.to_string())?;
+        let wall = time_run(gpu, &mut self.shader, bindings, options)?;
+        let stats = self.shader.read_stats(&gpu.device)?;
         if reference.is_none() {
             walls.push(wall);
         }
-        if let Some(t) = stats.timings {
-            gpus.push(t.total_ms);
-            coarse.push(t.coarse_ms + t.coarse2_ms);
-            fine.push(t.fine_ms);
-        }
-        let timed = !gpus.is_empty();
+        let timings = stats.timings;
         Ok(Measured {
             stats,
             wall_ms: median(walls),
             relative: if reference.is_some() { median(ratios) } else { 1.0 },
-            gpu_ms: timed.then(|| median(gpus)),
-            coarse_pass_ms: timed.then(|| median(coarse)),
-            fine_pass_ms: timed.then(|| median(fine)),
+            gpu_ms: timings.map(|t| t.total_ms),
+            coarse_pass_ms: timings.map(|t| t.coarse_ms + t.coarse2_ms),
+            fine_pass_ms: timings.map(|t| t.fine_ms),
         })
     }
 
-    fn set(&mut self, name: &str, value: f64) -> Result<(), String> {
-        self.shader.set_uniform(name, &[value]).map_err(|e| e.to_string())
+    fn set(&mut self, name: &str, value: f64) -> Result<()> {
+        Ok(self.shader.set_uniform(name, &[value])?)
     }
 }
 
@@ -159,19 +120,19 @@ impl Bench<'_> {
 /// samples, the hierarchical levels) count `operations`; per-pixel
 /// evaluations, where refinement is already decided, count
 /// `value_operations`, as the kernels run them.
-fn shading_operations(program: &mrsl::Program, stats: &Stats) -> (f64, f64) {
+fn shading_operations(program: &mrsl::Program, mode: Mode, stats: &Stats) -> (f64, f64) {
     let pixels = f64::from(stats.width) * f64::from(stats.height);
-    let per_pixel_decides = stats.mode == Mode::Hierarchical.name();
-    let mut mode = 0.0;
+    let per_pixel_decides = mode == Mode::Hierarchical;
+    let mut ops = 0.0;
     let mut reference = 0.0;
     for e in &stats.effects {
         let Some(layout) = program.layout.effects.iter().find(|l| l.name == e.name) else { continue };
         let (Some(full), Some(value)) = (layout.operations, layout.value_operations) else { continue };
         let per_pixel = if per_pixel_decides { full } else { value };
-        mode += full as f64 * e.coarse_evaluations as f64 + per_pixel as f64 * e.pixel_evaluations as f64;
+        ops += full as f64 * e.coarse_evaluations as f64 + per_pixel as f64 * e.pixel_evaluations as f64;
         reference += value as f64 * pixels;
     }
-    (mode, reference)
+    (ops, reference)
 }
 
 /// The program's uniform `name`, if it declares one.
@@ -202,53 +163,87 @@ fn plan(args: &BenchArgs, has_knob: bool) -> Vec<(Mode, Option<f64>, bool)> {
     plan
 }
 
+/// What every scene of a benchmark shares.
+struct Workload<'a> {
+    args: &'a BenchArgs,
+    gpu: &'a Gpu,
+    program: &'a mrsl::Program,
+    /// Whether the program declares `--knob`, and its default.
+    has_knob: bool,
+    knob_default: Option<f64>,
+}
+
 /// Runs the benchmark; returns the files written.
-pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
+pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>> {
     // The kernels of the modes measured, and of the reference every point is compared with.
     let mut modes = vec![Mode::Reference];
     modes.extend(args.modes.iter().copied().filter(|m| *m != Mode::Reference));
     let (name, program) = compile_program(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &modes)?;
-    let gpu = Gpu::new().map_err(|e| e.to_string())?;
+    let gpu = Gpu::new()?;
     let device_name = format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
     eprintln!("bench: {name} on {device_name}, {}x{}, {} runs per point (median)", args.size.0, args.size.1, args.runs);
-    std::fs::create_dir_all(&args.out_dir).map_err(|e| format!("cannot create {}: {e}", args.out_dir.display()))?;
+    std::fs::create_dir_all(&args.out_dir)
+        .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", args.out_dir.display()))?;
 
     let knob = uniform(&program, &args.knob);
-    let has_knob = knob.is_some();
-    let knob_default = knob.and_then(|f| f.default.as_ref()).and_then(|d| d.first().copied());
-    if !has_knob && args.modes.iter().any(|m| !matches!(m, Mode::Reference | Mode::Checkerboard | Mode::Hierarchical)) {
+    let workload = Workload {
+        args,
+        gpu: &gpu,
+        program: &program,
+        has_knob: knob.is_some(),
+        knob_default: knob.and_then(|f| f.default.as_ref()).and_then(|d| d.first().copied()),
+    };
+    if !workload.has_knob
+        && args.modes.iter().any(|m| !matches!(m, Mode::Reference | Mode::Checkerboard | Mode::Hierarchical))
+    {
         eprintln!("bench: {name} has no uniform `{}`: the block modes run once at the program's defaults", args.knob);
     }
     let mut points: Vec<Point> = vec![];
     let mut frames: Vec<ControllerFrame> = vec![];
     for scene_name in &args.scenes {
         let mut scene = bind_scene(&gpu, scene_name, Some(args.size))?;
-        let mut shader = Shader::new(&gpu.device, &program).map_err(|e| e.to_string())?;
+        let mut scene_points = workload.sweep(scene_name, &mut scene)?;
+        // Every point's time is its paired ratio times one reference time.
+        let reference_ms =
+            scene_points.iter().find(|p| p.mode == Mode::Reference && !p.forced).map(|p| p.wall_ms).unwrap_or(f64::NAN);
+        for p in &mut scene_points {
+            p.reference_ms = reference_ms;
+        }
+        points.extend(scene_points);
+        if args.path_frames > 0 && scene.mesh.is_some() && args.modes.contains(&Mode::Hierarchical) {
+            frames = controller_run(&gpu, &program, &mut scene, args)?;
+        }
+    }
+    write_report(args, &name, &device_name, &points, &frames)
+}
+
+/// A progress bar of `len` steps drawn with `template`.
+fn progress_bar(len: usize, template: &str) -> Result<ProgressBar> {
+    Ok(ProgressBar::new(len as u64).with_style(ProgressStyle::with_template(template)?.progress_chars("=> ")))
+}
+
+impl Workload<'_> {
+    /// Every configuration of the [`plan`] over one scene, the reference first.
+    fn sweep(&self, scene_name: &str, scene: &mut BoundScene) -> Result<Vec<Point>> {
+        let (gpu, program) = (self.gpu, self.program);
+        let mut shader = Shader::new(&gpu.device, program)?;
         shader.set_timestamp_period(&gpu.queue);
-        let textures = scene.prepare(&gpu, &mut shader).map_err(|e| format!("{scene_name}: {e}"))?.warn();
-        let resources = Resources::new(&gpu, &program, scene.size, textures, DEFAULT_RATE_TILE)?;
+        let textures = scene.prepare(gpu, &mut shader).map_err(|e| anyhow::anyhow!("{scene_name}: {e}"))?.warn();
+        let resources = Resources::new(gpu, program, scene.size, textures, DEFAULT_RATE_TILE)?;
         resources.note_fallbacks();
-        let mut bench = Bench { gpu: &gpu, shader, runs: args.runs.max(1) };
-        let plan = plan(args, has_knob);
-        let bar = ProgressBar::new(plan.len() as u64).with_style(
-            ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} {msg} ({elapsed})")
-                .map_err(|e| e.to_string())?
-                .progress_chars("=> "),
-        );
-        bar.set_prefix(scene_name.clone());
-        let bindings = resources.bindings(&program, &scene.channels);
-        let first_output = &resources.outputs.first().ok_or("the program has no output")?.1;
+        let mut bench = Bench { gpu, shader, runs: self.args.runs.max(1) };
+        let plan = plan(self.args, self.has_knob);
+        let bar = progress_bar(plan.len(), "{prefix} [{bar:30}] {pos}/{len} {msg} ({elapsed})")?;
+        bar.set_prefix(scene_name.to_string());
+        let bindings = resources.bindings(program, &scene.channels);
+        let first_output = &resources.outputs.first().context("the program has no output")?.1;
         if first_output.format() != wgpu::TextureFormat::Rgba32Float {
-            return Err("bench compares images: the program's first output must be rgba32float".into());
+            bail!("bench compares images: the program's first output must be rgba32float");
         }
         let mut reference: Option<Vec<[f32; 4]>> = None;
+        let mut points = vec![];
         for (mode, value, forced) in plan {
-            let knob = match (mode, value) {
-                (Mode::Hierarchical, Some(_)) => "similarity".to_string(),
-                (Mode::RateImage, Some(_)) => "rate_sensitivity".to_string(),
-                (_, Some(_)) => args.knob.clone(),
-                _ => "-".to_string(),
-            };
+            let knob = self.knob_name(mode, value);
             let what = format!(
                 "{mode}{}{}",
                 value.map(|v| format!(" {knob}={v:e}")).unwrap_or_default(),
@@ -259,45 +254,19 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
                 eprintln!("{scene_name} [{}/{}] {what}", bar.position() + 1, bar.length().unwrap_or(0));
             }
             bar.set_message(what);
-            let mut options = DispatchOptions { force_refine: forced, ..DispatchOptions::new(mode) };
-            if has_knob {
-                let v = match (mode, value) {
-                    (Mode::Hierarchical, _) => KNOB_OFF,
-                    (Mode::RateImage, _) => knob_default.unwrap_or(KNOB_OFF),
-                    (_, Some(v)) => v,
-                    _ => knob_default.unwrap_or(KNOB_OFF),
-                };
-                bench.set(&args.knob, v)?;
-            }
-            if let (Mode::Hierarchical, Some(s)) = (mode, value) {
-                options.similarity = s as f32;
-            }
-            if mode == Mode::RateImage {
-                // The rate image of this view and sensitivity, settled over frames of a still camera.
-                let rates = RateOptions {
-                    sensitivity: value.unwrap_or(Preset::Balanced.sensitivity() as f64) as f32,
-                    ..RateOptions::preset(Preset::Balanced)
-                };
-                let settled = crate::rates::settle(&gpu, &mut bench.shader, &bindings, first_output, &rates, options)?;
-                if bar.is_hidden() {
-                    eprintln!("  {}", settled.describe());
-                }
-            }
-            let paired = (mode != Mode::Reference || forced).then(|| DispatchOptions::new(Mode::Reference));
-            let m = bench.measure(&bindings, options, paired)?;
-            let pixels = gpu.read_rgba32f(first_output).map_err(|e| e.to_string())?;
+            let m = self.measure_point(&mut bench, &bindings, first_output, (mode, value, forced), &bar)?;
+            let pixels = gpu.read_rgba32f(first_output)?;
             let metrics = match &reference {
                 None => {
                     reference = Some(pixels);
-                    mrsl_lab::metrics::Metrics { rmse: 0.0, psnr: f64::INFINITY, mssim: 1.0, flip: 0.0 }
+                    Metrics { rmse: 0.0, psnr: f64::INFINITY, mssim: 1.0, flip: 0.0 }
                 }
-                Some(r) => {
-                    mrsl_lab::metrics::compare(&pixels, r, scene.size.0, scene.size.1).map_err(|e| e.to_string())?
-                }
+                Some(r) => mrsl_lab::metrics::compare(&pixels, r, scene.size.0, scene.size.1)?,
             };
+            let (ops, reference_ops) = shading_operations(program, mode, &m.stats);
             points.push(Point {
-                scene: scene_name.clone(),
-                mode: mode.to_string(),
+                scene: scene_name.to_string(),
+                mode,
                 knob,
                 value: value.unwrap_or(f64::NAN),
                 forced,
@@ -305,11 +274,8 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
                 coarse_fraction: m.stats.coarse_shaded_fraction,
                 wall_ms: m.wall_ms,
                 relative_time: m.relative,
-                fewer_operations: {
-                    let (ops, reference) = shading_operations(&program, &m.stats);
-                    reference / ops
-                },
-                // Set below, once the scene's reference is measured.
+                fewer_operations: reference_ops / ops,
+                // Set by the caller, once the scene's reference is measured.
                 reference_ms: f64::NAN,
                 gpu_ms: m.gpu_ms,
                 coarse_pass_ms: m.coarse_pass_ms,
@@ -322,20 +288,68 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
             bar.inc(1);
         }
         bar.finish_with_message("done");
-        // Every point's time is its paired ratio times one reference time.
-        let reference_ms = points
-            .iter()
-            .find(|p| &p.scene == scene_name && p.mode == Mode::Reference.to_string() && !p.forced)
-            .map(|p| p.wall_ms)
-            .unwrap_or(f64::NAN);
-        for p in points.iter_mut().filter(|p| &p.scene == scene_name) {
-            p.reference_ms = reference_ms;
-        }
-        if args.path_frames > 0 && scene.mesh.is_some() && args.modes.contains(&Mode::Hierarchical) {
-            frames = controller_run(&gpu, &program, &mut scene, args)?;
+        Ok(points)
+    }
+
+    /// What a point sweeps: the hierarchical mode's similarity, the
+    /// rate-image mode's sensitivity, the program's knob, or `-`.
+    fn knob_name(&self, mode: Mode, value: Option<f64>) -> String {
+        match (mode, value) {
+            (Mode::Hierarchical, Some(_)) => "similarity".to_string(),
+            (Mode::RateImage, Some(_)) => "rate_sensitivity".to_string(),
+            (_, Some(_)) => self.args.knob.clone(),
+            _ => "-".to_string(),
         }
     }
 
+    /// Sets one configuration's knob (and its rate image, settled over
+    /// frames of a still camera, for the rate-image mode) and measures it,
+    /// paired with the reference.
+    fn measure_point(
+        &self,
+        bench: &mut Bench,
+        bindings: &Bindings,
+        first_output: &wgpu::Texture,
+        (mode, value, forced): (Mode, Option<f64>, bool),
+        bar: &ProgressBar,
+    ) -> Result<Measured> {
+        let mut options = DispatchOptions { force_refine: forced, ..DispatchOptions::new(mode) };
+        if self.has_knob {
+            let v = match (mode, value) {
+                (Mode::Hierarchical, _) => KNOB_OFF,
+                (Mode::RateImage, _) => self.knob_default.unwrap_or(KNOB_OFF),
+                (_, Some(v)) => v,
+                _ => self.knob_default.unwrap_or(KNOB_OFF),
+            };
+            bench.set(&self.args.knob, v)?;
+        }
+        if let (Mode::Hierarchical, Some(s)) = (mode, value) {
+            options.similarity = s as f32;
+        }
+        if mode == Mode::RateImage {
+            let rates = RateOptions {
+                sensitivity: value.unwrap_or(Preset::Balanced.sensitivity() as f64) as f32,
+                ..RateOptions::preset(Preset::Balanced)
+            };
+            let settled = crate::rates::settle(self.gpu, &mut bench.shader, bindings, first_output, &rates, options)?;
+            if bar.is_hidden() {
+                eprintln!("  {}", settled.describe());
+            }
+        }
+        let paired = (mode != Mode::Reference || forced).then(|| DispatchOptions::new(Mode::Reference));
+        bench.measure(bindings, options, paired)
+    }
+}
+
+/// Writes bench.md, bench.csv, controller.csv and the plots; prints the
+/// markdown report.
+fn write_report(
+    args: &BenchArgs,
+    name: &str,
+    device_name: &str,
+    points: &[Point],
+    frames: &[ControllerFrame],
+) -> Result<Vec<PathBuf>> {
     let setup = format!(
         "Program `{name}`; scenes {}; {}x{}; device {device_name}; {} timed runs per point after one warm-up, each \
          paired with a reference run (alternately before and after it); times are the median of the per-pair ratios \
@@ -352,27 +366,27 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>, String> {
         args.knob
     );
     let mut written = vec![];
-    let mut write = |file: &str, bytes: &[u8]| -> Result<(), String> {
+    let mut write = |file: &str, bytes: &[u8]| -> Result<()> {
         let path = args.out_dir.join(file);
-        std::fs::write(&path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        crate::output::write(&path, bytes)?;
         written.push(path);
         Ok(())
     };
-    let markdown = report::markdown(&setup, &points, &frames);
+    let markdown = report::markdown(&setup, points, frames);
     write("bench.md", markdown.as_bytes())?;
-    write("bench.csv", report::csv(&points)?.as_bytes())?;
+    write("bench.csv", report::csv(points)?.as_bytes())?;
     if !frames.is_empty() {
-        write("controller.csv", report::csv(&frames)?.as_bytes())?;
+        write("controller.csv", report::csv(frames)?.as_bytes())?;
     }
     let plot_size = (900, 600);
     for scene in &args.scenes {
-        let rgb = report::plot_quality_vs_time(&points, scene, plot_size)?;
+        let rgb = report::plot_quality_vs_time(points, scene, plot_size)?;
         let path = args.out_dir.join(format!("quality_vs_time.{}.png", file_safe(scene)));
         save_rgb(&rgb, plot_size, &path)?;
         written.push(path);
     }
     if !frames.is_empty() {
-        let rgb = report::plot_controller(&frames, plot_size)?;
+        let rgb = report::plot_controller(frames, plot_size)?;
         let path = args.out_dir.join("controller.png");
         save_rgb(&rgb, plot_size, &path)?;
         written.push(path);
@@ -385,13 +399,12 @@ fn file_safe(name: &str) -> String {
     Path::new(name).file_stem().and_then(|s| s.to_str()).unwrap_or(name).replace(|c: char| !c.is_alphanumeric(), "_")
 }
 
-fn save_rgb(rgb: &[u8], size: (u32, u32), path: &Path) -> Result<(), String> {
-    image::RgbImage::from_raw(size.0, size.1, rgb.to_vec())
-        .ok_or("plot buffer has the wrong size")?
-        .save(path)
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))
+fn save_rgb(rgb: &[u8], size: (u32, u32), path: &Path) -> Result<()> {
+    save_image(
+        &image::RgbImage::from_raw(size.0, size.1, rgb.to_vec()).context("plot buffer has the wrong size")?,
+        path,
+    )
 }
-
 /// The dynamic threshold: the hierarchical mode's similarity steered to a
 /// target shaded fraction, frame by frame along a camera path.
 fn controller_run(
@@ -399,37 +412,33 @@ fn controller_run(
     program: &mrsl::Program,
     scene: &mut BoundScene,
     args: &BenchArgs,
-) -> Result<Vec<ControllerFrame>, String> {
-    let mut shader = Shader::new(&gpu.device, program).map_err(|e| e.to_string())?;
+) -> Result<Vec<ControllerFrame>> {
+    let mut shader = Shader::new(&gpu.device, program)?;
     shader.set_timestamp_period(&gpu.queue);
     // The same bindings as the sweep's, whose warnings were printed there.
     let textures = scene.prepare(gpu, &mut shader)?.textures;
-    let mesh = scene.mesh.as_ref().ok_or("the controller needs a mesh scene")?;
+    let mesh = scene.mesh.as_ref().context("the controller needs a mesh scene")?;
     let resources = Resources::new(gpu, program, args.size, textures, DEFAULT_RATE_TILE)?;
     if uniform(program, &args.knob).is_some() {
-        shader.set_uniform(&args.knob, &[KNOB_OFF]).map_err(|e| e.to_string())?;
+        shader.set_uniform(&args.knob, &[KNOB_OFF])?;
     }
     let start = args.similarities.iter().copied().fold(f64::NAN, f64::min);
     let start = if start.is_finite() { start } else { DispatchOptions::DEFAULT_SIMILARITY as f64 };
     let mut controller = ThresholdController::new(Target::ShadedFraction(args.target_fraction), start, (1e-9, 1e3));
-    let bar = ProgressBar::new(args.path_frames as u64).with_style(
-        ProgressStyle::with_template("controller [{bar:30}] {pos}/{len} {msg} ({elapsed})")
-            .map_err(|e| e.to_string())?
-            .progress_chars("=> "),
-    );
+    let bar = progress_bar(args.path_frames, "controller [{bar:30}] {pos}/{len} {msg} ({elapsed})")?;
     let mut frames = vec![];
     let mut bench = Bench { gpu, shader, runs: 1 };
     for i in 0..args.path_frames {
         let camera = CameraPath::Walk.camera(&mesh.camera, i, args.path_frames);
-        let channels = mesh.gbuffer(gpu, &camera, args.size).map_err(|e| e.to_string())?;
-        mesh.set_uniforms(&mut bench.shader, &camera).map_err(|e| e.to_string())?;
+        let channels = mesh.gbuffer(gpu, &camera, args.size)?;
+        mesh.set_uniforms(&mut bench.shader, &camera)?;
         let bindings = resources.bindings(program, &channels);
         let threshold = controller.threshold();
         let options = DispatchOptions { similarity: threshold as f32, ..DispatchOptions::new(Mode::Hierarchical) };
         let m = bench.measure(&bindings, options, None)?;
         frames.push(ControllerFrame {
             frame: i,
-            mode: Mode::Hierarchical.to_string(),
+            mode: Mode::Hierarchical,
             knob: "similarity".into(),
             threshold,
             shaded_fraction: m.stats.shaded_fraction,

@@ -9,17 +9,23 @@
 //! warm wall time, with `--compare` the metrics against that frame's
 //! reference, and the temporal-stability figure) go to `STEM.frames.json`.
 
+use crate::args::RenderArgs;
 use crate::legend::{self, Legend};
-use crate::render::{BoundScene, PAIRS, RenderArgs, Resources, median, save_output, time_run};
+use crate::output::{save_image, save_output};
+use crate::render::{Session, dispatch_options};
+use crate::setup::Resources;
+use crate::timing::{PAIRS, median, paired, time_run};
+use anyhow::{Context, Result, anyhow, bail};
 use mrsl_abi::ShadingRate;
 use mrsl_lab::camera::Camera;
 use mrsl_lab::color::linear_to_srgb8;
 use mrsl_lab::gpu::Gpu;
+use mrsl_lab::mesh_scene::MeshScene;
 use mrsl_lab::metrics::Metrics;
 use mrsl_lab::uniforms::{Offered, Verdict};
 use mrsl_runtime::rate_source::{RateInputs, RateOptions, RateSource, rate_fraction, read_rate_image};
-use mrsl_runtime::{DispatchOptions, Mode, Shader};
-use std::path::PathBuf;
+use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader};
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// The most frames `--frames` takes (file names have three digits).
@@ -48,7 +54,7 @@ pub fn mean_change(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
 /// One mode's frame, as written to `frames.json`.
 #[derive(serde::Serialize)]
 struct ModeFrame {
-    mode: String,
+    mode: Mode,
     shaded_fraction: f64,
     /// Warm wall time of the frame's run, from encoding to idle, in ms.
     wall_ms: f64,
@@ -99,7 +105,7 @@ struct Frame {
 /// Means over frames, per mode.
 #[derive(serde::Serialize)]
 struct Summary {
-    mode: String,
+    mode: Mode,
     shaded_fraction: f64,
     wall_ms: f64,
     psnr: Option<f64>,
@@ -123,34 +129,15 @@ struct FramesFile {
     summary: Vec<Summary>,
 }
 
-/// What the frame loop needs from `render`'s set-up.
-pub struct Setup<'a> {
-    pub gpu: &'a Gpu,
-    pub program: &'a mrsl::Program,
-    pub name: &'a str,
-    pub stem: &'a str,
-    pub scene: &'a BoundScene,
-    pub resources: &'a Resources,
-}
-
 /// Renders `n` frames along the scene's camera path; returns the paths written.
-pub fn render_frames(setup: &Setup, shader: &mut Shader, args: &RenderArgs, n: usize) -> Result<Vec<PathBuf>, String> {
-    let Setup { gpu, program, name, stem, scene, resources } = *setup;
-    let path = scene.path.as_ref().ok_or_else(|| no_path(&args.scene))?;
-    let mesh = scene.mesh.as_ref().ok_or_else(|| no_path(&args.scene))?;
-    let size = resources.size;
-    let base = mesh.camera;
-    let in_out = |file: String| args.out_dir.join(file);
-    let first_output = &resources.outputs.first().ok_or("the program has no output")?.1;
+pub fn render_frames(session: &mut Session, args: &RenderArgs, n: usize) -> Result<Vec<PathBuf>> {
+    let Session { gpu, program, name, stem, scene, shader, resources, .. } = session;
+    let path = scene.path.as_ref().ok_or_else(|| anyhow!(no_path(&args.scene)))?;
+    let mesh = scene.mesh.as_ref().ok_or_else(|| anyhow!(no_path(&args.scene)))?;
+    let first_output = &resources.outputs.first().context("the program has no output")?.1;
     let float_output = first_output.format() == wgpu::TextureFormat::Rgba32Float;
     if (args.compare || args.modes.contains(&Mode::RateImage)) && !float_output {
-        return Err("--frames with --compare or the rate-image mode needs the first output to be rgba32float".into());
-    }
-    // The reference runs first when it is compared with or asked for.
-    let with_reference = args.compare || args.modes.contains(&Mode::Reference);
-    let mut order: Vec<Mode> = args.modes.iter().copied().filter(|m| *m != Mode::Reference).collect();
-    if with_reference {
-        order.insert(0, Mode::Reference);
+        bail!("--frames with --compare or the rate-image mode needs the first output to be rgba32float");
     }
     // The eye follows the camera where the program takes it, unless the
     // scene file or `--set` gave `camera_pos` a value of its own.
@@ -161,20 +148,10 @@ pub fn render_frames(setup: &Setup, shader: &mut Shader, args: &RenderArgs, n: u
             mrsl_lab::uniforms::check(shader.layout(), "the camera path", "camera_pos", &Offered::float3()),
             Ok(Verdict::Bind)
         );
-    let rate_options = RateOptions { motion: args.motion, reproject: args.motion, ..args.rates };
-    let mut source = RateSource::new(&gpu.device).map_err(|e| e.to_string())?;
-    // The rate-image mode's previous output, kept apart from the shared
-    // output textures that the other modes overwrite.
-    let history = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("mrsl previous rate-image frame"),
-        size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba32Float,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
+    let mut sequence = Sequence::new(gpu, args, stem, resources, first_output, mesh)?;
+    sequence.follow_eye = follow_eye;
+    sequence.float_output = float_output;
+    let size = resources.size;
     eprintln!(
         "{n} frames of {name} along the {} camera path of {} at {}x{}{}",
         path.describe(),
@@ -188,165 +165,286 @@ pub fn render_frames(setup: &Setup, shader: &mut Shader, args: &RenderArgs, n: u
             ""
         }
     );
-    let mut written = vec![];
     let mut frames: Vec<Frame> = vec![];
-    let mut previous_camera: Option<Camera> = None;
-    let mut previous_channels: Option<Vec<(String, wgpu::Texture)>> = None;
-    let mut previous_pixels: Vec<(Mode, Vec<[f32; 4]>)> = vec![];
     for k in 0..n {
-        let start = Instant::now();
-        let camera = path.camera(&base, k, n);
-        let channels =
-            mesh.gbuffer_moving(gpu, &camera, previous_camera.as_ref(), size).map_err(|e| format!("frame {k}: {e}"))?;
-        let velocity = &channels.iter().find(|(n, _)| n == "velocity").ok_or("the G-buffer has no velocity")?.1;
-        let (mean_speed_px, max_speed_px) = speeds(gpu, velocity)?;
-        if follow_eye {
-            shader.set_uniform("camera_pos", &camera.eye.map(f64::from)).map_err(|e| e.to_string())?;
-        }
-        let bindings = resources.bindings(program, &channels);
-        let mut runs: Vec<ModeFrame> = vec![];
-        let mut reference: Option<(Vec<[f32; 4]>, f64, Option<f64>)> = None;
-        let mut pixels_now: Vec<(Mode, Vec<[f32; 4]>)> = vec![];
-        for &mode in &order {
-            let dispatch = DispatchOptions {
-                force_refine: args.force_refine,
-                similarity: args.similarity,
-                rate_tile: rate_options.tile,
-                ..DispatchOptions::new(mode)
-            };
-            let mut source_ms = None;
-            if mode == Mode::RateImage
-                && let (Some(previous), true) = (&previous_channels, k > 0)
-            {
-                // This frame's rates, from the previous frame's output and
-                // the motion that frame had (the estimate of this one's).
-                let previous_velocity = &previous.iter().find(|(n, _)| n == "velocity").expect("checked above").1;
-                let start = Instant::now();
-                let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                let inputs = RateInputs { velocity: Some(previous_velocity), ..RateInputs::new(&history) };
-                source
-                    .encode(&gpu.device, &mut encoder, &inputs, &rate_options, &resources.shading_rate)
-                    .map_err(|e| e.to_string())?;
-                gpu.queue.submit([encoder.finish()]);
-                gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| e.to_string())?;
-                source_ms = Some(start.elapsed().as_secs_f64() * 1e3);
-            }
-            // Timed runs carry no instrumentation; the statistics come from one more run after them.
-            let timed = dispatch.uninstrumented();
-            if k == 0 {
-                // The first run builds pipelines: time the second.
-                time_run(gpu, shader, &bindings, timed)?;
-            }
-            let mut wall_ms = time_run(gpu, shader, &bindings, timed)?;
-            // Paired with reference runs of the same frame, when the reference runs too.
-            let mut paired = None;
-            if mode != Mode::Reference && reference.is_some() {
-                let reference_dispatch = DispatchOptions { mode: Mode::Reference, ..timed };
-                let (mut walls, mut ratios) = (vec![], vec![]);
-                for pair in 0..PAIRS {
-                    let (wall, reference_wall) = if pair % 2 == 0 {
-                        let r = time_run(gpu, shader, &bindings, reference_dispatch)?;
-                        (time_run(gpu, shader, &bindings, timed)?, r)
-                    } else {
-                        let w = time_run(gpu, shader, &bindings, timed)?;
-                        (w, time_run(gpu, shader, &bindings, reference_dispatch)?)
-                    };
-                    walls.push(wall);
-                    ratios.push(wall / reference_wall);
-                }
-                wall_ms = median(walls);
-                paired = Some(1.0 / median(ratios));
-            }
-            // The image and statistics below are this mode's, from an untimed run.
-            time_run(gpu, shader, &bindings, dispatch)?;
-            let stats = shader.read_stats(&gpu.device).map_err(|e| e.to_string())?;
-            let pixels = if float_output { gpu.read_rgba32f(first_output).map_err(|e| e.to_string())? } else { vec![] };
-            let mut rates = None;
-            if mode == Mode::RateImage {
-                let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                encoder.copy_texture_to_texture(
-                    first_output.as_image_copy(),
-                    history.as_image_copy(),
-                    first_output.size(),
-                );
-                gpu.queue.submit([encoder.finish()]);
-                let tiles =
-                    read_rate_image(&gpu.device, &gpu.queue, &resources.shading_rate).map_err(|e| e.to_string())?;
-                let file = in_out(format!("{stem}.rate-image.rates.f{k:03}.png"));
-                save_rates(&pixels, size, &tiles, rate_options.tile, &file)?;
-                written.push(file);
-                let histogram = ShadingRate::ALL
-                    .iter()
-                    .map(|&r| (r.to_string(), tiles.iter().filter(|t| **t == r).count()))
-                    .collect();
-                let fraction = rate_fraction(&tiles, size, rate_options.tile).unwrap_or(f64::NAN);
-                rates = Some(RateFrame { histogram, fraction, source_ms });
-            }
-            if mode != Mode::Reference || args.modes.contains(&Mode::Reference) {
-                for (j, (output, texture)) in resources.outputs.iter().enumerate() {
-                    let file = match j {
-                        0 => in_out(format!("{stem}.{mode}.f{k:03}.png")),
-                        _ => in_out(format!("{stem}.{mode}.f{k:03}.{output}.png")),
-                    };
-                    save_output(gpu, texture, &file)?;
-                    written.push(file);
-                }
-            }
-            let change = previous_pixels.iter().find(|(m, _)| *m == mode).map(|(_, p)| mean_change(&pixels, p));
-            let (metrics, speed_vs_reference, flicker) = match (&reference, mode) {
-                (Some((reference, reference_ms, reference_change)), m) if m != Mode::Reference => {
-                    let metrics = if args.compare {
-                        Some(
-                            mrsl_lab::metrics::compare_with_flip_map(&pixels, reference, size.0, size.1)
-                                .map_err(|e| e.to_string())?,
-                        )
-                    } else {
-                        None
-                    };
-                    let flicker = change.zip(*reference_change).map(|(c, r)| c - r);
-                    (metrics, paired.or(Some(reference_ms / wall_ms)), flicker)
-                }
-                _ => (None, None, None),
-            };
-            let (metrics, flip_weighted_quartiles, flip_histogram) = match metrics {
-                Some((m, map)) => (Some(m), Some(map.weighted_quartiles()), Some(map.histogram(20))),
-                None => (None, None, None),
-            };
-            if mode == Mode::Reference {
-                reference = Some((pixels.clone(), wall_ms, change));
-            }
-            pixels_now.push((mode, pixels));
-            runs.push(ModeFrame {
-                mode: mode.to_string(),
-                shaded_fraction: stats.shaded_fraction,
-                wall_ms,
-                speed_vs_reference,
-                metrics,
-                flip_weighted_quartiles,
-                flip_histogram,
-                change,
-                flicker,
-                rates,
-            });
-        }
-        eprintln!("{}", progress_line(k, n, &runs, mean_speed_px, start));
-        frames.push(Frame {
-            frame: k,
-            eye: camera.eye,
-            target: camera.target,
-            mean_speed_px,
-            max_speed_px,
-            modes: runs
-                .into_iter()
-                .filter(|r| r.mode != "reference" || args.modes.contains(&Mode::Reference))
-                .collect(),
-        });
-        previous_pixels = pixels_now;
-        previous_camera = Some(camera);
-        previous_channels = Some(channels);
+        let camera = path.camera(&mesh.camera, k, n);
+        frames.push(sequence.frame(shader, program, camera, k, n)?);
     }
     let summary = summarise(&frames);
-    for s in &summary {
+    print_summary(&summary, n);
+    let file = FramesFile {
+        program: name.to_string(),
+        scene: args.scene.clone(),
+        size,
+        frames: n,
+        camera_path: path.describe(),
+        rate_sensitivity: sequence.rate_options.sensitivity,
+        rate_tile: sequence.rate_options.tile,
+        per_frame: frames,
+        summary,
+    };
+    let json_path = args.out_dir.join(format!("{stem}.frames.json"));
+    crate::output::write(&json_path, serde_json::to_string_pretty(&file)?)?;
+    let mut written = sequence.written;
+    written.push(json_path);
+    Ok(written)
+}
+
+/// The frame loop's state: what every frame shares, and what the next one
+/// takes from the last (its camera for the motion vectors, its G-buffer's
+/// velocity and output for the rate source, each mode's image for the change).
+struct Sequence<'a> {
+    gpu: &'a Gpu,
+    args: &'a RenderArgs,
+    stem: &'a str,
+    resources: &'a Resources,
+    mesh: &'a MeshScene,
+    first_output: &'a wgpu::Texture,
+    float_output: bool,
+    follow_eye: bool,
+    /// The modes in the order they run: the reference first when it is
+    /// compared with or asked for.
+    order: Vec<Mode>,
+    /// The rate source's options: motion and reprojection as the command line says.
+    rate_options: RateOptions,
+    source: RateSource,
+    /// The rate-image mode's previous output, kept apart from the shared
+    /// output textures that the other modes overwrite.
+    history: wgpu::Texture,
+    previous_camera: Option<Camera>,
+    previous_channels: Option<Vec<(String, wgpu::Texture)>>,
+    previous_pixels: Vec<(Mode, Vec<[f32; 4]>)>,
+    written: Vec<PathBuf>,
+}
+
+/// The reference's run of the frame being rendered: its image, its wall
+/// time and its change from the previous frame.
+type ReferenceRun = (Vec<[f32; 4]>, f64, Option<f64>);
+
+impl<'a> Sequence<'a> {
+    fn new(
+        gpu: &'a Gpu,
+        args: &'a RenderArgs,
+        stem: &'a str,
+        resources: &'a Resources,
+        first_output: &'a wgpu::Texture,
+        mesh: &'a MeshScene,
+    ) -> Result<Sequence<'a>> {
+        let with_reference = args.compare || args.modes.contains(&Mode::Reference);
+        let mut order: Vec<Mode> = args.modes.iter().copied().filter(|m| *m != Mode::Reference).collect();
+        if with_reference {
+            order.insert(0, Mode::Reference);
+        }
+        let size = resources.size;
+        let history = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("mrsl previous rate-image frame"),
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        Ok(Sequence {
+            gpu,
+            args,
+            stem,
+            resources,
+            mesh,
+            first_output,
+            float_output: true,
+            follow_eye: false,
+            order,
+            rate_options: RateOptions { motion: args.motion, reproject: args.motion, ..args.rates },
+            source: RateSource::new(&gpu.device)?,
+            history,
+            previous_camera: None,
+            previous_channels: None,
+            previous_pixels: vec![],
+            written: vec![],
+        })
+    }
+
+    /// Frame `k` of `n` from `camera`: its G-buffer with motion vectors, and every mode over it.
+    fn frame(
+        &mut self,
+        shader: &mut Shader,
+        program: &mrsl::Program,
+        camera: Camera,
+        k: usize,
+        n: usize,
+    ) -> Result<Frame> {
+        let (gpu, size) = (self.gpu, self.resources.size);
+        let start = Instant::now();
+        let channels = self
+            .mesh
+            .gbuffer_moving(gpu, &camera, self.previous_camera.as_ref(), size)
+            .map_err(|e| anyhow!("frame {k}: {e}"))?;
+        let velocity = &channels.iter().find(|(n, _)| n == "velocity").context("the G-buffer has no velocity")?.1;
+        let (mean_speed_px, max_speed_px) = speeds(gpu, velocity)?;
+        if self.follow_eye {
+            shader.set_uniform("camera_pos", &camera.eye.map(f64::from))?;
+        }
+        let bindings = self.resources.bindings(program, &channels);
+        let mut runs: Vec<ModeFrame> = vec![];
+        let mut reference: Option<ReferenceRun> = None;
+        let mut pixels_now: Vec<(Mode, Vec<[f32; 4]>)> = vec![];
+        for mode in self.order.clone() {
+            let (run, pixels) = self.mode_frame(shader, &bindings, mode, k, &mut reference)?;
+            pixels_now.push((mode, pixels));
+            runs.push(run);
+        }
+        eprintln!("{}", progress_line(k, n, &runs, mean_speed_px, start));
+        let asked_for_reference = self.args.modes.contains(&Mode::Reference);
+        let modes = runs.into_iter().filter(|r| r.mode != Mode::Reference || asked_for_reference).collect();
+        self.previous_pixels = pixels_now;
+        self.previous_camera = Some(camera);
+        self.previous_channels = Some(channels);
+        Ok(Frame { frame: k, eye: camera.eye, target: camera.target, mean_speed_px, max_speed_px, modes })
+    }
+
+    /// One mode's run of frame `k`: its rates (the rate-image mode), its
+    /// timing (paired with the reference's when that ran first), its images,
+    /// and its figures against `reference` (which the reference mode sets).
+    /// Returns the figures and the image.
+    fn mode_frame(
+        &mut self,
+        shader: &mut Shader,
+        bindings: &Bindings,
+        mode: Mode,
+        k: usize,
+        reference: &mut Option<ReferenceRun>,
+    ) -> Result<(ModeFrame, Vec<[f32; 4]>)> {
+        let gpu = self.gpu;
+        let source_ms = if mode == Mode::RateImage && k > 0 { self.decide_rates()? } else { None };
+        let dispatch = dispatch_options(self.args, mode);
+        let (wall_ms, paired_speed) = self.wall_time(shader, bindings, dispatch, k, reference.is_some())?;
+        // The image and statistics below are this mode's, from an untimed run.
+        time_run(gpu, shader, bindings, dispatch)?;
+        let stats = shader.read_stats(&gpu.device)?;
+        let pixels = if self.float_output { gpu.read_rgba32f(self.first_output)? } else { vec![] };
+        let rates = if mode == Mode::RateImage { Some(self.record_rates(&pixels, k, source_ms)?) } else { None };
+        if mode != Mode::Reference || self.args.modes.contains(&Mode::Reference) {
+            self.save_outputs(mode, k)?;
+        }
+        let change = self.previous_pixels.iter().find(|(m, _)| *m == mode).map(|(_, p)| mean_change(&pixels, p));
+        let (metrics, speed_vs_reference, flicker) = match reference.as_ref() {
+            Some((reference, reference_ms, reference_change)) if mode != Mode::Reference => {
+                let metrics = if self.args.compare {
+                    let size = self.resources.size;
+                    Some(mrsl_lab::metrics::compare_with_flip_map(&pixels, reference, size.0, size.1)?)
+                } else {
+                    None
+                };
+                let flicker = change.zip(*reference_change).map(|(c, r)| c - r);
+                (metrics, paired_speed.or(Some(reference_ms / wall_ms)), flicker)
+            }
+            _ => (None, None, None),
+        };
+        let (metrics, flip_weighted_quartiles, flip_histogram) = match metrics {
+            Some((m, map)) => (Some(m), Some(map.weighted_quartiles()), Some(map.histogram(20))),
+            None => (None, None, None),
+        };
+        if mode == Mode::Reference {
+            *reference = Some((pixels.clone(), wall_ms, change));
+        }
+        let run = ModeFrame {
+            mode,
+            shaded_fraction: stats.shaded_fraction,
+            wall_ms,
+            speed_vs_reference,
+            metrics,
+            flip_weighted_quartiles,
+            flip_histogram,
+            change,
+            flicker,
+            rates,
+        };
+        Ok((run, pixels))
+    }
+
+    /// This frame's rates, from the previous frame's output and the motion
+    /// that frame had (the estimate of this one's); the rate source's wall
+    /// time in ms. `None` before there is a previous frame.
+    fn decide_rates(&mut self) -> Result<Option<f64>> {
+        let gpu = self.gpu;
+        let Some(previous) = &self.previous_channels else { return Ok(None) };
+        let previous_velocity = &previous.iter().find(|(n, _)| n == "velocity").expect("checked above").1;
+        let start = Instant::now();
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let inputs = RateInputs { velocity: Some(previous_velocity), ..RateInputs::new(&self.history) };
+        self.source.encode(&gpu.device, &mut encoder, &inputs, &self.rate_options, &self.resources.shading_rate)?;
+        gpu.queue.submit([encoder.finish()]);
+        gpu.device.poll(wgpu::PollType::wait_indefinitely())?;
+        Ok(Some(start.elapsed().as_secs_f64() * 1e3))
+    }
+
+    /// Warm wall time without instrumentation (the first frame's first run
+    /// builds pipelines and is not timed); with the reference run first on
+    /// this frame, the median of [`PAIRS`] runs paired with it, and the
+    /// reference's speed relative to this mode's.
+    fn wall_time(
+        &self,
+        shader: &mut Shader,
+        bindings: &Bindings,
+        dispatch: DispatchOptions,
+        k: usize,
+        reference_ran: bool,
+    ) -> Result<(f64, Option<f64>)> {
+        let gpu = self.gpu;
+        let timed = dispatch.uninstrumented();
+        if k == 0 {
+            time_run(gpu, shader, bindings, timed)?;
+        }
+        let wall_ms = time_run(gpu, shader, bindings, timed)?;
+        if dispatch.mode == Mode::Reference || !reference_ran {
+            return Ok((wall_ms, None));
+        }
+        let reference = DispatchOptions { mode: Mode::Reference, ..timed };
+        let p = paired(PAIRS, timed, reference, |o| time_run(gpu, shader, bindings, o))?;
+        Ok((median(p.walls), Some(1.0 / median(p.ratios))))
+    }
+
+    /// Keeps the rate-image mode's output for the next frame's rate source,
+    /// writes the rates it was shaded at over it, and counts them.
+    fn record_rates(&mut self, pixels: &[[f32; 4]], k: usize, source_ms: Option<f64>) -> Result<RateFrame> {
+        let (gpu, size, tile) = (self.gpu, self.resources.size, self.rate_options.tile);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        encoder.copy_texture_to_texture(
+            self.first_output.as_image_copy(),
+            self.history.as_image_copy(),
+            self.first_output.size(),
+        );
+        gpu.queue.submit([encoder.finish()]);
+        let tiles = read_rate_image(&gpu.device, &gpu.queue, &self.resources.shading_rate)?;
+        let file = self.args.out_dir.join(format!("{}.rate-image.rates.f{k:03}.png", self.stem));
+        save_rates(pixels, size, &tiles, tile, &file)?;
+        self.written.push(file);
+        let histogram =
+            ShadingRate::ALL.iter().map(|&r| (r.to_string(), tiles.iter().filter(|t| **t == r).count())).collect();
+        let fraction = rate_fraction(&tiles, size, tile).unwrap_or(f64::NAN);
+        Ok(RateFrame { histogram, fraction, source_ms })
+    }
+
+    /// The mode's outputs of frame `k`: `STEM.MODE.fNNN.png`, outputs after
+    /// the first with their name.
+    fn save_outputs(&mut self, mode: Mode, k: usize) -> Result<()> {
+        for (j, (output, texture)) in self.resources.outputs.iter().enumerate() {
+            let file = match j {
+                0 => self.args.out_dir.join(format!("{}.{mode}.f{k:03}.png", self.stem)),
+                _ => self.args.out_dir.join(format!("{}.{mode}.f{k:03}.{output}.png", self.stem)),
+            };
+            save_output(self.gpu, texture, &file)?;
+            self.written.push(file);
+        }
+        Ok(())
+    }
+}
+
+/// One line per mode: its means over the frames.
+fn print_summary(summary: &[Summary], n: usize) {
+    for s in summary {
         let metric = |name: &str, v: Option<f64>, digits: usize| v.map(|v| format!(", {name} {v:.digits$}"));
         eprintln!(
             "{} over {n} frames: shaded {:.1}%, {:.1} ms{}{}{}{}",
@@ -359,22 +457,6 @@ pub fn render_frames(setup: &Setup, shader: &mut Shader, args: &RenderArgs, n: u
             metric("flicker", s.flicker, 5).unwrap_or_default(),
         );
     }
-    let file = FramesFile {
-        program: name.to_string(),
-        scene: args.scene.clone(),
-        size,
-        frames: n,
-        camera_path: path.describe(),
-        rate_sensitivity: rate_options.sensitivity,
-        rate_tile: rate_options.tile,
-        per_frame: frames,
-        summary,
-    };
-    let json_path = in_out(format!("{stem}.frames.json"));
-    std::fs::write(&json_path, serde_json::to_string_pretty(&file).map_err(|e| e.to_string())?)
-        .map_err(|e| format!("cannot write {}: {e}", json_path.display()))?;
-    written.push(json_path);
-    Ok(written)
 }
 
 /// The error for a scene without a camera path.
@@ -386,10 +468,9 @@ pub fn no_path(scene: &str) -> String {
 }
 
 /// Mean and largest length of a velocity texture (`Rg32Float`), in pixels.
-fn speeds(gpu: &Gpu, velocity: &wgpu::Texture) -> Result<(f64, f64), String> {
-    let bytes = gpu.read_texture(velocity).map_err(|e| e.to_string())?;
-    let v: Vec<f32> = bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
-    let lengths: Vec<f64> = v.chunks_exact(2).map(|p| f64::from(p[0]).hypot(f64::from(p[1]))).collect();
+fn speeds(gpu: &Gpu, velocity: &wgpu::Texture) -> Result<(f64, f64)> {
+    let v: Vec<[f32; 2]> = bytemuck::pod_collect_to_vec(&gpu.read_texture(velocity)?);
+    let lengths: Vec<f64> = v.iter().map(|p| f64::from(p[0]).hypot(f64::from(p[1]))).collect();
     let mean = lengths.iter().sum::<f64>() / lengths.len().max(1) as f64;
     Ok((mean, lengths.iter().copied().fold(0.0, f64::max)))
 }
@@ -431,7 +512,7 @@ fn summarise(frames: &[Frame]) -> Vec<Summary> {
                 frames.iter().flat_map(|f| f.modes.iter().filter(|r| r.mode == m.mode)).collect();
             let metric = |f: fn(&Metrics) -> f64| mean(runs.iter().filter_map(|r| r.metrics.as_ref().map(f)).collect());
             Summary {
-                mode: m.mode.clone(),
+                mode: m.mode,
                 shaded_fraction: mean(runs.iter().map(|r| r.shaded_fraction).collect()).unwrap_or(f64::NAN),
                 wall_ms: mean(runs.iter().map(|r| r.wall_ms).collect()).unwrap_or(f64::NAN),
                 // Identical frames have an infinite PSNR: the mean of the finite ones.
@@ -449,13 +530,7 @@ fn summarise(frames: &[Frame]) -> Vec<Summary> {
 /// The rate visualisation: the frame dimmed to half its brightness, each
 /// tile not at 1x1 tinted half-way to its rate's colour
 /// ([`legend::rate_color`]), and the key below.
-fn save_rates(
-    pixels: &[[f32; 4]],
-    size: (u32, u32),
-    tiles: &[ShadingRate],
-    tile: u32,
-    path: &std::path::Path,
-) -> Result<(), String> {
+fn save_rates(pixels: &[[f32; 4]], size: (u32, u32), tiles: &[ShadingRate], tile: u32, path: &Path) -> Result<()> {
     let columns = size.0.div_ceil(tile);
     let image = image::RgbImage::from_fn(size.0, size.1, |x, y| {
         let p = pixels.get((y * size.0 + x) as usize).copied().unwrap_or([0.0; 4]);
@@ -466,9 +541,7 @@ fn save_rates(
             Some(color) => [0, 1, 2].map(|c| ((u16::from(dimmed[c]) + u16::from(color[c])) / 2) as u8),
         })
     });
-    legend::with_legend(&image, &Legend::Rates { tile })?
-        .save(path)
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))
+    save_image(&legend::with_legend(&image, &Legend::Rates { tile })?, path)
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@
 //! over it, so that every pixel of the map stays visible; the canvas is
 //! widened (with white) when the image is too narrow for the key.
 
+use anyhow::{Context, Result, anyhow};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
@@ -67,7 +68,7 @@ fn rgb(c: [u8; 3]) -> RGBColor {
 }
 
 /// `image` with its key drawn below it.
-pub fn with_legend(image: &image::RgbImage, legend: &Legend) -> Result<image::RgbImage, String> {
+pub fn with_legend(image: &image::RgbImage, legend: &Legend) -> Result<image::RgbImage> {
     crate::report::register_font()?;
     let (w, h) = image.dimensions();
     let (cw, ch) = (w.max(MIN_WIDTH), h + STRIP);
@@ -78,10 +79,10 @@ pub fn with_legend(image: &image::RgbImage, legend: &Legend) -> Result<image::Rg
     }
     {
         let root = BitMapBackend::with_buffer(&mut buffer, (cw, ch)).into_drawing_area();
-        draw(&root, legend, h as i32, cw as i32).map_err(|e| format!("drawing the key: {e}"))?;
-        root.present().map_err(|e| format!("drawing the key: {e}"))?;
+        draw(&root, legend, h as i32, cw as i32).map_err(|e| anyhow!("drawing the key: {e}"))?;
+        root.present().map_err(|e| anyhow!("drawing the key: {e}"))?;
     }
-    image::RgbImage::from_raw(cw, ch, buffer).ok_or_else(|| "the key's canvas has the wrong size".into())
+    image::RgbImage::from_raw(cw, ch, buffer).context("the key's canvas has the wrong size")
 }
 
 type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;

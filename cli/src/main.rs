@@ -1,5 +1,6 @@
 //! `mrslc`: the command-line driver of the mrsl compiler.
 
+use anyhow::{Result, anyhow, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use codespan_reporting::term::termcolor::{ColorChoice, StandardStream};
 use mrsl::{Diagnostic, KernelKind, KernelRef, Options};
@@ -8,12 +9,16 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 mod ablation;
+mod args;
 mod bench;
 mod frames;
 mod legend;
+mod output;
 mod rates;
 mod render;
 mod report;
+mod setup;
+mod timing;
 
 #[derive(Parser)]
 #[command(name = "mrslc", version, about = "Compiler for mrsl, a multi-rate shading language", long_about = None)]
@@ -56,8 +61,8 @@ enum Command {
         emit: Option<Emit>,
         /// Modes to compile for, comma-separated (reference, coarse2x2, coarse4x4, dynamic,
         /// hierarchical, checkerboard, rate-image), or all.
-        #[arg(long, alias = "modes", value_parser = render::parse_modes, default_value = "all")]
-        mode: render::ModeList,
+        #[arg(long, alias = "modes", value_parser = args::parse_modes, default_value = "all")]
+        mode: args::ModeList,
         /// With --emit coarse or fine: the block size of the kernel printed.
         #[arg(short, long = "block", value_parser = ["2", "4"], default_value = "4")]
         block: String,
@@ -87,11 +92,11 @@ struct Bench {
     #[arg(long = "scene", default_values = ["sponza"])]
     scenes: Vec<String>,
     /// Image size, WIDTHxHEIGHT.
-    #[arg(long, value_parser = render::parse_size, default_value = "1920x1080")]
+    #[arg(long, value_parser = args::parse_size, default_value = "1920x1080")]
     size: (u32, u32),
     /// Modes, comma-separated (reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard), or all.
-    #[arg(long, alias = "mode", value_parser = render::parse_modes, default_value = "all")]
-    modes: render::ModeList,
+    #[arg(long, alias = "mode", value_parser = args::parse_modes, default_value = "all")]
+    modes: args::ModeList,
     /// The block and dynamic modes' knob: a float uniform of the program.
     #[arg(long, default_value = "light_tolerance")]
     knob: String,
@@ -129,13 +134,13 @@ struct Render {
     #[arg(long, default_value = "demo")]
     scene: String,
     /// Modes, comma-separated (reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard), or all.
-    #[arg(long, alias = "modes", value_parser = render::parse_modes, default_value = "coarse4x4")]
-    mode: render::ModeList,
+    #[arg(long, alias = "modes", value_parser = args::parse_modes, default_value = "coarse4x4")]
+    mode: args::ModeList,
     /// Image size, WIDTHxHEIGHT (default: the scene file's, else 960x540).
-    #[arg(long, value_parser = render::parse_size)]
+    #[arg(long, value_parser = args::parse_size)]
     size: Option<(u32, u32)>,
     /// Set a uniform: NAME=VALUE or NAME=X,Y,Z (repeatable).
-    #[arg(long = "set", value_parser = render::parse_set)]
+    #[arg(long = "set", value_parser = args::parse_set)]
     sets: Vec<(String, Vec<f64>)>,
     /// Directory of the files written (created if missing), except those named by -o and --heatmap
     /// (default: the directory of -o's file when -o is given, else `out`).
@@ -256,128 +261,149 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(cli: &Cli) -> Result<ExitCode, String> {
+fn run(cli: &Cli) -> Result<ExitCode> {
     match &cli.command {
-        Command::Check { file } => {
-            let (name, source) = read(file)?;
-            let diagnostics = mrsl::check(&source);
-            report(cli.color, &diagnostics, &name, &source);
-            let errors = diagnostics.iter().filter(|d| d.is_error()).count();
-            let warnings = diagnostics.len() - errors;
-            if errors > 0 {
-                eprintln!("{name}: {errors} error{}, {warnings} warning{}", plural(errors), plural(warnings));
-                Ok(ExitCode::from(1))
-            } else {
-                eprintln!("{name}: ok ({warnings} warning{})", plural(warnings));
-                Ok(ExitCode::SUCCESS)
-            }
-        }
-        Command::Render(r) => {
-            let args = render::RenderArgs {
-                program: r.program.clone(),
-                scene: r.scene.clone(),
-                modes: r.mode.0.clone(),
-                size: r.size,
-                sets: r.sets.clone(),
-                output: r.output.clone(),
-                heatmap: r.heatmap.clone(),
-                out_dir: render_out_dir(r.out_dir.as_deref(), r.output.as_deref()),
-                stats: r.stats,
-                force_refine: r.force_refine,
-                compare: r.compare,
-                similarity: r.similarity,
-                uniform_rate: r.uniform_rate,
-                rates: mrsl_runtime::rate_source::RateOptions {
-                    tile: r.rate_tile,
-                    weber_fechner: r.weber_fechner,
-                    ..mrsl_runtime::rate_source::RateOptions::preset(r.rate_preset.runtime())
-                },
-                motion: !r.no_motion,
-                frames: r.frames,
-            };
-            Ok(written(render::render(&args)))
-        }
-        Command::Bench(b) => {
-            let modes = b.modes.0.clone();
-            if b.ablation {
-                let mode = match modes.as_slice() {
-                    [mode] => *mode,
-                    _ if modes == mrsl_runtime::Mode::ALL => mrsl_runtime::Mode::Coarse4x4,
-                    _ => return Err("--ablation takes one block mode in --modes (coarse2x2 or coarse4x4)".into()),
-                };
-                let args = ablation::AblationArgs {
-                    program: b.program.clone(),
-                    scene: b.scenes.first().cloned().unwrap_or_else(|| "sponza".into()),
-                    size: b.size,
-                    mode,
-                    runs: b.runs,
-                    out_dir: b.out_dir.clone(),
-                };
-                return Ok(written(ablation::ablation(&args)));
-            }
-            if !(b.target_fraction > 0.0 && b.target_fraction <= 1.0) {
-                return Err(format!("--target-fraction must be in (0, 1], not {}", b.target_fraction));
-            }
-            let args = bench::BenchArgs {
-                program: b.program.clone(),
-                scenes: b.scenes.clone(),
-                size: b.size,
-                modes,
-                knob: b.knob.clone(),
-                values: b.values.clone(),
-                similarities: b.similarities.clone(),
-                runs: b.runs,
-                out_dir: b.out_dir.clone(),
-                path_frames: b.path_frames,
-                target_fraction: b.target_fraction,
-            };
-            Ok(written(bench::bench(&args)))
-        }
-        Command::Compile { file, out_dir, emit, mode, block } => {
-            let (name, source) = read(file)?;
-            let options = Options { file_name: name.clone(), ..Options::for_modes(&mode.0) };
-            let program = match mrsl::compile(&source, &options) {
-                Ok(p) => p,
-                Err(diagnostics) => {
-                    report(cli.color, &diagnostics, &name, &source);
-                    return Ok(ExitCode::from(1));
-                }
-            };
-            report(cli.color, &program.warnings, &name, &source);
-            if let Some(emit) = emit {
-                let block: u32 = block.parse().expect("clap restricts block sizes");
-                let kernel = |kind: KernelKind| {
-                    program.kernel(kind, block).map(|k| k.wgsl.clone()).ok_or_else(|| {
-                        let what = KernelRef::new(kind, kind.per_block_size().then_some(block));
-                        format!("{name} was compiled without its {what} kernel: add a mode that runs it with --mode")
-                    })
-                };
-                let text = match emit {
-                    Emit::Layout => program.layout.to_json(),
-                    Emit::Coarse => kernel(KernelKind::Coarse)?,
-                    Emit::Fine => kernel(KernelKind::Fine)?,
-                    Emit::Reference => kernel(KernelKind::Reference)?,
-                };
-                std::io::stdout().write_all(text.as_bytes()).map_err(|e| e.to_string())?;
-                return Ok(ExitCode::SUCCESS);
-            }
-            std::fs::create_dir_all(out_dir).map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
-            let stem = file.file_stem().and_then(|s| s.to_str()).unwrap_or("program");
-            let written = program
-                .compiled
-                .write_dir(out_dir, stem)
-                .map_err(|(path, e)| format!("cannot write {}: {e}", path.display()))?;
-            for path in written {
-                eprintln!("wrote {}", path.display());
-            }
-            Ok(ExitCode::SUCCESS)
+        Command::Check { file } => check(cli.color, file),
+        Command::Render(r) => Ok(written(render::render(&r.args()))),
+        Command::Bench(b) => bench(b),
+        Command::Compile { file, out_dir, emit, mode, block } => compile(cli.color, file, out_dir, *emit, mode, block),
+    }
+}
+
+/// `mrslc check`: the diagnostics; exit 1 with errors.
+fn check(color: Color, file: &Path) -> Result<ExitCode> {
+    let (name, source) = read(file)?;
+    let diagnostics = mrsl::check(&source);
+    report(color, &diagnostics, &name, &source);
+    let errors = diagnostics.iter().filter(|d| d.is_error()).count();
+    let warnings = diagnostics.len() - errors;
+    if errors > 0 {
+        eprintln!("{name}: {errors} error{}, {warnings} warning{}", plural(errors), plural(warnings));
+        Ok(ExitCode::from(1))
+    } else {
+        eprintln!("{name}: ok ({warnings} warning{})", plural(warnings));
+        Ok(ExitCode::SUCCESS)
+    }
+}
+
+impl Render {
+    /// The arguments as `render` takes them.
+    fn args(&self) -> args::RenderArgs {
+        args::RenderArgs {
+            program: self.program.clone(),
+            scene: self.scene.clone(),
+            modes: self.mode.0.clone(),
+            size: self.size,
+            sets: self.sets.clone(),
+            output: self.output.clone(),
+            heatmap: self.heatmap.clone(),
+            out_dir: render_out_dir(self.out_dir.as_deref(), self.output.as_deref()),
+            stats: self.stats,
+            force_refine: self.force_refine,
+            compare: self.compare,
+            similarity: self.similarity,
+            uniform_rate: self.uniform_rate,
+            rates: mrsl_runtime::rate_source::RateOptions {
+                tile: self.rate_tile,
+                weber_fechner: self.weber_fechner,
+                ..mrsl_runtime::rate_source::RateOptions::preset(self.rate_preset.runtime())
+            },
+            motion: !self.no_motion,
+            frames: self.frames,
         }
     }
 }
 
+/// `mrslc bench`: the sweep, or with `--ablation` the ablation.
+fn bench(b: &Bench) -> Result<ExitCode> {
+    let modes = b.modes.0.clone();
+    if b.ablation {
+        let mode = match modes.as_slice() {
+            [mode] => *mode,
+            _ if modes == mrsl_runtime::Mode::ALL => mrsl_runtime::Mode::Coarse4x4,
+            _ => bail!("--ablation takes one block mode in --modes (coarse2x2 or coarse4x4)"),
+        };
+        let args = ablation::AblationArgs {
+            program: b.program.clone(),
+            scene: b.scenes.first().cloned().unwrap_or_else(|| "sponza".into()),
+            size: b.size,
+            mode,
+            runs: b.runs,
+            out_dir: b.out_dir.clone(),
+        };
+        return Ok(written(ablation::ablation(&args)));
+    }
+    if !(b.target_fraction > 0.0 && b.target_fraction <= 1.0) {
+        bail!("--target-fraction must be in (0, 1], not {}", b.target_fraction);
+    }
+    let args = bench::BenchArgs {
+        program: b.program.clone(),
+        scenes: b.scenes.clone(),
+        size: b.size,
+        modes,
+        knob: b.knob.clone(),
+        values: b.values.clone(),
+        similarities: b.similarities.clone(),
+        runs: b.runs,
+        out_dir: b.out_dir.clone(),
+        path_frames: b.path_frames,
+        target_fraction: b.target_fraction,
+    };
+    Ok(written(bench::bench(&args)))
+}
+
+/// `mrslc compile`: the kernels and the layout into `out_dir`, or one of
+/// them to standard output (`--emit`).
+fn compile(
+    color: Color,
+    file: &Path,
+    out_dir: &Path,
+    emit: Option<Emit>,
+    mode: &args::ModeList,
+    block: &str,
+) -> Result<ExitCode> {
+    let (name, source) = read(file)?;
+    let options = Options { file_name: name.clone(), ..Options::for_modes(&mode.0) };
+    let program = match mrsl::compile(&source, &options) {
+        Ok(p) => p,
+        Err(diagnostics) => {
+            report(color, &diagnostics, &name, &source);
+            return Ok(ExitCode::from(1));
+        }
+    };
+    report(color, &program.warnings, &name, &source);
+    if let Some(emit) = emit {
+        let block: u32 = block.parse().expect("clap restricts block sizes");
+        let kernel = |kind: KernelKind| {
+            program.kernel(kind, block).map(|k| k.wgsl.clone()).ok_or_else(|| {
+                let what = KernelRef::new(kind, kind.per_block_size().then_some(block));
+                anyhow!("{name} was compiled without its {what} kernel: add a mode that runs it with --mode")
+            })
+        };
+        let text = match emit {
+            Emit::Layout => program.layout.to_json(),
+            Emit::Coarse => kernel(KernelKind::Coarse)?,
+            Emit::Fine => kernel(KernelKind::Fine)?,
+            Emit::Reference => kernel(KernelKind::Reference)?,
+        };
+        std::io::stdout().write_all(text.as_bytes())?;
+        return Ok(ExitCode::SUCCESS);
+    }
+    std::fs::create_dir_all(out_dir).map_err(|e| anyhow!("cannot create {}: {e}", out_dir.display()))?;
+    let stem = file.file_stem().and_then(|s| s.to_str()).unwrap_or("program");
+    let written = program
+        .compiled
+        .write_dir(out_dir, stem)
+        .map_err(|(path, e)| anyhow!("cannot write {}: {e}", path.display()))?;
+    for path in written {
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
 /// The exit of a command that writes files: lists them at the end (exit
 /// 0), or prints why it failed (exit 1).
-fn written(result: Result<Vec<PathBuf>, String>) -> ExitCode {
+fn written(result: Result<Vec<PathBuf>>) -> ExitCode {
     match result {
         Ok(paths) => {
             for p in &paths {
@@ -392,15 +418,15 @@ fn written(result: Result<Vec<PathBuf>, String>) -> ExitCode {
     }
 }
 
-fn read(file: &Path) -> Result<(String, String), String> {
+fn read(file: &Path) -> Result<(String, String)> {
     Ok((file.display().to_string(), read_source(file)?))
 }
 
 /// Reads a program. A file that is not UTF-8 is refused with the place of
 /// its first bad byte: "FILE: not valid UTF-8 at byte N (line L, column C)".
-pub(crate) fn read_source(file: &Path) -> Result<String, String> {
-    let bytes = std::fs::read(file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
-    String::from_utf8(bytes).map_err(|e| not_utf8(&file.display().to_string(), e.as_bytes(), e.utf8_error()))
+pub(crate) fn read_source(file: &Path) -> Result<String> {
+    let bytes = std::fs::read(file).map_err(|e| anyhow!("cannot read {}: {e}", file.display()))?;
+    String::from_utf8(bytes).map_err(|e| anyhow!(not_utf8(&file.display().to_string(), e.as_bytes(), e.utf8_error())))
 }
 
 /// The message for a file whose bytes are not UTF-8; the line and the column
@@ -485,7 +511,7 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let bad = dir.join("bad.mrsl");
         std::fs::write(&bad, b"in float3 n\xff;\n").unwrap();
-        let message = read_source(&bad).unwrap_err();
+        let message = read_source(&bad).unwrap_err().to_string();
         assert!(message.ends_with(": not valid UTF-8 at byte 11 (line 1, column 12)"), "{message}");
         let bom = dir.join("bom.mrsl");
         std::fs::write(&bom, "\u{FEFF}in float3 n;\n").unwrap();
@@ -519,7 +545,7 @@ mod tests {
         assert_eq!(two.kernels.len(), 3, "coarse b4, fine b4, hierarchical");
         std::fs::remove_dir_all(&dir).unwrap();
         let argv = ["mrslc", "compile", demo, "--mode", "coarse4x4", "--emit", "fine", "-b", "2"];
-        let message = run(&Cli::try_parse_from(argv).unwrap()).unwrap_err();
+        let message = run(&Cli::try_parse_from(argv).unwrap()).unwrap_err().to_string();
         assert!(message.contains("without its 2x2 fine kernel"), "{message}");
     }
 

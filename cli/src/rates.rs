@@ -9,6 +9,8 @@
 //! threshold may keep alternating between two rates when each frame's small
 //! resampling error tips them).
 
+use crate::timing::median;
+use anyhow::{Context, Result};
 use mrsl_abi::ShadingRate;
 use mrsl_lab::gpu::Gpu;
 use mrsl_runtime::rate_source::{RateInputs, RateOptions, RateSource, read_rate_image};
@@ -67,26 +69,24 @@ pub fn settle(
     color: &wgpu::Texture,
     options: &RateOptions,
     dispatch: DispatchOptions,
-) -> Result<Settled, String> {
-    let target = bindings.shading_rate.ok_or("the rate-image mode has no shading-rate image")?;
-    let submit = |shader: &mut Shader, mode: Mode| -> Result<(), String> {
+) -> Result<Settled> {
+    let target = bindings.shading_rate.context("the rate-image mode has no shading-rate image")?;
+    let submit = |shader: &mut Shader, mode: Mode| -> Result<()> {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let options = DispatchOptions { mode, rate_tile: options.tile, ..dispatch };
-        shader.encode(&gpu.device, &gpu.queue, &mut encoder, bindings, options).map_err(|e| e.to_string())?;
+        shader.encode(&gpu.device, &gpu.queue, &mut encoder, bindings, options)?;
         gpu.queue.submit([encoder.finish()]);
         Ok(())
     };
-    let mut source = RateSource::new(&gpu.device).map_err(|e| e.to_string())?;
-    let decide = |source: &mut RateSource| -> Result<f64, String> {
+    let mut source = RateSource::new(&gpu.device)?;
+    let decide = |source: &mut RateSource| -> Result<f64> {
         // The frame before must be done, or its time would count as the source's.
-        gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| e.to_string())?;
+        gpu.device.poll(wgpu::PollType::wait_indefinitely())?;
         let start = Instant::now();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        source
-            .encode(&gpu.device, &mut encoder, &RateInputs::new(color), options, target)
-            .map_err(|e| e.to_string())?;
+        source.encode(&gpu.device, &mut encoder, &RateInputs::new(color), options, target)?;
         gpu.queue.submit([encoder.finish()]);
-        gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| e.to_string())?;
+        gpu.device.poll(wgpu::PollType::wait_indefinitely())?;
         Ok(start.elapsed().as_secs_f64() * 1e3)
     };
     submit(shader, Mode::Reference)?;
@@ -95,7 +95,7 @@ pub fn settle(
     let mut times = vec![];
     while frames < MAX_FRAMES {
         times.push(decide(&mut source)?);
-        let rates = read_rate_image(&gpu.device, &gpu.queue, target).map_err(|e| e.to_string())?;
+        let rates = read_rate_image(&gpu.device, &gpu.queue, target)?;
         if let Some(previous) = &previous {
             changed = previous.iter().zip(&rates).filter(|(a, b)| a != b).count();
             if changed as f64 <= SETTLED_FRACTION * rates.len() as f64 {
@@ -111,10 +111,13 @@ pub fn settle(
     let histogram = ShadingRate::ALL.iter().map(|&r| (r, rates.iter().filter(|x| **x == r).count())).collect();
     // The first decisions build pipelines and history; time the last ones.
     let warm: Vec<f64> = times.iter().rev().take(3).copied().collect();
-    Ok(Settled { frames, stable, changed, histogram, source_ms: crate::render::median(warm) })
+    Ok(Settled { frames, stable, changed, histogram, source_ms: median(warm) })
 }
 
-/// Sets every tile of `target` (an `R32Uint` rate image) to `rate`.
+/// Sets every tile of `target` (an `R32Uint` rate image) to `rate`. The
+/// target is the rate image the shader is bound to
+/// (`mrsl_runtime::rate_source::create_rate_image`), written in place: the
+/// runtime's `upload_rate_image` makes a new `R8Uint` texture instead.
 pub fn fill(gpu: &Gpu, target: &wgpu::Texture, rate: ShadingRate) {
     let (w, h) = (target.width(), target.height());
     let codes = vec![u32::from(rate.code()); (w * h) as usize];

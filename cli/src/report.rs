@@ -4,13 +4,15 @@
 //!
 //! Everything here is pure (no GPU), so it is unit-tested on made-up sweeps.
 
+use anyhow::Result;
+use mrsl_runtime::Mode;
 use std::fmt::Write as _;
 
 /// One measured configuration: a scene, a mode and a threshold value.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Point {
     pub scene: String,
-    pub mode: String,
+    pub mode: Mode,
     /// What was swept (`light_tolerance`, `similarity`, or `-` for none).
     pub knob: String,
     /// The knob's value (NaN where nothing was swept).
@@ -159,7 +161,7 @@ pub fn metric_at_fraction(points: &[&Point], f: f64, metric: impl Fn(&Point) -> 
 /// The figures the evaluation reports for one adaptive mode of one scene.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModeSummary {
-    pub mode: String,
+    pub mode: Mode,
     /// Reference time / time at MSSIM 0.99 and 0.993.
     pub speedup_mssim_990: Figure,
     pub speedup_mssim_993: Figure,
@@ -176,8 +178,8 @@ pub struct ModeSummary {
 /// The shading rates of DACS's Table 1.
 pub const RATES: [f64; 3] = [0.2, 0.5, 0.8];
 
-pub fn summarize_mode(points: &[Point], scene: &str, mode: &str) -> Option<ModeSummary> {
-    let reference = points.iter().find(|p| p.scene == scene && p.mode == "reference" && !p.forced)?;
+pub fn summarize_mode(points: &[Point], scene: &str, mode: Mode) -> Option<ModeSummary> {
+    let reference = points.iter().find(|p| p.scene == scene && p.mode == Mode::Reference && !p.forced)?;
     let sweep: Vec<&Point> = points.iter().filter(|p| p.scene == scene && p.mode == mode && !p.forced).collect();
     if sweep.is_empty() {
         return None;
@@ -211,7 +213,7 @@ pub fn summarize_mode(points: &[Point], scene: &str, mode: &str) -> Option<ModeS
         .find(|p| p.scene == scene && p.mode == mode && p.forced)
         .map(|p| p.time_ms() / reference.time_ms());
     Some(ModeSummary {
-        mode: mode.into(),
+        mode,
         speedup_mssim_990: s990,
         speedup_mssim_993: speedup(0.993),
         efficiency_990: efficiency,
@@ -231,9 +233,9 @@ pub struct VersusCheckerboard {
 }
 
 pub fn versus_checkerboard(points: &[Point], scene: &str) -> Option<VersusCheckerboard> {
-    let cb = points.iter().find(|p| p.scene == scene && p.mode == "checkerboard" && !p.forced)?;
+    let cb = points.iter().find(|p| p.scene == scene && p.mode == Mode::Checkerboard && !p.forced)?;
     let dacs: Vec<&Point> =
-        points.iter().filter(|p| p.scene == scene && p.mode == "hierarchical" && !p.forced).collect();
+        points.iter().filter(|p| p.scene == scene && p.mode == Mode::Hierarchical && !p.forced).collect();
     if dacs.is_empty() {
         return None;
     }
@@ -247,7 +249,7 @@ pub fn versus_checkerboard(points: &[Point], scene: &str) -> Option<VersusChecke
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ControllerFrame {
     pub frame: usize,
-    pub mode: String,
+    pub mode: Mode,
     pub knob: String,
     pub threshold: f64,
     pub shaded_fraction: f64,
@@ -257,17 +259,17 @@ pub struct ControllerFrame {
 
 /// Rows ([`Point`]s or [`ControllerFrame`]s) as CSV: a header from the
 /// field names, one row each, empty cells for missing values.
-pub fn csv<T: serde::Serialize>(rows: &[T]) -> Result<String, String> {
+pub fn csv<T: serde::Serialize>(rows: &[T]) -> Result<String> {
     let mut writer = csv::Writer::from_writer(vec![]);
     for row in rows {
-        writer.serialize(row).map_err(|e| e.to_string())?;
+        writer.serialize(row)?;
     }
-    String::from_utf8(writer.into_inner().map_err(|e| e.to_string())?).map_err(|e| e.to_string())
+    Ok(String::from_utf8(writer.into_inner().map_err(|e| e.into_error())?)?)
 }
 
 /// The distinct items, in order of first appearance.
-fn unique<'a>(items: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
-    let mut out: Vec<&str> = vec![];
+fn unique<T: PartialEq>(items: impl Iterator<Item = T>) -> Vec<T> {
+    let mut out: Vec<T> = vec![];
     for item in items {
         if !out.contains(&item) {
             out.push(item);
@@ -284,111 +286,126 @@ fn dash(v: Option<f64>, decimals: usize) -> String {
 pub fn markdown(setup: &str, points: &[Point], frames: &[ControllerFrame]) -> String {
     let mut out = String::new();
     let _ = writeln!(out, "# mrsl benchmark\n\n{setup}\n");
-    let scenes = unique(points.iter().map(|p| p.scene.as_str()));
-    for scene in scenes {
+    for scene in unique(points.iter().map(|p| p.scene.as_str())) {
         let _ = writeln!(out, "## {scene}\n");
-        let modes = unique(
-            points
-                .iter()
-                .filter(|p| p.scene == scene && p.mode != "reference" && p.mode != "checkerboard")
-                .map(|p| p.mode.as_str()),
-        );
-        let _ = writeln!(
-            out,
-            "Speedup is reference time / mode time, interpolated along each mode's quality/time frontier; \
-             fewer shading operations is the reference's / the mode's by the compiler's cost model (operations per \
-             evaluation times evaluations, docs/evaluation.md), along the same frontier; \
-             `*` marks a bound (the sweep's cheapest point already exceeds the quality: the speedup is at least this). \
-             Efficiency = speedup / (1 / coarse shading rate) at MSSIM 0.99. \
-             Times are paired with reference runs: speedup = 1 / median(mode time / reference time) over the pairs.\n"
-        );
-        let _ = writeln!(
-            out,
-            "| mode | speedup @ MSSIM 0.99 | speedup @ MSSIM 0.993 | efficiency @ 0.99 | fewer shading operations @ 0.99 | worst case (forced) / reference |"
-        );
-        let _ = writeln!(out, "|---|---|---|---|---|---|");
-        let summaries: Vec<ModeSummary> = modes.iter().filter_map(|m| summarize_mode(points, scene, m)).collect();
-        for s in &summaries {
-            let _ = writeln!(
-                out,
-                "| {} | {} | {} | {} | {} | {} |",
-                s.mode,
-                s.speedup_mssim_990.show(2),
-                s.speedup_mssim_993.show(2),
-                s.efficiency_990.show(2),
-                s.fewer_operations_990.show(2),
-                dash(s.worst_case_overhead, 2)
-            );
-        }
-        let _ = writeln!(
-            out,
-            "\nQuality at the coarse shading rates of DACS Table 1 (PSNR dB / MSSIM; `*`: outside the sweep, nearest end):\n"
-        );
-        let _ = writeln!(out, "| mode | 20% | 50% | 80% |");
-        let _ = writeln!(out, "|---|---|---|---|");
-        for s in &summaries {
-            let cells: Vec<String> = s.at_rates.iter().map(|(p, m)| format!("{} / {}", p.show(1), m.show(4))).collect();
-            let _ = writeln!(out, "| {} | {} |", s.mode, cells.join(" | "));
-        }
-        if let Some(v) = versus_checkerboard(points, scene) {
-            let _ = writeln!(
-                out,
-                "\nHierarchical (DACS) against checkerboard: {}x faster at the checkerboard's MSSIM; {}x the checkerboard's RMSE at the checkerboard's time.",
-                v.speedup_equal_mssim.show(2),
-                v.rmse_ratio_equal_time.show(3)
-            );
-        }
-        let _ = writeln!(out, "\n### Every point\n");
-        let _ = writeln!(
-            out,
-            "| mode | knob | value | forced | shaded | coarse rate | wall ms | paired speedup | fewer ops | RMSE | PSNR dB | MSSIM | FLIP |"
-        );
-        let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-        for p in points.iter().filter(|p| p.scene == scene) {
-            let value = if p.value.is_nan() { "-".to_string() } else { format!("{:.3e}", p.value) };
-            let _ = writeln!(
-                out,
-                "| {} | {} | {} | {} | {:.1}% | {:.1}% | {:.1} | {:.2} | {:.2} | {:.5} | {:.2} | {:.5} | {:.5} |",
-                p.mode,
-                p.knob,
-                value,
-                if p.forced { "yes" } else { "" },
-                100.0 * p.shaded_fraction,
-                100.0 * p.coarse_fraction,
-                p.wall_ms,
-                1.0 / p.relative_time,
-                p.fewer_operations,
-                p.rmse,
-                p.psnr,
-                p.mssim,
-                p.flip
-            );
-        }
+        summaries_markdown(&mut out, points, scene);
+        points_markdown(&mut out, points, scene);
         let _ = writeln!(out);
     }
     if !frames.is_empty() {
-        let _ = writeln!(out, "## Dynamic threshold along a camera path\n");
-        let _ = writeln!(out, "| frame | mode | {} | shaded | target | time ms |", frames[0].knob);
-        let _ = writeln!(out, "|---|---|---|---|---|---|");
-        for f in frames {
-            let _ = writeln!(
-                out,
-                "| {} | {} | {:.4e} | {:.1}% | {:.1}% | {:.1} |",
-                f.frame,
-                f.mode,
-                f.threshold,
-                100.0 * f.shaded_fraction,
-                100.0 * f.target,
-                f.time_ms
-            );
-        }
+        controller_markdown(&mut out, frames);
     }
     out
 }
 
+/// A scene's summaries: speedups, quality at the rates of DACS's Table 1,
+/// and DACS against checkerboard.
+fn summaries_markdown(out: &mut String, points: &[Point], scene: &str) {
+    let modes = unique(
+        points
+            .iter()
+            .filter(|p| p.scene == scene && !matches!(p.mode, Mode::Reference | Mode::Checkerboard))
+            .map(|p| p.mode),
+    );
+    let _ = writeln!(
+        out,
+        "Speedup is reference time / mode time, interpolated along each mode's quality/time frontier; \
+         fewer shading operations is the reference's / the mode's by the compiler's cost model (operations per \
+         evaluation times evaluations, docs/evaluation.md), along the same frontier; \
+         `*` marks a bound (the sweep's cheapest point already exceeds the quality: the speedup is at least this). \
+         Efficiency = speedup / (1 / coarse shading rate) at MSSIM 0.99. \
+         Times are paired with reference runs: speedup = 1 / median(mode time / reference time) over the pairs.\n"
+    );
+    let _ = writeln!(
+        out,
+        "| mode | speedup @ MSSIM 0.99 | speedup @ MSSIM 0.993 | efficiency @ 0.99 | fewer shading operations @ 0.99 | worst case (forced) / reference |"
+    );
+    let _ = writeln!(out, "|---|---|---|---|---|---|");
+    let summaries: Vec<ModeSummary> = modes.iter().filter_map(|&m| summarize_mode(points, scene, m)).collect();
+    for s in &summaries {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {} | {} |",
+            s.mode,
+            s.speedup_mssim_990.show(2),
+            s.speedup_mssim_993.show(2),
+            s.efficiency_990.show(2),
+            s.fewer_operations_990.show(2),
+            dash(s.worst_case_overhead, 2)
+        );
+    }
+    let _ = writeln!(
+        out,
+        "\nQuality at the coarse shading rates of DACS Table 1 (PSNR dB / MSSIM; `*`: outside the sweep, nearest end):\n"
+    );
+    let _ = writeln!(out, "| mode | 20% | 50% | 80% |");
+    let _ = writeln!(out, "|---|---|---|---|");
+    for s in &summaries {
+        let cells: Vec<String> = s.at_rates.iter().map(|(p, m)| format!("{} / {}", p.show(1), m.show(4))).collect();
+        let _ = writeln!(out, "| {} | {} |", s.mode, cells.join(" | "));
+    }
+    if let Some(v) = versus_checkerboard(points, scene) {
+        let _ = writeln!(
+            out,
+            "\nHierarchical (DACS) against checkerboard: {}x faster at the checkerboard's MSSIM; {}x the checkerboard's RMSE at the checkerboard's time.",
+            v.speedup_equal_mssim.show(2),
+            v.rmse_ratio_equal_time.show(3)
+        );
+    }
+}
+
+/// Every point of a scene.
+fn points_markdown(out: &mut String, points: &[Point], scene: &str) {
+    let _ = writeln!(out, "\n### Every point\n");
+    let _ = writeln!(
+        out,
+        "| mode | knob | value | forced | shaded | coarse rate | wall ms | paired speedup | fewer ops | RMSE | PSNR dB | MSSIM | FLIP |"
+    );
+    let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for p in points.iter().filter(|p| p.scene == scene) {
+        let value = if p.value.is_nan() { "-".to_string() } else { format!("{:.3e}", p.value) };
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {:.1}% | {:.1}% | {:.1} | {:.2} | {:.2} | {:.5} | {:.2} | {:.5} | {:.5} |",
+            p.mode,
+            p.knob,
+            value,
+            if p.forced { "yes" } else { "" },
+            100.0 * p.shaded_fraction,
+            100.0 * p.coarse_fraction,
+            p.wall_ms,
+            1.0 / p.relative_time,
+            p.fewer_operations,
+            p.rmse,
+            p.psnr,
+            p.mssim,
+            p.flip
+        );
+    }
+}
+
+/// The controller run, frame by frame.
+fn controller_markdown(out: &mut String, frames: &[ControllerFrame]) {
+    let _ = writeln!(out, "## Dynamic threshold along a camera path\n");
+    let _ = writeln!(out, "| frame | mode | {} | shaded | target | time ms |", frames[0].knob);
+    let _ = writeln!(out, "|---|---|---|---|---|---|");
+    for f in frames {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {:.4e} | {:.1}% | {:.1}% | {:.1} |",
+            f.frame,
+            f.mode,
+            f.threshold,
+            100.0 * f.shaded_fraction,
+            100.0 * f.target,
+            f.time_ms
+        );
+    }
+}
+
 /// Registers the plots' font once (plotters draws text with ab_glyph from a
 /// font it is given; the machines CI runs on have no system fonts).
-pub(crate) fn register_font() -> Result<(), String> {
+pub(crate) fn register_font() -> Result<()> {
     static ONCE: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
     ONCE.get_or_init(|| {
         plotters::style::register_font(
@@ -399,6 +416,7 @@ pub(crate) fn register_font() -> Result<(), String> {
         .map_err(|_| "the plot font is invalid".to_string())
     })
     .clone()
+    .map_err(anyhow::Error::msg)
 }
 
 /// Draws a chart with `draw` on a white `size` canvas; returns its RGB bytes.
@@ -406,16 +424,16 @@ fn draw_rgb(
     size: (u32, u32),
     draw: impl FnOnce(
         &plotters::drawing::DrawingArea<plotters::prelude::BitMapBackend, plotters::coord::Shift>,
-    ) -> Result<(), String>,
-) -> Result<Vec<u8>, String> {
+    ) -> Result<()>,
+) -> Result<Vec<u8>> {
     use plotters::prelude::*;
     register_font()?;
     let mut buffer = vec![255u8; (size.0 * size.1 * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buffer, size).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        root.fill(&WHITE)?;
         draw(&root)?;
-        root.present().map_err(|e| e.to_string())?;
+        root.present()?;
     }
     Ok(buffer)
 }
@@ -431,60 +449,52 @@ const PALETTE: [plotters::style::RGBColor; 6] = [
 
 /// Quality (MSSIM, as -log10(1 - MSSIM) so that 0.99 and 0.999 are apart)
 /// against time per mode, one PNG of `size` pixels per scene; returns RGB bytes.
-pub fn plot_quality_vs_time(points: &[Point], scene: &str, size: (u32, u32)) -> Result<Vec<u8>, String> {
+pub fn plot_quality_vs_time(points: &[Point], scene: &str, size: (u32, u32)) -> Result<Vec<u8>> {
     use plotters::prelude::*;
     draw_rgb(size, |root| {
         let pts: Vec<&Point> = points.iter().filter(|p| p.scene == scene && !p.forced).collect();
         let nines = |m: f64| -(1.0 - m).max(1e-6).log10();
         let t_max = pts.iter().map(|p| p.time_ms()).fold(1.0, f64::max) * 1.1;
-        let q_max = pts.iter().filter(|p| p.mode != "reference").map(|p| nines(p.mssim)).fold(2.5, f64::max) * 1.1;
+        let q_max = pts.iter().filter(|p| p.mode != Mode::Reference).map(|p| nines(p.mssim)).fold(2.5, f64::max) * 1.1;
         let mut chart = ChartBuilder::on(root)
             .caption(format!("{scene}: quality vs time"), ("sans-serif", 22))
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(60)
-            .build_cartesian_2d(0.0..t_max, 1.0..q_max)
-            .map_err(|e| e.to_string())?;
+            .build_cartesian_2d(0.0..t_max, 1.0..q_max)?;
         chart
             .configure_mesh()
             .x_desc("wall time of mrsl's passes (ms, median)")
             .y_desc("MSSIM")
             .y_label_formatter(&|v| format!("{:.4}", 1.0 - 10f64.powf(-v)))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        let modes = unique(pts.iter().map(|p| p.mode.as_str()));
+            .draw()?;
+        let modes = unique(pts.iter().map(|p| p.mode));
         for (k, mode) in modes.iter().enumerate() {
             let color = PALETTE[k % PALETTE.len()];
             let mut series: Vec<(f64, f64)> =
                 pts.iter().filter(|p| p.mode == *mode).map(|p| (p.time_ms(), nines(p.mssim).min(q_max))).collect();
             series.sort_by(|a, b| a.0.total_cmp(&b.0));
             chart
-                .draw_series(LineSeries::new(series.clone(), color.stroke_width(2)))
-                .map_err(|e| e.to_string())?
-                .label(*mode)
+                .draw_series(LineSeries::new(series.clone(), color.stroke_width(2)))?
+                .label(mode.name())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
-            chart
-                .draw_series(series.iter().map(|&(x, y)| Circle::new((x, y), 4, color.filled())))
-                .map_err(|e| e.to_string())?;
+            chart.draw_series(series.iter().map(|&(x, y)| Circle::new((x, y), 4, color.filled())))?;
         }
         for q in [0.99, 0.993] {
-            chart
-                .draw_series(LineSeries::new([(0.0, nines(q)), (t_max, nines(q))], BLACK.mix(0.3)))
-                .map_err(|e| e.to_string())?;
+            chart.draw_series(LineSeries::new([(0.0, nines(q)), (t_max, nines(q))], BLACK.mix(0.3)))?;
         }
         chart
             .configure_series_labels()
             .background_style(WHITE.mix(0.8))
             .border_style(BLACK)
             .position(SeriesLabelPosition::LowerRight)
-            .draw()
-            .map_err(|e| e.to_string())?;
+            .draw()?;
         Ok(())
     })
 }
 
 /// The controller run: shaded fraction per frame and the target; RGB bytes.
-pub fn plot_controller(frames: &[ControllerFrame], size: (u32, u32)) -> Result<Vec<u8>, String> {
+pub fn plot_controller(frames: &[ControllerFrame], size: (u32, u32)) -> Result<Vec<u8>> {
     use plotters::prelude::*;
     draw_rgb(size, |root| {
         let n = frames.len().max(2) as f64;
@@ -493,35 +503,20 @@ pub fn plot_controller(frames: &[ControllerFrame], size: (u32, u32)) -> Result<V
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(60)
-            .build_cartesian_2d(0.0..n, 0.0..1.0)
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc("frame along the camera path")
-            .y_desc("shaded fraction")
-            .draw()
-            .map_err(|e| e.to_string())?;
+            .build_cartesian_2d(0.0..n, 0.0..1.0)?;
+        chart.configure_mesh().x_desc("frame along the camera path").y_desc("shaded fraction").draw()?;
         let measured: Vec<(f64, f64)> = frames.iter().map(|f| (f.frame as f64, f.shaded_fraction)).collect();
         let target: Vec<(f64, f64)> = frames.iter().map(|f| (f.frame as f64, f.target)).collect();
         chart
-            .draw_series(LineSeries::new(measured.clone(), PALETTE[0].stroke_width(2)))
-            .map_err(|e| e.to_string())?
+            .draw_series(LineSeries::new(measured.clone(), PALETTE[0].stroke_width(2)))?
             .label("measured")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], PALETTE[0].stroke_width(2)));
+        chart.draw_series(measured.iter().map(|&(x, y)| Circle::new((x, y), 3, PALETTE[0].filled())))?;
         chart
-            .draw_series(measured.iter().map(|&(x, y)| Circle::new((x, y), 3, PALETTE[0].filled())))
-            .map_err(|e| e.to_string())?;
-        chart
-            .draw_series(LineSeries::new(target, PALETTE[3].stroke_width(1)))
-            .map_err(|e| e.to_string())?
+            .draw_series(LineSeries::new(target, PALETTE[3].stroke_width(1)))?
             .label("target")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], PALETTE[3].stroke_width(1)));
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| e.to_string())?;
+        chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw()?;
         Ok(())
     })
 }
@@ -530,10 +525,13 @@ pub fn plot_controller(frames: &[ControllerFrame], size: (u32, u32)) -> Result<V
 mod tests {
     use super::*;
 
-    fn point(mode: &str, time: f64, mssim: f64, fraction: f64) -> Point {
+    /// The adaptive mode of the made-up sweeps.
+    const M: Mode = Mode::Coarse4x4;
+
+    fn point(mode: Mode, time: f64, mssim: f64, fraction: f64) -> Point {
         Point {
             scene: "s".into(),
-            mode: mode.into(),
+            mode,
             knob: "k".into(),
             value: f64::NAN,
             forced: false,
@@ -556,11 +554,11 @@ mod tests {
     #[test]
     fn interpolates_time_at_quality_on_the_frontier() {
         let pts = [
-            point("m", 10.0, 0.98, 0.2),
-            point("m", 20.0, 0.99, 0.4),
+            point(M, 10.0, 0.98, 0.2),
+            point(M, 20.0, 0.99, 0.4),
             // Slower and worse: off the frontier, never used.
-            point("m", 25.0, 0.985, 0.5),
-            point("m", 40.0, 0.995, 0.8),
+            point(M, 25.0, 0.985, 0.5),
+            point(M, 40.0, 0.995, 0.8),
         ];
         let refs: Vec<&Point> = pts.iter().collect();
         assert_eq!(time_at_quality(&refs, 0.99, |p| p.mssim), Figure::At(20.0));
@@ -573,12 +571,12 @@ mod tests {
 
     #[test]
     fn summarises_a_mode_against_the_reference() {
-        let mut pts = vec![point("reference", 100.0, 1.0, 1.0)];
-        pts.extend([point("m", 20.0, 0.98, 0.2), point("m", 40.0, 0.99, 0.4), point("m", 80.0, 0.998, 0.8)]);
-        let mut forced = point("m", 110.0, 1.0, 1.0);
+        let mut pts = vec![point(Mode::Reference, 100.0, 1.0, 1.0)];
+        pts.extend([point(M, 20.0, 0.98, 0.2), point(M, 40.0, 0.99, 0.4), point(M, 80.0, 0.998, 0.8)]);
+        let mut forced = point(M, 110.0, 1.0, 1.0);
         forced.forced = true;
         pts.push(forced);
-        let s = summarize_mode(&pts, "s", "m").unwrap();
+        let s = summarize_mode(&pts, "s", M).unwrap();
         assert_eq!(s.speedup_mssim_990, Figure::At(2.5));
         // Efficiency: 2.5x at 40% shaded, ideal 2.5x.
         assert!((s.efficiency_990.value().unwrap() - 1.0).abs() < 1e-12);
@@ -593,9 +591,9 @@ mod tests {
     #[test]
     fn compares_dacs_with_checkerboard_at_equal_quality_and_time() {
         let pts = vec![
-            point("checkerboard", 50.0, 0.98, 0.5),
-            point("hierarchical", 10.0, 0.97, 0.1),
-            point("hierarchical", 20.0, 0.99, 0.2),
+            point(Mode::Checkerboard, 50.0, 0.98, 0.5),
+            point(Mode::Hierarchical, 10.0, 0.97, 0.1),
+            point(Mode::Hierarchical, 20.0, 0.99, 0.2),
         ];
         let v = versus_checkerboard(&pts, "s").unwrap();
         // MSSIM 0.98 at 15 ms: 50 / 15.
@@ -606,7 +604,7 @@ mod tests {
 
     #[test]
     fn writes_csv_markdown_and_plots() {
-        let pts = vec![point("reference", 100.0, 1.0, 1.0), point("m", 20.0, 0.98, 0.2), point("m", 60.0, 0.995, 0.6)];
+        let pts = vec![point(Mode::Reference, 100.0, 1.0, 1.0), point(M, 20.0, 0.98, 0.2), point(M, 60.0, 0.995, 0.6)];
         let text = csv(&pts).unwrap();
         assert_eq!(text.lines().count(), 4);
         assert!(text.starts_with(
@@ -614,7 +612,7 @@ mod tests {
         ));
         let md = markdown("setup", &pts, &[]);
         // MSSIM 0.99 at 46.7 ms: 100 / 46.7.
-        assert!(md.contains("| m | 2.14 |"), "{md}");
+        assert!(md.contains("| coarse4x4 | 2.14 |"), "{md}");
         let png = plot_quality_vs_time(&pts, "s", (320, 240)).unwrap();
         assert_eq!(png.len(), 320 * 240 * 3);
         // Something other than the white background was drawn.

@@ -1,0 +1,229 @@
+//! What every command sets up before it renders: the program compiled for
+//! the modes that run, the scene bound (its G-buffer, mesh scene, light rig
+//! and scene file), and the resources a program binds besides the G-buffer
+//! (outputs, textures, samplers, the shading-rate image).
+
+use anyhow::{Result, anyhow, bail};
+use mrsl::Options;
+use mrsl_lab::camera_path::CameraPath;
+use mrsl_lab::gpu::Gpu;
+use mrsl_lab::mesh_scene::MeshScene;
+use mrsl_lab::scene::Scene;
+use mrsl_lab::scene_file::SceneFile;
+use mrsl_runtime::{Bindings, Mode, Shader};
+use std::path::Path;
+
+/// Image size when neither `--size` nor a scene file gives one.
+pub const DEFAULT_SIZE: (u32, u32) = (960, 540);
+
+/// The built-in demo program (examples/demo.mrsl).
+pub const DEMO_PROGRAM: &str = include_str!("../../examples/demo.mrsl");
+
+/// The default workload of `bench` (examples/sponza_lights.mrsl).
+pub const WORKLOAD_PROGRAM: &str = include_str!("../../examples/sponza_lights.mrsl");
+
+/// Reads and compiles the program at `path`, or the built-in `(name,
+/// source)`, to the kernels of `modes` alone; returns its name for messages
+/// and the program, or the diagnostics rendered.
+pub fn compile_program(path: Option<&Path>, builtin: (&str, &str), modes: &[Mode]) -> Result<(String, mrsl::Program)> {
+    let (name, source) = match path {
+        Some(path) => (path.display().to_string(), crate::read_source(path)?),
+        None => (format!("{} (built in)", builtin.0), builtin.1.to_string()),
+    };
+    let options = Options { file_name: name.clone(), ..Options::for_modes(modes) };
+    let program = mrsl::compile(&source, &options).map_err(|d| anyhow!(mrsl::render_all(&d, &name, &source)))?;
+    Ok((name, program))
+}
+
+/// A scene ready to bind: its G-buffer textures, the image size, the
+/// mesh scene (camera, light rig, shadow map) for scenes made of a mesh, and
+/// the scene file, if any (its uniforms and images).
+pub struct BoundScene {
+    pub channels: Vec<(String, wgpu::Texture)>,
+    pub size: (u32, u32),
+    pub mesh: Option<MeshScene>,
+    /// The camera path of `--frames`, if the scene has one.
+    pub path: Option<CameraPath>,
+    pub file: Option<SceneFile>,
+}
+
+impl BoundScene {
+    /// Sets the uniforms the scene provides (the mesh scene's rig and
+    /// camera, then the scene file's), by name and type, and renders the
+    /// shadow map if the program samples `shadow_map`. Returns the textures
+    /// to bind by name (the shadow map and the scene file's images) and the
+    /// names the program declares with another type, left at its defaults.
+    pub fn prepare(&mut self, gpu: &Gpu, shader: &mut Shader) -> Result<Prepared> {
+        let mut textures = vec![];
+        let mut warnings = vec![];
+        if let Some(mesh) = &mut self.mesh {
+            let applied = mesh.set_uniforms(shader, &mesh.camera.clone())?;
+            if applied.set.iter().any(|name| name == "shadow_map") {
+                textures.push(("shadow_map".to_string(), mesh.shadow_map(gpu)?.clone()));
+            }
+            warnings.extend(applied.warnings);
+        }
+        if let Some(file) = &self.file {
+            let bound = file.bind(gpu, shader)?;
+            warnings.extend(bound.applied.warnings);
+            textures.extend(bound.textures);
+        }
+        Ok(Prepared { textures, warnings })
+    }
+}
+
+/// What [`BoundScene::prepare`] provides besides uniform values.
+pub struct Prepared {
+    pub textures: Vec<(String, wgpu::Texture)>,
+    pub warnings: Vec<mrsl_lab::uniforms::Mismatch>,
+}
+
+impl Prepared {
+    /// Prints the warnings; returns the textures.
+    pub fn warn(self) -> Vec<(String, wgpu::Texture)> {
+        for warning in &self.warnings {
+            eprintln!("warning: {warning}");
+        }
+        self.textures
+    }
+}
+
+/// `--scene`: a built-in scene's name, or a `.toml` scene file (see
+/// docs/scenes.md). A scene file's `size` applies unless `--size` was given.
+/// What loading a mesh skipped or could not use is printed as warnings.
+pub fn bind_scene(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> Result<BoundScene> {
+    let bound = bind_scene_quietly(gpu, scene, size)?;
+    for warning in bound.mesh.iter().flat_map(|m| &m.warnings) {
+        eprintln!("warning: {scene}: {warning}");
+    }
+    Ok(bound)
+}
+
+fn bind_scene_quietly(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> Result<BoundScene> {
+    if let Some(builtin) = Scene::parse(scene) {
+        let size = size.unwrap_or(DEFAULT_SIZE);
+        let mesh = builtin.mesh_scene(gpu)?;
+        let channels = match &mesh {
+            Some(m) => m.gbuffer(gpu, &m.camera, size)?,
+            None => builtin.textures_on(gpu, size.0, size.1)?,
+        };
+        return Ok(BoundScene { channels, size, mesh, path: builtin.camera_path(), file: None });
+    }
+    let path = Path::new(scene);
+    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
+        let file = SceneFile::load(path)?;
+        // The command line's --size wins over the file's.
+        let size = size.or(file.size).unwrap_or(DEFAULT_SIZE);
+        let mesh = file.mesh_scene(gpu, size)?;
+        let channels = mesh.gbuffer(gpu, &mesh.camera, size).map_err(|e| anyhow!("{scene}: {e}"))?;
+        return Ok(BoundScene { channels, size, mesh: Some(mesh), path: file.path(), file: Some(file) });
+    }
+    bail!("unknown scene `{scene}` (expected {}, or a .toml scene file)", Scene::NAMES.join(", "))
+}
+
+/// What a program binds besides the G-buffer: its outputs, and for each of
+/// its textures the scene's texture of that name (the shadow map, a scene
+/// file's image), else a procedural checker; every sampler is linear and
+/// repeating.
+pub struct Resources {
+    pub size: (u32, u32),
+    pub outputs: Vec<(String, wgpu::Texture)>,
+    checker_view: wgpu::TextureView,
+    views: Vec<(String, wgpu::TextureView)>,
+    /// The program's textures that get the checker.
+    checkered: Vec<String>,
+    sampler: wgpu::Sampler,
+    /// The rate-image mode's shading-rate image (full rate until a rate source writes it).
+    pub shading_rate: wgpu::Texture,
+}
+
+impl Resources {
+    pub fn new(
+        gpu: &Gpu,
+        program: &mrsl::Program,
+        size: (u32, u32),
+        textures: Vec<(String, wgpu::Texture)>,
+        rate_tile: u32,
+    ) -> Result<Resources> {
+        let shading_rate = mrsl_runtime::rate_source::create_rate_image(&gpu.device, size, rate_tile)?;
+        let outputs = program
+            .layout
+            .outputs
+            .iter()
+            .map(|o| (o.name.clone(), gpu.output_texture(&o.name, size, mrsl_runtime::wgpu_format(o.format))))
+            .collect();
+        let views: Vec<(String, wgpu::TextureView)> =
+            textures.iter().map(|(name, t)| (name.clone(), t.create_view(&Default::default()))).collect();
+        let checkered = program
+            .layout
+            .textures
+            .iter()
+            .filter(|t| !views.iter().any(|(name, _)| *name == t.name))
+            .map(|t| t.name.clone())
+            .collect();
+        Ok(Resources {
+            size,
+            outputs,
+            checker_view: checker_texture(gpu).create_view(&Default::default()),
+            views,
+            checkered,
+            sampler: linear_sampler(gpu),
+            shading_rate,
+        })
+    }
+
+    /// Says which textures get the procedural checker, and how to give them an image.
+    pub fn note_fallbacks(&self) {
+        for name in &self.checkered {
+            eprintln!(
+                "note: texture `{name}` gets a procedural 64x64 checker (a scene file binds an image to it: \
+                 `{name} = \"FILE.png\"` under [uniforms])"
+            );
+        }
+    }
+
+    /// The bindings of `program` over the G-buffer `channels`.
+    pub fn bindings<'a>(&'a self, program: &mrsl::Program, channels: &'a [(String, wgpu::Texture)]) -> Bindings<'a> {
+        let mut bindings = Bindings { size: self.size, ..Default::default() };
+        for (name, texture) in channels {
+            bindings.channels.insert(name.clone(), texture);
+        }
+        for t in &program.layout.textures {
+            let view = self.views.iter().find(|(name, _)| *name == t.name).map_or(&self.checker_view, |(_, v)| v);
+            bindings.textures.insert(t.name.clone(), view);
+        }
+        for s in &program.layout.samplers {
+            bindings.samplers.insert(s.name.clone(), &self.sampler);
+        }
+        for (name, texture) in &self.outputs {
+            bindings.outputs.insert(name.clone(), texture);
+        }
+        bindings.shading_rate = Some(&self.shading_rate);
+        bindings
+    }
+}
+
+/// A linear, repeating sampler (what programs' `sampler` uniforms get).
+pub fn linear_sampler(gpu: &Gpu) -> wgpu::Sampler {
+    gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+        address_mode_u: wgpu::AddressMode::Repeat,
+        address_mode_v: wgpu::AddressMode::Repeat,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Linear,
+        ..Default::default()
+    })
+}
+
+fn checker_texture(gpu: &Gpu) -> wgpu::Texture {
+    let n = 64u32;
+    let mut data = Vec::with_capacity((n * n * 4) as usize);
+    for y in 0..n {
+        for x in 0..n {
+            let odd = ((x / 8) + (y / 8)) % 2 == 1;
+            let (r, g, b) = if odd { (200, 80, 60) } else { (235, 225, 200) };
+            data.extend_from_slice(&[r, g, b, 255]);
+        }
+    }
+    gpu.texture_with_data("checker", (n, n), wgpu::TextureFormat::Rgba8UnormSrgb, &data)
+}

@@ -1,0 +1,96 @@
+//! Wall-time measurement shared by `render --compare`, `render --frames`,
+//! `bench` and the ablation: one warm run timed from encoding to idle, runs
+//! paired with reference runs, and the median.
+//!
+//! A shared machine has slow moments; pairing each run of a mode with a
+//! reference run beside it, alternately after and before it, makes a slow
+//! moment weigh on both members of a pair, so the median of the per-pair
+//! ratios says how fast the mode is relative to the reference even where
+//! the absolute times drift.
+
+use anyhow::Result;
+use mrsl_lab::gpu::Gpu;
+use mrsl_runtime::{Bindings, DispatchOptions, Shader};
+use std::time::Instant;
+
+/// Runs of each mode paired with reference runs for the timing of
+/// `render --compare` and `render --frames`.
+pub const PAIRS: usize = 3;
+
+/// One run of `options`, from encoding to idle: its wall time in ms.
+pub fn time_run(gpu: &Gpu, shader: &mut Shader, bindings: &Bindings, options: DispatchOptions) -> Result<f64> {
+    let start = Instant::now();
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    shader.encode(&gpu.device, &gpu.queue, &mut encoder, bindings, options)?;
+    gpu.queue.submit([encoder.finish()]);
+    gpu.device.poll(wgpu::PollType::wait_indefinitely())?;
+    Ok(start.elapsed().as_secs_f64() * 1e3)
+}
+
+/// The wall times of `pairs` runs of `options` and each run's ratio to the
+/// reference run paired with it.
+pub struct Paired {
+    pub walls: Vec<f64>,
+    pub ratios: Vec<f64>,
+}
+
+/// Times `pairs` runs of `options` with `time`, each paired with a run of
+/// `reference`: the reference first in even pairs, second in odd ones.
+pub fn paired(
+    pairs: usize,
+    options: DispatchOptions,
+    reference: DispatchOptions,
+    mut time: impl FnMut(DispatchOptions) -> Result<f64>,
+) -> Result<Paired> {
+    let (mut walls, mut ratios) = (vec![], vec![]);
+    for pair in 0..pairs {
+        let (wall, reference_wall) = if pair % 2 == 0 {
+            let r = time(reference)?;
+            (time(options)?, r)
+        } else {
+            let w = time(options)?;
+            (w, time(reference)?)
+        };
+        walls.push(wall);
+        ratios.push(wall / reference_wall);
+    }
+    Ok(Paired { walls, ratios })
+}
+
+/// The median (the mean of the middle two for an even count); NaN for none.
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mrsl_runtime::Mode;
+
+    #[test]
+    fn the_median_of_odd_even_and_no_values() {
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(vec![4.0, 1.0, 2.0, 3.0]), 2.5);
+        assert!(median(vec![]).is_nan());
+    }
+
+    #[test]
+    fn pairs_alternate_which_run_goes_first() {
+        let mut order = vec![];
+        let mode = DispatchOptions::new(Mode::Coarse4x4);
+        let reference = DispatchOptions::new(Mode::Reference);
+        let p = paired(3, mode, reference, |o| {
+            order.push(o.mode);
+            Ok(if o.mode == Mode::Reference { 4.0 } else { 1.0 })
+        })
+        .unwrap();
+        use Mode::{Coarse4x4 as M, Reference as R};
+        assert_eq!(order, [R, M, M, R, R, M]);
+        assert_eq!((p.walls, p.ratios), (vec![1.0; 3], vec![0.25; 3]));
+    }
+}
