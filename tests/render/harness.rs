@@ -101,9 +101,11 @@ pub struct Dispatched {
     pub pixels: Vec<[f32; 4]>,
     /// [`Shader::read_stats`] after the dispatch.
     pub stats: Result<Stats, Error>,
-    /// The `.x` words of [`Shader::rate_image`] after the dispatch (the
+    /// The `.x` words of [`Shader::refine_mask`] after the dispatch (the
     /// per-pixel refine masks), if the shader has one.
     pub refine_masks: Option<Vec<u32>>,
+    /// Its `.y` words (the dynamic mode's 2x2 level; all ones at a background pixel).
+    pub refine_masks_y: Option<Vec<u32>>,
 }
 
 /// Dispatches `options` one after the other with one shader over one
@@ -173,15 +175,18 @@ pub fn dispatch_in_turn<const N: usize>(
         gpu.queue.submit([encoder.finish()]);
         let stats = shader.read_stats(&gpu.device);
         let pixels = gpu.read_rgba32f(&outputs[0].1).map_err(|e| Error::Readback(e.to_string()))?;
-        let refine_masks = match shader.refine_mask() {
+        let (refine_masks, refine_masks_y) = match shader.refine_mask() {
             Some(t) => {
                 let texels = gpu.read_texture(t).map_err(|e| Error::Readback(e.to_string()))?;
-                // rg32uint: the mask is the first word of each 8-byte texel.
-                Some(texels.chunks_exact(8).map(|t| u32::from_le_bytes([t[0], t[1], t[2], t[3]])).collect())
+                // rg32uint: the mask is the first word of each 8-byte texel, then `.y`.
+                let word = |t: &[u8]| u32::from_le_bytes([t[0], t[1], t[2], t[3]]);
+                let x = texels.chunks_exact(8).map(|t| word(&t[..4])).collect();
+                let y = texels.chunks_exact(8).map(|t| word(&t[4..])).collect();
+                (Some(x), Some(y))
             }
-            None => None,
+            None => (None, None),
         };
-        dispatched.push(Dispatched { pixels, stats, refine_masks });
+        dispatched.push(Dispatched { pixels, stats, refine_masks, refine_masks_y });
     }
     Ok(dispatched.try_into().unwrap_or_else(|_| unreachable!("one result per dispatch")))
 }

@@ -9,6 +9,7 @@
 
 mod harness;
 
+mod background;
 mod binding;
 mod errors;
 mod frames;
@@ -27,6 +28,14 @@ type GpuTest = (&'static str, fn(&mrsl_lab::gpu::Gpu));
 
 /// Tests that need a device.
 const GPU_TESTS: &[GpuTest] = &[
+    (
+        "background::background_pixels_are_never_shaded_or_refined",
+        background::background_pixels_are_never_shaded_or_refined,
+    ),
+    (
+        "background::surface_keys_refine_the_same_pixels_at_any_scale",
+        background::surface_keys_refine_the_same_pixels_at_any_scale,
+    ),
     ("binding::textured_materials_are_lit_over_a_mesh_scene", binding::textured_materials_are_lit_over_a_mesh_scene),
     ("binding::mismatches_without_defaults_are_typed_errors", binding::mismatches_without_defaults_are_typed_errors),
     ("errors::binding_mismatches_are_typed_errors", errors::binding_mismatches_are_typed_errors),

@@ -1,0 +1,128 @@
+//! The background rule (`@background`) and the surface key
+//! (`@surface_key`): background pixels are never evaluated, refined or
+//! resampled from, forced refinement still equals the reference there, and
+//! a surface key refines the same pixels whatever the scene's scale.
+
+use crate::harness::*;
+use mrsl_lab::gpu::Gpu;
+use mrsl_lab::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
+use mrsl_runtime::{DispatchOptions, Mode};
+
+/// Lighting over the demo scene's spheres, ground and sky (material 255),
+/// with a derivative, a refine predicate, an integer coarse effect and one
+/// that reads the position.
+const PROGRAM: &str = "\
+@surface_key(normal, 0.25) in float3 position;
+@key(0.4) in float3 normal;
+@background(255) in uint material;
+uniform float3 light = float3(0.3, 0.9, 0.3);
+coarse effect float diffuse {
+    diffuse = saturate(dot(normalize(normal), normalize(light)));
+    if (fwidth(diffuse) > 0.02) refine;
+}
+coarse effect uint band = uint(diffuse * 4.0);
+coarse effect float3 tint = float3(diffuse * 0.5, 0.25, 0.1 * float(band));
+// Reads the position (so its key concerns it) in a way no scale changes.
+coarse effect float3 direction = normalize(position);
+fine out float4 color = material == 255u
+    ? float4(0.3, 0.4, 0.6, 1.0)
+    : float4(tint + float3(diffuse) + 0.1 * direction, 1.0);
+";
+
+const ADAPTIVE: [Mode; 6] =
+    [Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic, Mode::Hierarchical, Mode::Checkerboard, Mode::RateImage];
+
+fn materials(gbuffer: &GBuffer) -> &[u32] {
+    match gbuffer.channels.iter().find(|(n, _)| n == "material") {
+        Some((_, ChannelData::Uint(ids))) => ids,
+        _ => panic!("the demo scene has a material channel"),
+    }
+}
+
+/// Forced refinement equals the reference bit for bit, background pixels
+/// included; adaptive, a background pixel is counted as background and
+/// nothing else (the refine mask marks it x 0, y all ones), its output is
+/// the reference's, and no coarse evaluation is spent on a background sample.
+pub fn background_pixels_are_never_shaded_or_refined(gpu: &Gpu) {
+    let program = compile(PROGRAM);
+    // An odd size: blocks and tiles the image cuts.
+    let gbuffer = Scene::Demo.render(67, 41);
+    let background: Vec<bool> = materials(&gbuffer).iter().map(|&m| m == BACKGROUND).collect();
+    let count = background.iter().filter(|&&b| b).count() as u64;
+    assert!(count > 200 && count < background.len() as u64 / 2, "the demo shows some sky: {count} pixels");
+    let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap().pixels;
+    for mode in ADAPTIVE {
+        let forced = run(gpu, &program, &gbuffer, mode, true).unwrap();
+        assert_eq!(worst_ulps(&forced.pixels, &reference), 0, "{mode}: forced refinement differs from the reference");
+        let rates = mrsl_lab::shading_rate::pattern(mrsl_abi::shading_rate::rate_image_size((67, 41), 8));
+        let options = DispatchOptions { rate_tile: 8, ..DispatchOptions::new(mode) };
+        let [run] = dispatch_in_turn(gpu, &program, &gbuffer, &rates, [options]).unwrap();
+        let stats = run.stats.unwrap();
+        assert_eq!(stats.background_pixels, count, "{mode}: background pixels counted");
+        let (x, y) = (run.refine_masks.unwrap(), run.refine_masks_y.unwrap());
+        for (i, &bg) in background.iter().enumerate() {
+            if bg {
+                assert_eq!((x[i], y[i]), (0, u32::MAX), "{mode}: pixel {i} is background");
+                assert_eq!(run.pixels[i], reference[i], "{mode}: pixel {i} shows the sky");
+            } else {
+                assert_ne!(y[i], u32::MAX, "{mode}: pixel {i} was drawn");
+            }
+        }
+        let pixels = background.len() as u64;
+        for e in stats.effects.iter().filter(|e| e.rate == mrsl_abi::Rate::Coarse) {
+            assert!(e.pixel_evaluations <= pixels - count, "{mode}: `{}` evaluated at background pixels", e.name);
+            assert_eq!(e.resampled + e.pixel_evaluations + count, pixels, "{mode}: `{}`'s pixels add up", e.name);
+            if stats.coarse_samples > 0 {
+                assert_eq!(e.coarse_evaluations, stats.coarse_samples - stats.background_samples, "{mode}");
+                assert!(stats.background_samples > 0, "{mode}: some coarse samples fall on the sky");
+            }
+        }
+    }
+}
+
+/// The scene with every position multiplied by `scale` about the origin (the
+/// camera with it): the same image, in other units.
+fn scaled(gbuffer: &GBuffer, scale: f32) -> GBuffer {
+    let mut scaled = gbuffer.clone();
+    for (name, data) in &mut scaled.channels {
+        if let (true, ChannelData::Float { data, .. }) = (name == "position", data) {
+            data.iter_mut().for_each(|v| *v *= scale);
+        }
+    }
+    scaled
+}
+
+/// The pixels that evaluated some coarse effect per pixel.
+fn refined(gpu: &Gpu, program: &mrsl::Program, gbuffer: &GBuffer) -> usize {
+    let options = DispatchOptions::new(Mode::Coarse4x4);
+    let size = (gbuffer.width, gbuffer.height);
+    let rates = mrsl_lab::shading_rate::pattern(mrsl_abi::shading_rate::rate_image_size(size, options.rate_tile));
+    let [run] = dispatch_in_turn(gpu, program, gbuffer, &rates, [options]).unwrap();
+    run.refine_masks.unwrap().iter().filter(|&&m| m != 0).count()
+}
+
+/// A surface key refines the same silhouettes in the scene scaled by 0.01
+/// and by 100 (within 1% of the refined pixels, for rounding), where a
+/// threshold key in world units refines others at each scale.
+pub fn surface_keys_refine_the_same_pixels_at_any_scale(gpu: &Gpu) {
+    let gbuffer = Scene::Demo.render(160, 90);
+    let surface = compile(PROGRAM);
+    let at_one = refined(gpu, &surface, &gbuffer);
+    assert!(at_one > 100, "the silhouettes refine: {at_one} pixels");
+    for scale in [0.01, 100.0] {
+        let at_scale = refined(gpu, &surface, &scaled(&gbuffer, scale));
+        let apart = at_scale.abs_diff(at_one) as f64 / at_one as f64;
+        println!("surface key: {at_scale} refined pixels at scale {scale}, {at_one} at 1");
+        assert!(
+            apart <= 0.01,
+            "scale {scale}: {at_scale} refined pixels against {at_one} ({:.1}% apart)",
+            100.0 * apart
+        );
+    }
+    // The same program with the position compared in world units.
+    let world = compile(&PROGRAM.replace("@surface_key(normal, 0.25)", "@key(0.5)"));
+    let small = refined(gpu, &world, &scaled(&gbuffer, 0.01));
+    let large = refined(gpu, &world, &scaled(&gbuffer, 100.0));
+    println!("world-unit key: {small} refined pixels at scale 0.01, {large} at 100");
+    assert!(large > 2 * small, "a world-unit key refines far more of a larger scene: {large} against {small}");
+}
