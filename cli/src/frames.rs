@@ -235,17 +235,9 @@ impl<'a> Sequence<'a> {
         if with_reference {
             order.insert(0, Mode::Reference);
         }
-        let size = resources.size;
-        let history = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("mrsl previous rate-image frame"),
-            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
+        let history =
+            gpu.texture_2d("mrsl previous rate-image frame", resources.size, wgpu::TextureFormat::Rgba32Float, usage);
         Ok(Sequence {
             gpu,
             args,

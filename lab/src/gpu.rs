@@ -71,7 +71,7 @@ impl Gpu {
     }
 
     /// A single-level 2D texture.
-    pub(crate) fn texture_2d(
+    pub fn texture_2d(
         &self,
         label: &str,
         size: (u32, u32),

@@ -159,8 +159,177 @@ struct Globals {
     size: [f32; 4],
 }
 
+impl Globals {
+    /// The globals of a `size` image of a mesh with `bounds` seen from
+    /// `camera`, `previous` (else `camera`) giving the motion vectors.
+    fn new(
+        bounds: Option<&Bounds>,
+        camera: &Camera,
+        previous: Option<&Camera>,
+        size: (u32, u32),
+    ) -> Result<Globals, RasterError> {
+        let (width, height) = size;
+        let (forward, right, up) = camera.basis()?;
+        let tan_half = (camera.fov_y_degrees.to_radians() / 2.0).tan();
+        let aspect = width as f32 / height as f32;
+        let far = background_distance(bounds, camera);
+        let near = bounds.map(|b| 1e-4 * b.diagonal()).unwrap_or(1e-3).max(1e-6);
+        let view_proj = camera.view_projection(aspect, near)?.to_cols_array_2d();
+        let previous_view_proj = match previous {
+            Some(previous) => previous.view_projection(aspect, near)?.to_cols_array_2d(),
+            None => view_proj,
+        };
+        Ok(Globals {
+            view_proj,
+            previous_view_proj,
+            eye: [camera.eye[0], camera.eye[1], camera.eye[2], far],
+            right: [right[0], right[1], right[2], tan_half * aspect],
+            up: [up[0], up[1], up[2], tan_half],
+            forward: [forward[0], forward[1], forward[2], 0.0],
+            size: [width as f32, height as f32, 0.0, 0.0],
+        })
+    }
+}
+
 /// The passes' shaders; `BACKGROUND_ID` is replaced by [`BACKGROUND`].
 const SHADER: &str = include_str!("raster.wgsl");
+
+/// The bind group layouts: group 0, the globals; group 1, a material
+/// (factors, three textures, a sampler).
+fn bind_group_layouts(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::BindGroupLayout) {
+    let uniform = |binding, size: usize| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: wgpu::BufferSize::new(size as u64),
+        },
+        count: None,
+    };
+    let globals_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("mrsl rasteriser globals"),
+        entries: &[uniform(0, std::mem::size_of::<Globals>())],
+    });
+    let texture = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    };
+    let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("mrsl rasteriser material"),
+        entries: &[
+            uniform(0, std::mem::size_of::<MaterialUniform>()),
+            texture(1),
+            texture(2),
+            texture(3),
+            wgpu::BindGroupLayoutEntry {
+                binding: 4,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+        ],
+    });
+    (globals_layout, material_layout)
+}
+
+/// The mesh and background pipelines of passes 1 to 3: pass 1 writes the
+/// depth buffer (greater-or-equal, reversed depth), passes 2 and 3 draw
+/// where the depth equals it.
+fn pipelines(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    globals_layout: &wgpu::BindGroupLayout,
+    material_layout: &wgpu::BindGroupLayout,
+) -> ([wgpu::RenderPipeline; 3], [wgpu::RenderPipeline; 3]) {
+    let mesh_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("mrsl rasteriser mesh"),
+        bind_group_layouts: &[Some(globals_layout), Some(material_layout)],
+        immediate_size: 0,
+    });
+    let background_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("mrsl rasteriser background"),
+        bind_group_layouts: &[Some(globals_layout)],
+        immediate_size: 0,
+    });
+    let attributes = wgpu::vertex_attr_array![
+        0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Uint32, 4 => Float32x4, 5 => Float32x4
+    ];
+    let vertex_layout = wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &attributes,
+    };
+    let targets = |pass: usize| -> Vec<Option<wgpu::ColorTargetState>> {
+        PASSES[pass]
+            .iter()
+            .map(|&i| {
+                let format = CHANNELS[i].1;
+                Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
+            })
+            .collect()
+    };
+    let pipeline = |label: &str,
+                    layout: &wgpu::PipelineLayout,
+                    vs: &str,
+                    fs: &str,
+                    buffers: &[Option<wgpu::VertexBufferLayout>],
+                    pass: usize,
+                    write: bool,
+                    compare: wgpu::CompareFunction| {
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some(vs),
+                compilation_options: Default::default(),
+                buffers,
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                front_face: wgpu::FrontFace::Ccw,
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: wgpu::TextureFormat::Depth32Float,
+                depth_write_enabled: Some(write),
+                depth_compare: Some(compare),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some(fs),
+                compilation_options: Default::default(),
+                targets: &targets(pass),
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    };
+    use wgpu::CompareFunction::{Equal, GreaterEqual};
+    let vertex = [Some(vertex_layout)];
+    let mesh = [0, 1, 2].map(|pass| {
+        let (write, compare) = if pass == 0 { (true, GreaterEqual) } else { (false, Equal) };
+        let label = format!("mrsl raster mesh {}", pass + 1);
+        pipeline(&label, &mesh_layout, "vs_mesh", &format!("fs_mesh{}", pass + 1), &vertex, pass, write, compare)
+    });
+    let background = [0, 1, 2].map(|pass| {
+        let label = format!("mrsl raster background {}", pass + 1);
+        let fs = format!("fs_background{}", pass + 1);
+        pipeline(&label, &background_layout, "vs_background", &fs, &[], pass, false, Equal)
+    });
+    (mesh, background)
+}
 
 /// A mesh in GPU buffers, its triangles grouped by material, with each
 /// material's bind group (factors and textures).
@@ -201,125 +370,8 @@ impl Rasterizer {
             label: Some("mrsl rasteriser"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         });
-        let uniform = |binding, size: usize| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: wgpu::BufferSize::new(size as u64),
-            },
-            count: None,
-        };
-        let globals_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("mrsl rasteriser globals"),
-            entries: &[uniform(0, std::mem::size_of::<Globals>())],
-        });
-        let texture = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
-        let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("mrsl rasteriser material"),
-            entries: &[
-                uniform(0, std::mem::size_of::<MaterialUniform>()),
-                texture(1),
-                texture(2),
-                texture(3),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
-        });
-        let mesh_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("mrsl rasteriser mesh"),
-            bind_group_layouts: &[Some(&globals_layout), Some(&material_layout)],
-            immediate_size: 0,
-        });
-        let background_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("mrsl rasteriser background"),
-            bind_group_layouts: &[Some(&globals_layout)],
-            immediate_size: 0,
-        });
-        let attributes = wgpu::vertex_attr_array![
-            0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Uint32, 4 => Float32x4, 5 => Float32x4
-        ];
-        let vertex_layout = wgpu::VertexBufferLayout {
-            array_stride: std::mem::size_of::<Vertex>() as u64,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &attributes,
-        };
-        let targets = |pass: usize| -> Vec<Option<wgpu::ColorTargetState>> {
-            PASSES[pass]
-                .iter()
-                .map(|&i| {
-                    let format = CHANNELS[i].1;
-                    Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
-                })
-                .collect()
-        };
-        let pipeline = |label: &str,
-                        layout: &wgpu::PipelineLayout,
-                        vs: &str,
-                        fs: &str,
-                        buffers: &[Option<wgpu::VertexBufferLayout>],
-                        pass: usize,
-                        write: bool,
-                        compare: wgpu::CompareFunction| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some(vs),
-                    compilation_options: Default::default(),
-                    buffers,
-                },
-                primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    front_face: wgpu::FrontFace::Ccw,
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: wgpu::TextureFormat::Depth32Float,
-                    depth_write_enabled: Some(write),
-                    depth_compare: Some(compare),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(fs),
-                    compilation_options: Default::default(),
-                    targets: &targets(pass),
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        use wgpu::CompareFunction::{Equal, GreaterEqual};
-        let vertex = [Some(vertex_layout)];
-        let mesh = [0, 1, 2].map(|pass| {
-            let (write, compare) = if pass == 0 { (true, GreaterEqual) } else { (false, Equal) };
-            let label = format!("mrsl raster mesh {}", pass + 1);
-            pipeline(&label, &mesh_layout, "vs_mesh", &format!("fs_mesh{}", pass + 1), &vertex, pass, write, compare)
-        });
-        let background = [0, 1, 2].map(|pass| {
-            let label = format!("mrsl raster background {}", pass + 1);
-            let fs = format!("fs_background{}", pass + 1);
-            pipeline(&label, &background_layout, "vs_background", &fs, &[], pass, false, Equal)
-        });
+        let (globals_layout, material_layout) = bind_group_layouts(device);
+        let (mesh, background) = pipelines(device, &module, &globals_layout, &material_layout);
         let pixel = |label: &str, format, texel: [u8; 4]| {
             gpu.texture_with_data(label, (1, 1), format, &texel).create_view(&Default::default())
         };
@@ -470,25 +522,7 @@ impl Rasterizer {
         if width == 0 || height == 0 || width > max || height > max {
             return Err(RasterError::BadSize { width, height, reason: format!("each side must be 1 to {max} pixels") });
         }
-        let (forward, right, up) = camera.basis()?;
-        let tan_half = (camera.fov_y_degrees.to_radians() / 2.0).tan();
-        let aspect = width as f32 / height as f32;
-        let far = background_distance(mesh.bounds.as_ref(), camera);
-        let near = mesh.bounds.map(|b| 1e-4 * b.diagonal()).unwrap_or(1e-3).max(1e-6);
-        let view_proj = camera.view_projection(aspect, near)?.to_cols_array_2d();
-        let previous_view_proj = match previous {
-            Some(previous) => previous.view_projection(aspect, near)?.to_cols_array_2d(),
-            None => view_proj,
-        };
-        let globals = Globals {
-            view_proj,
-            previous_view_proj,
-            eye: [camera.eye[0], camera.eye[1], camera.eye[2], far],
-            right: [right[0], right[1], right[2], tan_half * aspect],
-            up: [up[0], up[1], up[2], tan_half],
-            forward: [forward[0], forward[1], forward[2], 0.0],
-            size: [width as f32, height as f32, 0.0, 0.0],
-        };
+        let globals = Globals::new(mesh.bounds.as_ref(), camera, previous, size)?;
 
         let device = &gpu.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -520,55 +554,70 @@ impl Rasterizer {
         let depth_view = depth.create_view(&Default::default());
         let views: Vec<wgpu::TextureView> = channels.iter().map(|(_, t)| t.create_view(&Default::default())).collect();
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mrsl raster") });
-        for (pass, written) in PASSES.iter().enumerate() {
-            let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = written
-                .iter()
-                .map(|&i| {
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: &views[i],
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })
-                })
-                .collect();
-            let label = format!("mrsl raster pass {}", pass + 1);
-            let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(&label),
-                color_attachments: &attachments,
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: if pass == 0 { wgpu::LoadOp::Clear(0.0) } else { wgpu::LoadOp::Load },
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            rp.set_bind_group(0, &bind_group, &[]);
-            if let (Some(vertices), Some(indices)) = (&mesh.vertices, &mesh.indices) {
-                rp.set_pipeline(&self.mesh[pass]);
-                rp.set_vertex_buffer(0, vertices.slice(..));
-                rp.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
-                for &(first, count, group) in &mesh.draws {
-                    rp.set_bind_group(1, &mesh.bind_groups[group], &[]);
-                    rp.draw_indexed(first..first + count, 0, 0..1);
-                }
-            }
-            rp.set_pipeline(&self.background[pass]);
-            rp.draw(0..3, 0..1);
+        for pass in 0..PASSES.len() {
+            self.encode_pass(&mut encoder, pass, &views, &depth_view, &bind_group, mesh);
         }
         gpu.queue.submit([encoder.finish()]);
         if let Some(error) = pollster::block_on(scope.pop()) {
             return Err(RasterError::Render(mrsl_runtime::gpu::describe(&error)));
         }
         Ok(channels)
+    }
+
+    /// Pass `pass` (0 to 2): the mesh, then the background behind it,
+    /// into the pass's channels of `views`.
+    fn encode_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pass: usize,
+        views: &[wgpu::TextureView],
+        depth_view: &wgpu::TextureView,
+        bind_group: &wgpu::BindGroup,
+        mesh: &GpuMesh,
+    ) {
+        let written = PASSES[pass];
+        let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = written
+            .iter()
+            .map(|&i| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view: &views[i],
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
+            })
+            .collect();
+        let label = format!("mrsl raster pass {}", pass + 1);
+        let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(&label),
+            color_attachments: &attachments,
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: if pass == 0 { wgpu::LoadOp::Clear(0.0) } else { wgpu::LoadOp::Load },
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        rp.set_bind_group(0, bind_group, &[]);
+        if let (Some(vertices), Some(indices)) = (&mesh.vertices, &mesh.indices) {
+            rp.set_pipeline(&self.mesh[pass]);
+            rp.set_vertex_buffer(0, vertices.slice(..));
+            rp.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
+            for &(first, count, group) in &mesh.draws {
+                rp.set_bind_group(1, &mesh.bind_groups[group], &[]);
+                rp.draw_indexed(first..first + count, 0, 0..1);
+            }
+        }
+        rp.set_pipeline(&self.background[pass]);
+        rp.draw(0..3, 0..1);
     }
 }
 

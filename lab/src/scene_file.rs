@@ -201,84 +201,17 @@ impl SceneFile {
         };
         let camera = match table.get("camera") {
             None => None,
-            Some(toml::Value::Table(t)) => {
-                for key in t.keys() {
-                    if !["eye", "target", "up", "fov"].contains(&key.as_str()) {
-                        return Err(key_error(
-                            &format!("camera.{key}"),
-                            "unknown key (expected eye, target, up or fov)".into(),
-                        ));
-                    }
-                }
-                let vec3 = |key: &str, default: Option<[f32; 3]>| -> Result<[f32; 3], SceneFileError> {
-                    match t.get(key) {
-                        None => default
-                            .ok_or_else(|| key_error(&format!("camera.{key}"), "missing: expected [x, y, z]".into())),
-                        Some(v) => numbers(v)
-                            .filter(|n| n.len() == 3)
-                            .map(|n| [n[0] as f32, n[1] as f32, n[2] as f32])
-                            .ok_or_else(|| {
-                                key_error(
-                                    &format!("camera.{key}"),
-                                    format!("expected [x, y, z], found {}", describe_value(v)),
-                                )
-                            }),
-                    }
-                };
-                let fov = match t.get("fov") {
-                    None => DEFAULT_FOV,
-                    Some(v) => match scalar(v) {
-                        Some(a) if a > 0.0 && a < 180.0 => a as f32,
-                        _ => {
-                            return Err(key_error(
-                                "camera.fov",
-                                format!("expected degrees between 0 and 180, found {}", describe_value(v)),
-                            ));
-                        }
-                    },
-                };
-                let camera = Camera {
-                    eye: vec3("eye", None)?,
-                    target: vec3("target", None)?,
-                    up: vec3("up", Some([0.0, 1.0, 0.0]))?,
-                    fov_y_degrees: fov,
-                };
-                camera.basis().map_err(|e| key_error("camera", e.to_string()))?;
-                Some(camera)
-            }
-            Some(other) => return Err(key_error("camera", format!("expected a table, found {}", other.type_str()))),
+            Some(v) => Some(camera(v).map_err(|(key, message)| key_error(&key, message))?),
         };
         let camera_path = match table.get("camera_path") {
             None => None,
             Some(v) => Some(camera_path(v).map_err(|(key, message)| key_error(&key, message))?),
         };
         let base = path.parent().unwrap_or(Path::new(""));
-        let mut uniforms = vec![];
-        match table.get("uniforms") {
-            None => {}
-            Some(toml::Value::Table(t)) => {
-                for (name, v) in t {
-                    let key = format!("uniforms.{name}");
-                    let value = match v {
-                        toml::Value::String(file) => {
-                            UniformValue::Image { path: base.join(file), color_space: ColorSpace::Srgb }
-                        }
-                        toml::Value::Table(image) => image_value(image, base).map_err(|m| key_error(&key, m))?,
-                        _ => UniformValue::Numbers(numbers(v).filter(|n| !n.is_empty()).ok_or_else(|| {
-                            key_error(
-                                &key,
-                                format!(
-                                    "expected a number, a bool, an array of them, or an image file, found {}",
-                                    describe_value(v)
-                                ),
-                            )
-                        })?),
-                    };
-                    uniforms.push((name.clone(), value));
-                }
-            }
-            Some(other) => return Err(key_error("uniforms", format!("expected a table, found {}", other.type_str()))),
-        }
+        let uniforms = match table.get("uniforms") {
+            None => vec![],
+            Some(v) => uniforms(v, base).map_err(|(key, message)| key_error(&key, message))?,
+        };
         Ok(SceneFile { path: path.to_path_buf(), mesh, camera, size, crease_angle, camera_path, uniforms })
     }
 
@@ -394,6 +327,69 @@ impl SceneFile {
         crate::raster::read_gbuffer(gpu, &textures)
             .map_err(|source| SceneFileError::Raster { path: self.path.clone(), source })
     }
+}
+
+/// `[camera]`: eye and target, optionally up and fov. Errors name the key at fault.
+fn camera(v: &toml::Value) -> Result<Camera, (String, String)> {
+    let toml::Value::Table(t) = v else {
+        return Err(("camera".into(), format!("expected a table, found {}", v.type_str())));
+    };
+    for key in t.keys() {
+        if !["eye", "target", "up", "fov"].contains(&key.as_str()) {
+            return Err((format!("camera.{key}"), "unknown key (expected eye, target, up or fov)".into()));
+        }
+    }
+    let vec3 = |key: &str, default: Option<[f32; 3]>| -> Result<[f32; 3], (String, String)> {
+        match t.get(key) {
+            None => default.ok_or_else(|| (format!("camera.{key}"), "missing: expected [x, y, z]".into())),
+            Some(v) => numbers(v)
+                .filter(|n| n.len() == 3)
+                .map(|n| [n[0] as f32, n[1] as f32, n[2] as f32])
+                .ok_or_else(|| (format!("camera.{key}"), format!("expected [x, y, z], found {}", describe_value(v)))),
+        }
+    };
+    let fov = match t.get("fov") {
+        None => DEFAULT_FOV,
+        Some(v) => match scalar(v) {
+            Some(a) if a > 0.0 && a < 180.0 => a as f32,
+            _ => {
+                return Err((
+                    "camera.fov".into(),
+                    format!("expected degrees between 0 and 180, found {}", describe_value(v)),
+                ));
+            }
+        },
+    };
+    let camera = Camera {
+        eye: vec3("eye", None)?,
+        target: vec3("target", None)?,
+        up: vec3("up", Some([0.0, 1.0, 0.0]))?,
+        fov_y_degrees: fov,
+    };
+    camera.basis().map_err(|e| ("camera".to_string(), e.to_string()))?;
+    Ok(camera)
+}
+
+/// `[uniforms]`: numbers, and images resolved against `base`, in the
+/// order of the file. Errors name the key at fault.
+fn uniforms(v: &toml::Value, base: &Path) -> Result<Vec<(String, UniformValue)>, (String, String)> {
+    let toml::Value::Table(t) = v else {
+        return Err(("uniforms".into(), format!("expected a table, found {}", v.type_str())));
+    };
+    let mut uniforms = vec![];
+    for (name, v) in t {
+        let key = format!("uniforms.{name}");
+        let value = match v {
+            toml::Value::String(file) => UniformValue::Image { path: base.join(file), color_space: ColorSpace::Srgb },
+            toml::Value::Table(image) => image_value(image, base).map_err(|m| (key.clone(), m))?,
+            _ => UniformValue::Numbers(numbers(v).filter(|n| !n.is_empty()).ok_or_else(|| {
+                let expected = "expected a number, a bool, an array of them, or an image file";
+                (key.clone(), format!("{expected}, found {}", describe_value(v)))
+            })?),
+        };
+        uniforms.push((name.clone(), value));
+    }
+    Ok(uniforms)
 }
 
 /// `camera_path`: `"walk"`, or an array of at least two `{ eye, target }`
