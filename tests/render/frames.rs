@@ -17,7 +17,8 @@ use mrsl_runtime::rate_source::{
 };
 use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader};
 
-const DEMO: &str = include_str!("../../examples/demo.mrsl");
+/// A program whose albedo is a checker from uv (8 squares per unit): the high contrast a rate source keeps fine.
+const DEMO: &str = include_str!("data/phong.mrsl");
 
 /// Axis-aligned quads facing +z: (x0, x1, y0, y1, z, material).
 type Quad = (f32, f32, f32, f32, f32, u32);
@@ -138,7 +139,7 @@ pub fn an_unmoved_camera_gives_zero_velocity(gpu: &Gpu) {
 }
 
 /// The rates of the last frame of a rate-image sequence: `frames` frames
-/// of the demo program over a checkered floor along `path`, each frame's
+/// of the Phong test program over a checkered floor along `path`, each frame's
 /// rates from the rate source on the previous frame's output and velocity.
 /// Returns the fraction of shading cells the last rate image asks for and
 /// the last frame's shaded fraction.
