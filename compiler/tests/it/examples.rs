@@ -62,7 +62,7 @@ fn examples_compile_to_layouts_that_match_their_declarations() {
     }
 }
 
-/// An `in` declaration: name, type, and whether it has `@key`.
+/// An `in` declaration: name, type, and whether it has `@key` or `@surface_key`.
 #[derive(Debug, PartialEq)]
 struct Declared {
     name: String,
@@ -101,7 +101,7 @@ impl Declarations {
                 ["in", ty, name, ..] => found.channels.push(Declared {
                     name: identifier(name),
                     ty: ty.to_string(),
-                    key: attributes.contains(&"key"),
+                    key: attributes.contains(&"key") || attributes.contains(&"surface_key"),
                 }),
                 ["uniform", "texture2d", name, ..] => found.textures.push(identifier(name)),
                 ["uniform", "sampler", name, ..] => found.samplers.push(identifier(name)),
