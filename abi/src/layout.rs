@@ -12,6 +12,12 @@ use serde::{Deserialize, Serialize};
 /// The layout format this crate reads and writes (the `format` field).
 pub const LAYOUT_FORMAT: &str = "mrsl-layout/6";
 
+/// The refine mask's texel at a background pixel (x: no effect evaluated per
+/// pixel, y: all ones). A shaded pixel holds it only in a program with at
+/// least 32 coarse effects that took every one of them from the dynamic
+/// mode's 2x2 level; the statistics' background count is exact regardless.
+pub const BACKGROUND_MARK: [u32; 2] = [0, u32::MAX];
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Layout {
     /// The format version, [`LAYOUT_FORMAT`].
@@ -26,6 +32,7 @@ pub struct Layout {
     pub stats: StatsLayout,
     /// The per-pixel kernels' refine mask (`rg32uint`: x bit k = coarse effect k
     /// (stats counter k) evaluated per pixel; y bit k = taken from the dynamic mode's 2x2 level).
+    /// A background pixel holds [`BACKGROUND_MARK`].
     pub refine_mask: ResourceBinding,
     /// The dynamic mode's second (2x2) level of coarse samples: records of
     /// `interface.stride_words + 1` words, the last being a validity tag.

@@ -148,7 +148,8 @@ pub fn render_frames(session: &mut Session, args: &RenderArgs, n: usize) -> Resu
             mrsl_lab::uniforms::check(shader.layout(), "the camera path", "camera_pos", &Offered::float3()),
             Ok(Verdict::Bind)
         );
-    let mut sequence = Sequence::new(gpu, args, stem, resources, first_output, mesh)?;
+    let modes = crate::render::runnable_modes(args, shader)?;
+    let mut sequence = Sequence::new(gpu, args, &modes, stem, resources, first_output, mesh)?;
     sequence.follow_eye = follow_eye;
     sequence.float_output = float_output;
     let size = resources.size;
@@ -225,13 +226,14 @@ impl<'a> Sequence<'a> {
     fn new(
         gpu: &'a Gpu,
         args: &'a RenderArgs,
+        modes: &[Mode],
         stem: &'a str,
         resources: &'a Resources,
         first_output: &'a wgpu::Texture,
         mesh: &'a MeshScene,
     ) -> Result<Sequence<'a>> {
-        let with_reference = args.compare || args.modes.contains(&Mode::Reference);
-        let mut order: Vec<Mode> = args.modes.iter().copied().filter(|m| *m != Mode::Reference).collect();
+        let with_reference = args.compare || modes.contains(&Mode::Reference);
+        let mut order: Vec<Mode> = modes.iter().copied().filter(|m| *m != Mode::Reference).collect();
         if with_reference {
             order.insert(0, Mode::Reference);
         }

@@ -17,7 +17,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 pub const STRIP: u32 = 52;
 
 /// The narrowest canvas the key fits.
-pub const MIN_WIDTH: u32 = 420;
+pub const MIN_WIDTH: u32 = 520;
 
 /// What a map shows.
 pub enum Legend {
@@ -45,6 +45,9 @@ pub fn rate_color(rate: mrsl_abi::ShadingRate) -> Option<[u8; 3]> {
         _ => Some([240, 30, 30]),
     }
 }
+
+/// The heatmaps' colour for a background pixel, which no mode shades.
+pub const BACKGROUND: [u8; 3] = [150, 150, 150];
 
 /// The heatmaps' colour for a pixel where a fraction `f` (0 to 1) of the
 /// coarse effects was evaluated per pixel; `level2`: none was, but some came
@@ -93,10 +96,11 @@ fn draw(root: &Area, legend: &Legend, top: i32, width: i32) -> DrawResult {
     let (bar_top, bar_bottom) = (top + 6, top + 20);
     match legend {
         Legend::Fraction => {
-            let (x0, x1) = (10, width - 150);
+            let (x0, x1) = (10, width - 240);
             bar(root, (x0, x1), (bar_top, bar_bottom), |t| rgb(heat(t, false)))?;
             ticks(root, (x0, x1), bar_bottom, &[(0.0, "0"), (0.25, "0.25"), (0.5, "0.5"), (0.75, "0.75"), (1.0, "1")])?;
-            swatch(root, (width - 135, bar_top), rgb(heat(0.0, true)), "from the 2x2 level")?;
+            swatch(root, (width - 225, bar_top), rgb(heat(0.0, true)), "2x2 level")?;
+            swatch(root, (width - 115, bar_top), rgb(BACKGROUND), "background")?;
             root.draw(&Text::new(
                 "fraction of the coarse effects evaluated per pixel (0: all resampled)",
                 (x0, top + 36),
@@ -107,6 +111,7 @@ fn draw(root: &Area, legend: &Legend, top: i32, width: i32) -> DrawResult {
             swatch(root, (10, bar_top), rgb(heat(0.0, false)), "resampled")?;
             swatch(root, (120, bar_top), rgb(heat(0.0, true)), "from the 2x2 level")?;
             swatch(root, (275, bar_top), rgb(heat(1.0, false)), "evaluated per pixel")?;
+            swatch(root, (420, bar_top), rgb(BACKGROUND), "background")?;
             root.draw(&Text::new(format!("coarse effect `{name}`"), (10, top + 32), font.clone()))?;
         }
         Legend::Error { scale } => {

@@ -61,7 +61,8 @@ pub fn save_output(gpu: &Gpu, texture: &wgpu::Texture, path: &Path) -> Result<()
 /// style of He et al.'s heatmaps ([`legend::heat`]): blue = every coarse
 /// effect resampled from the first (2x2 or 4x4) level, green = some taken
 /// from the dynamic mode's 2x2 level, then yellow to red as the fraction
-/// evaluated per pixel grows; `only`: one effect's bit (blue, green or red).
+/// evaluated per pixel grows, grey at a background pixel (never shaded);
+/// `only`: one effect's bit (blue, green or red).
 /// `rate` is the shader's refine mask (two words a pixel: the refined
 /// effects, and those taken from the 2x2 level). The key is drawn below the map.
 pub fn save_heatmap(
@@ -76,6 +77,9 @@ pub fn save_heatmap(
     let counted = effects.clamp(1, 32) as f32;
     let image = image::RgbImage::from_fn(w, h, |x, y| {
         let [mut mask, mut level2] = words[(y * w + x) as usize];
+        if [mask, level2] == mrsl_abi::BACKGROUND_MARK {
+            return image::Rgb(legend::BACKGROUND);
+        }
         let mut counted = counted;
         if let Some((bit, _)) = only {
             // A single effect: red where it was evaluated per pixel.

@@ -104,6 +104,28 @@ fn open(args: &RenderArgs) -> Result<Session> {
     Ok(Session { gpu, program, name, stem, scene, channels, shader, resources })
 }
 
+/// The modes asked for that the program and device run, in order. Of a
+/// list of modes (`--mode all`, say), one the device cannot run (the
+/// dynamic mode's 2x2 level where storage is short, a kernel left out of
+/// the program) is skipped with a note saying why; a mode asked for on its
+/// own is kept, so that rendering it fails with the runtime's error.
+pub fn runnable_modes(args: &RenderArgs, shader: &Shader) -> Result<Vec<Mode>> {
+    if args.modes.len() == 1 {
+        return Ok(args.modes.clone());
+    }
+    let mut modes = vec![];
+    for &mode in &args.modes {
+        match shader.supports(mode) {
+            Ok(()) => modes.push(mode),
+            Err(e) => eprintln!("skipped {mode}: {e}"),
+        }
+    }
+    if modes.is_empty() {
+        bail!("none of the modes asked for can run on this device");
+    }
+    Ok(modes)
+}
+
 /// The dispatch options of `mode` under the command line's.
 pub fn dispatch_options(args: &RenderArgs, mode: Mode) -> DispatchOptions {
     DispatchOptions {
@@ -162,7 +184,7 @@ fn render_still(session: &mut Session, args: &RenderArgs) -> Result<Vec<PathBuf>
     }
     let mut written = vec![];
     let mut runs: Vec<Run> = vec![];
-    for &mode in &args.modes {
+    for mode in runnable_modes(args, shader)? {
         runs.push(still.render_mode(shader, mode, &mut reference, &mut written)?);
     }
     let stats_path = match &args.output {

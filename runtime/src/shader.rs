@@ -250,8 +250,11 @@ impl Shader {
         self.uniform_values.set(self.layout.uniforms.as_ref(), name, values)
     }
 
-    /// The plan of `mode`, if the device can run it and its kernels are here.
-    fn mode_plan(&self, mode: Mode) -> Result<(), Error> {
+    /// Whether [`Shader::encode`] can run `mode`: the device runs its kernels
+    /// and the program was compiled with them (else
+    /// [`Error::UnsupportedMode`], saying which kernel and why). Lets a tool
+    /// that renders several modes skip one before binding anything.
+    pub fn supports(&self, mode: Mode) -> Result<(), Error> {
         let unsupported = |reason: String| Error::UnsupportedMode(mode.name().into(), reason);
         if let Some((kind, reason)) = mode.kernels().iter().find_map(|k| self.unavailable.get_key_value(&k.kind)) {
             return Err(unsupported(format!("the device cannot run its {kind} kernel: {reason}")));
@@ -278,9 +281,9 @@ impl Shader {
         bindings: &Bindings,
         options: DispatchOptions,
     ) -> Result<(), Error> {
-        self.mode_plan(options.mode)?;
+        self.supports(options.mode)?;
         let whole = Arc::clone(&self.plan);
-        let plan = whole.mode(options.mode).expect("checked by mode_plan");
+        let plan = whole.mode(options.mode).expect("checked by supports");
         crate::validate::size(&whole, plan, bindings.size)?;
         crate::validate::bindings(&self.layout, plan, bindings, options.rate_tile)?;
         let uniform_bytes = match &self.layout.uniforms {
