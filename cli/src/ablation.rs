@@ -217,6 +217,19 @@ fn apply(variant: &Variant, wgsl: &str) -> Option<String> {
     variant.edits.iter().try_fold(wgsl.to_string(), |w, edit| edit(&w))
 }
 
+/// `program` with the block fine kernel of size `block` refining nothing
+/// ([`nothing_refined`]): the block mode's fixed cost, which `bench --suite`
+/// reports as its floor. `None` when the kernel has nothing to edit.
+pub fn refining_nothing(program: &CompiledProgram, block: u32) -> Option<CompiledProgram> {
+    let fine = program.kernel(KernelKind::Fine, block)?;
+    let wgsl = nothing_refined(&fine.wgsl)?;
+    let mut p = program.clone();
+    for k in p.kernels.iter_mut().filter(|k| k.kind == KernelKind::Fine && k.block_size == Some(block)) {
+        k.wgsl = wgsl.clone();
+    }
+    Some(p)
+}
+
 /// The full kernel, the compacted one and the variants that apply, each
 /// as a whole program: (name, what it removes, program).
 type Programs = Vec<(&'static str, &'static str, CompiledProgram)>;

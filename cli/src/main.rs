@@ -18,6 +18,7 @@ mod rates;
 mod render;
 mod report;
 mod setup;
+mod suite;
 mod timing;
 
 #[derive(Parser)]
@@ -88,12 +89,13 @@ enum Command {
 struct Bench {
     /// The .mrsl program (default: the built-in Sponza lights-and-shadows workload).
     program: Option<PathBuf>,
-    /// Scene(s), as for `render` (repeatable).
-    #[arg(long = "scene", default_values = ["sponza"])]
+    /// Scene(s), as for `render` (repeatable; default: sponza, and with
+    /// --suite the suite: sponza, dungeon, outdoor, small, generated).
+    #[arg(long = "scene")]
     scenes: Vec<String>,
-    /// Image size, WIDTHxHEIGHT.
-    #[arg(long, value_parser = args::parse_size, default_value = "1920x1080")]
-    size: (u32, u32),
+    /// Image size, WIDTHxHEIGHT (default 1920x1080; repeatable with --suite).
+    #[arg(long = "size", value_parser = args::parse_size)]
+    sizes: Vec<(u32, u32)>,
     /// Modes, comma-separated (reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard), or all.
     #[arg(long, alias = "mode", value_parser = args::parse_modes, default_value = "all")]
     modes: args::ModeList,
@@ -122,8 +124,14 @@ struct Bench {
     /// Instead of the sweep: time the fine pass of the block mode given by
     /// --modes (coarse4x4 unless given) with one part removed at a time,
     /// paired with the full kernel, on the first scene (writes ablation.md).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "suite")]
     ablation: bool,
+    /// Instead of the sweep: every mode at its defaults over the scene suite
+    /// (or the --scene list) at each --size, paired with the reference:
+    /// speedup, quality, forced and nothing-refined times (writes suite.md
+    /// and suite.json).
+    #[arg(long)]
+    suite: bool,
 }
 
 #[derive(clap::Args)]
@@ -317,6 +325,25 @@ impl Render {
 /// `mrslc bench`: the sweep, or with `--ablation` the ablation.
 fn bench(b: &Bench) -> Result<ExitCode> {
     let modes = b.modes.0.clone();
+    if b.suite {
+        if modes != mrsl_runtime::Mode::ALL {
+            bail!("--suite runs every mode: leave out --modes");
+        }
+        let args = suite::SuiteArgs {
+            program: b.program.clone(),
+            scenes: if b.scenes.is_empty() { suite::SUITE.map(String::from).to_vec() } else { b.scenes.clone() },
+            sizes: if b.sizes.is_empty() { vec![(1920, 1080)] } else { b.sizes.clone() },
+            runs: b.runs,
+            out_dir: b.out_dir.clone(),
+        };
+        return Ok(written(suite::suite(&args)));
+    }
+    let size = match b.sizes.as_slice() {
+        [] => (1920, 1080),
+        [size] => *size,
+        _ => bail!("one --size at a time, except with --suite"),
+    };
+    let scenes = if b.scenes.is_empty() { vec!["sponza".to_string()] } else { b.scenes.clone() };
     if b.ablation {
         let mode = match modes.as_slice() {
             [mode] => *mode,
@@ -325,8 +352,8 @@ fn bench(b: &Bench) -> Result<ExitCode> {
         };
         let args = ablation::AblationArgs {
             program: b.program.clone(),
-            scene: b.scenes.first().cloned().unwrap_or_else(|| "sponza".into()),
-            size: b.size,
+            scene: scenes[0].clone(),
+            size,
             mode,
             runs: b.runs,
             out_dir: b.out_dir.clone(),
@@ -338,8 +365,8 @@ fn bench(b: &Bench) -> Result<ExitCode> {
     }
     let args = bench::BenchArgs {
         program: b.program.clone(),
-        scenes: b.scenes.clone(),
-        size: b.size,
+        scenes,
+        size,
         modes,
         knob: b.knob.clone(),
         values: b.values.clone(),

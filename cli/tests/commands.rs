@@ -16,6 +16,7 @@ const FIVE_STORAGE_TEXTURES: &str = "in float3 normal;\ncoarse effect float d = 
 const TESTS: &[(&str, fn())] = &[
     ("render_all_skips_only_the_modes_the_device_cannot_run", render_all_skips_only_the_modes_the_device_cannot_run),
     ("heatmaps_mark_background_pixels_grey", heatmaps_mark_background_pixels_grey),
+    ("gpu_bench_script_writes_the_suite_report", gpu_bench_script_writes_the_suite_report),
 ];
 
 fn main() {
@@ -122,5 +123,55 @@ fn heatmaps_mark_background_pixels_grey() {
     let heatmap = image::open(dir.join("demo.coarse4x4.heatmap.png")).unwrap().to_rgb8();
     let grey = (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).filter(|&(x, y)| heatmap.get_pixel(x, y).0 == GREY);
     assert_eq!(grey.count() as u64, background);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `scripts/gpu-bench.sh OUTDIR` at a small size (with this build's mrslc,
+/// not a release build): one markdown and one JSON file, every mode over
+/// Sponza with finite paired figures, the block modes' floors, and a scene
+/// whose file is missing listed as not measured rather than failing the run.
+fn gpu_bench_script_writes_the_suite_report() {
+    let dir = scratch("gpu-bench");
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../scripts/gpu-bench.sh");
+    let missing = dir.join("missing.toml");
+    let run = Command::new("sh")
+        .arg(script)
+        .arg(&dir)
+        .args(["--size", "48x27", "--runs", "1", "--scene", "sponza", "--scene"])
+        .arg(&missing)
+        .env("MRSLC", env!("CARGO_BIN_EXE_mrslc"))
+        .output()
+        .expect("the script runs");
+    let said = stderr(&run);
+    assert!(run.status.success(), "{said}");
+    let mut files: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    files.sort();
+    assert_eq!(files, ["suite.json", "suite.md"]);
+    let suite = read_json(&dir.join("suite.json"));
+    assert_eq!(suite["format"], "mrsl-suite/1");
+    assert!(suite["device"]["name"].as_str().is_some_and(|n| !n.is_empty()));
+    let scenes = suite["scenes"].as_array().unwrap();
+    assert_eq!(scenes.len(), 1, "{suite}");
+    assert_eq!((scenes[0]["scene"].as_str(), scenes[0]["width"].as_u64()), (Some("sponza"), Some(48)));
+    let modes = scenes[0]["modes"].as_array().unwrap();
+    assert_eq!(modes.len(), 6, "every adaptive mode");
+    for m in modes {
+        let figure = |key: &str| m[key].as_f64().unwrap_or_else(|| panic!("{key} of {m}"));
+        for key in ["speedup", "time_ratio", "forced_ratio", "wall_ms"] {
+            assert!(figure(key).is_finite() && figure(key) > 0.0, "{key} of {m}");
+        }
+        let mssim = m["metrics"]["mssim"].as_f64().unwrap();
+        assert!(mssim > 0.5 && mssim <= 1.0, "{m}");
+        let block = matches!(m["mode"].as_str(), Some("coarse2x2" | "coarse4x4"));
+        assert_eq!(m["floor_ratio"].is_f64(), block, "{m}");
+    }
+    let skipped = suite["skipped"].as_array().unwrap();
+    assert_eq!(skipped.len(), 1);
+    assert!(skipped[0]["reason"].as_str().unwrap().contains("missing.toml"), "{skipped:?}");
+    let md = std::fs::read_to_string(dir.join("suite.md")).unwrap();
+    for heading in ["## 48x27", "### sponza (48x27)", "| geometric mean speedup |", "## Not measured"] {
+        assert!(md.contains(heading), "{heading} in:\n{md}");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

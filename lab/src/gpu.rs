@@ -22,6 +22,14 @@ pub struct Gpu {
     pub queue: wgpu::Queue,
 }
 
+/// Every adapter the machine offers (what [`Gpu::new`] chooses from: it
+/// prefers a discrete GPU, by wgpu's high-performance preference).
+pub fn adapters() -> Vec<wgpu::AdapterInfo> {
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+    adapters.iter().map(|a| a.get_info()).collect()
+}
+
 impl Gpu {
     pub fn new() -> Result<Gpu, Error> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());

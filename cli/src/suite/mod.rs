@@ -1,0 +1,328 @@
+//! `mrslc bench --suite`: every mode at its defaults (no per-scene tuning)
+//! over a suite of scenes, at one or more sizes, against the reference of
+//! the same program: the paired speedup, quality, shaded fractions, the
+//! forced worst case and the block modes' fixed cost (nothing refined).
+//! Writes `suite.md` and `suite.json` and nothing else.
+//!
+//! A scene whose files are missing (not fetched) is reported as skipped
+//! with the reason, so that a machine without every asset (a lent GPU
+//! machine cannot download) still measures the rest; an unknown scene name
+//! is an error before anything runs.
+
+mod report;
+
+use crate::ablation::refining_nothing;
+use crate::setup::{Resources, WORKLOAD_PROGRAM, bind_scene, compile_program};
+use crate::timing::{median, paired, time_run};
+use anyhow::{Context, Result, anyhow, bail};
+use mrsl_abi::shading_rate::DEFAULT_RATE_TILE;
+use mrsl_lab::gpu::Gpu;
+use mrsl_lab::metrics::Metrics;
+use mrsl_lab::scene::Scene;
+use mrsl_runtime::rate_source::{Preset, RateOptions};
+use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader};
+use serde::Serialize;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// The scenes `--suite` runs unless `--scene` names others.
+pub const SUITE: [&str; 5] = ["sponza", "dungeon", "outdoor", "small", "generated"];
+
+pub struct SuiteArgs {
+    pub program: Option<PathBuf>,
+    pub scenes: Vec<String>,
+    pub sizes: Vec<(u32, u32)>,
+    /// Pairs of runs behind each ratio.
+    pub runs: usize,
+    pub out_dir: PathBuf,
+}
+
+/// An adapter as the report names it.
+#[derive(Debug, Clone, Serialize)]
+pub struct Device {
+    pub name: String,
+    pub backend: String,
+    pub device_type: String,
+    pub driver: String,
+}
+
+impl Device {
+    fn of(info: &wgpu::AdapterInfo) -> Device {
+        Device {
+            name: info.name.clone(),
+            backend: format!("{:?}", info.backend),
+            device_type: format!("{:?}", info.device_type),
+            driver: [info.driver.as_str(), info.driver_info.as_str()].join(" ").trim().to_string(),
+        }
+    }
+}
+
+/// One mode over one scene.
+#[derive(Debug, Clone, Serialize)]
+pub struct ModeRun {
+    pub mode: Mode,
+    /// Median over the pairs of this mode's wall time / the reference's.
+    pub time_ratio: f64,
+    pub speedup: f64,
+    /// Median wall time of the timed (uninstrumented) runs.
+    pub wall_ms: f64,
+    pub metrics: Metrics,
+    pub shaded_fraction: f64,
+    pub coarse_shaded_fraction: f64,
+    /// Speedup x coarse shaded fraction: 1 when time follows the coarse work.
+    pub efficiency: f64,
+    /// Every predicate forced true: its time / the reference's.
+    pub forced_ratio: f64,
+    /// The block modes with nothing refined (the fixed cost): time / the reference's.
+    pub floor_ratio: Option<f64>,
+}
+
+/// Every mode over one scene at one size.
+#[derive(Debug, Clone, Serialize)]
+pub struct SceneRun {
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    pub reference_ms: f64,
+    /// Pixels the program's background rule made background.
+    pub background_fraction: f64,
+    pub modes: Vec<ModeRun>,
+    /// Modes the device cannot run for this program, and why.
+    pub unsupported: Vec<(Mode, String)>,
+}
+
+/// A scene that could not be measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct Skipped {
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    pub reason: String,
+}
+
+/// The whole run, as `suite.json` holds it.
+#[derive(Debug, Clone, Serialize)]
+pub struct Suite {
+    pub format: &'static str,
+    pub program: String,
+    pub device: Device,
+    pub adapters: Vec<Device>,
+    pub runs: usize,
+    pub sizes: Vec<(u32, u32)>,
+    pub scenes: Vec<SceneRun>,
+    pub skipped: Vec<Skipped>,
+    pub seconds: f64,
+}
+
+/// Runs the suite; returns the files written.
+pub fn suite(args: &SuiteArgs) -> Result<Vec<PathBuf>> {
+    for scene in &args.scenes {
+        if Scene::parse(scene).is_none() && !scene.ends_with(".toml") {
+            bail!("unknown scene `{scene}` (expected {}, or a .toml scene file)", Scene::NAMES.join(", "));
+        }
+    }
+    let start = Instant::now();
+    let (name, program) =
+        compile_program(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &Mode::ALL)?;
+    let gpu = Gpu::new()?;
+    let device = Device::of(&gpu.adapter_info);
+    let adapters: Vec<Device> = mrsl_lab::gpu::adapters().iter().map(Device::of).collect();
+    eprintln!(
+        "suite: {name} on {} ({}, {}); adapters present: {}",
+        device.name,
+        device.backend,
+        device.device_type,
+        adapters.iter().map(|a| a.name.as_str()).collect::<Vec<_>>().join(", ")
+    );
+    std::fs::create_dir_all(&args.out_dir).map_err(|e| anyhow!("cannot create {}: {e}", args.out_dir.display()))?;
+    let (mut scenes, mut skipped) = (vec![], vec![]);
+    for &size in &args.sizes {
+        for scene in &args.scenes {
+            let at = Instant::now();
+            match measure_scene(&gpu, &program, scene, size, args.runs.max(1)) {
+                Ok(run) => {
+                    eprintln!("suite: {scene} at {}x{} ({:.0} s)", size.0, size.1, at.elapsed().as_secs_f64());
+                    scenes.push(run);
+                }
+                Err(e) => {
+                    eprintln!("suite: skipped {scene} at {}x{}: {e:#}", size.0, size.1);
+                    skipped.push(Skipped {
+                        scene: scene.clone(),
+                        width: size.0,
+                        height: size.1,
+                        reason: format!("{e:#}"),
+                    });
+                }
+            }
+        }
+    }
+    let suite = Suite {
+        format: "mrsl-suite/1",
+        program: name,
+        device,
+        adapters,
+        runs: args.runs.max(1),
+        sizes: args.sizes.clone(),
+        scenes,
+        skipped,
+        seconds: start.elapsed().as_secs_f64(),
+    };
+    let markdown = report::markdown(&suite);
+    let (md_path, json_path) = (args.out_dir.join("suite.md"), args.out_dir.join("suite.json"));
+    crate::output::write(&md_path, &markdown)?;
+    crate::output::write(&json_path, serde_json::to_string_pretty(&suite)?)?;
+    println!("{markdown}");
+    Ok(vec![md_path, json_path])
+}
+
+/// A scene bound for one program: its shader, resources and reference image.
+struct Bound<'a> {
+    gpu: &'a Gpu,
+    shader: Shader,
+    bindings: Bindings<'a>,
+    first_output: &'a wgpu::Texture,
+    reference: Vec<[f32; 4]>,
+    size: (u32, u32),
+    runs: usize,
+}
+
+/// Every mode over `scene_name` at `size`.
+fn measure_scene(
+    gpu: &Gpu,
+    program: &mrsl::Program,
+    scene_name: &str,
+    size: (u32, u32),
+    runs: usize,
+) -> Result<SceneRun> {
+    let mut scene = bind_scene(gpu, scene_name, Some(size))?;
+    let mut shader = Shader::new(&gpu.device, program)?;
+    shader.set_timestamp_period(&gpu.queue);
+    let textures = scene.prepare(gpu, &mut shader).map_err(|e| anyhow!("{scene_name}: {e}"))?.warn();
+    let resources = Resources::new(gpu, program, scene.size, textures, DEFAULT_RATE_TILE)?;
+    let first_output = &resources.outputs.first().context("the program has no output")?.1;
+    if first_output.format() != wgpu::TextureFormat::Rgba32Float {
+        bail!("the suite compares images: the program's first output must be rgba32float");
+    }
+    // The block modes' floors, made before the bindings borrow the scene.
+    let mut floors = vec![];
+    for block in Mode::ALL.into_iter().filter_map(floor_block) {
+        floors.push((block, floor_shader(gpu, program, &mut scene, block)?));
+    }
+    let bindings = resources.bindings(program, &scene.channels);
+    let reference_options = DispatchOptions::new(Mode::Reference);
+    time_run(gpu, &mut shader, &bindings, reference_options)?;
+    let reference = gpu.read_rgba32f(first_output)?;
+    let reference_walls: Vec<f64> = (0..runs)
+        .map(|_| time_run(gpu, &mut shader, &bindings, reference_options.uninstrumented()))
+        .collect::<Result<_>>()?;
+    let mut bound = Bound { gpu, shader, bindings, first_output, reference, size: scene.size, runs };
+    let (mut modes, mut unsupported, mut background) = (vec![], vec![], 0);
+    for mode in Mode::ALL.into_iter().filter(|m| *m != Mode::Reference) {
+        if let Err(e) = bound.shader.supports(mode) {
+            unsupported.push((mode, e.to_string()));
+            continue;
+        }
+        let floor = floors.iter_mut().find(|(b, _)| Some(*b) == floor_block(mode)).map(|(_, s)| s);
+        let (run, background_pixels) = bound.measure_mode(mode, floor)?;
+        background = background.max(background_pixels);
+        modes.push(run);
+    }
+    let pixels = f64::from(size.0) * f64::from(size.1);
+    Ok(SceneRun {
+        scene: scene_name.to_string(),
+        width: size.0,
+        height: size.1,
+        reference_ms: median(reference_walls),
+        background_fraction: background as f64 / pixels,
+        modes,
+        unsupported,
+    })
+}
+
+/// The block size of the modes whose floor is measured: the block modes,
+/// whose fine kernel [`refining_nothing`] edits. (The other modes' kernels
+/// decide refinement in other places; their floors are not measured.)
+fn floor_block(mode: Mode) -> Option<u32> {
+    match mode {
+        Mode::Coarse2x2 => Some(2),
+        Mode::Coarse4x4 => Some(4),
+        _ => None,
+    }
+}
+
+/// The program with the block fine kernel of `block` refining nothing, on
+/// the scene's uniforms.
+fn floor_shader(
+    gpu: &Gpu,
+    program: &mrsl::Program,
+    scene: &mut crate::setup::BoundScene,
+    block: u32,
+) -> Result<Shader> {
+    let floor = refining_nothing(program, block).context("the block fine kernel has no refinement to remove")?;
+    let mut shader = Shader::new(&gpu.device, &floor)?;
+    scene.prepare(gpu, &mut shader)?;
+    Ok(shader)
+}
+
+impl Bound<'_> {
+    /// One mode: its rate image (the rate-image mode, settled over a still
+    /// camera), paired timings at its defaults, forced and (block modes)
+    /// with nothing refined, and its image against the reference. Also the
+    /// background pixels its statistics counted.
+    fn measure_mode(&mut self, mode: Mode, floor: Option<&mut Shader>) -> Result<(ModeRun, u64)> {
+        let gpu = self.gpu;
+        let options = DispatchOptions::new(mode);
+        if mode == Mode::RateImage {
+            let rates = RateOptions::preset(Preset::Balanced);
+            crate::rates::settle(gpu, &mut self.shader, &self.bindings, self.first_output, &rates, options)?;
+        }
+        let reference = DispatchOptions::new(Mode::Reference).uninstrumented();
+        // The median ratio to the reference and the median wall time.
+        let ratio =
+            |shader: &mut Shader, bindings: &Bindings, options: DispatchOptions, runs: usize| -> Result<(f64, f64)> {
+                time_run(gpu, shader, bindings, options)?;
+                let p = paired(runs, options, reference, |o| time_run(gpu, shader, bindings, o))?;
+                Ok((median(p.ratios), median(p.walls)))
+            };
+        let (time_ratio, wall_ms) = ratio(&mut self.shader, &self.bindings, options.uninstrumented(), self.runs)?;
+        let forced = DispatchOptions { force_refine: true, ..options }.uninstrumented();
+        let (forced_ratio, _) = ratio(&mut self.shader, &self.bindings, forced, self.runs)?;
+        let floor_ratio = match floor {
+            Some(floor) => Some(self.floor_ratio(floor, options.uninstrumented())?),
+            None => None,
+        };
+        // The statistics and the image of one more run at the defaults.
+        time_run(gpu, &mut self.shader, &self.bindings, options)?;
+        let stats = self.shader.read_stats(&gpu.device)?;
+        let pixels = gpu.read_rgba32f(self.first_output)?;
+        let metrics = mrsl_lab::metrics::compare(&pixels, &self.reference, self.size.0, self.size.1)?;
+        let speedup = 1.0 / time_ratio;
+        let run = ModeRun {
+            mode,
+            time_ratio,
+            speedup,
+            wall_ms,
+            metrics,
+            shaded_fraction: stats.shaded_fraction,
+            coarse_shaded_fraction: stats.coarse_shaded_fraction,
+            efficiency: speedup * stats.coarse_shaded_fraction,
+            forced_ratio,
+            floor_ratio,
+        };
+        Ok((run, stats.background_pixels))
+    }
+
+    /// The floor program's time / the reference's (the reference runs on
+    /// the full program's shader), median over the pairs.
+    fn floor_ratio(&mut self, floor: &mut Shader, options: DispatchOptions) -> Result<f64> {
+        let (gpu, bindings) = (self.gpu, &self.bindings);
+        time_run(gpu, floor, bindings, options)?;
+        let reference = DispatchOptions::new(Mode::Reference).uninstrumented();
+        let shader = &mut self.shader;
+        let p = paired(self.runs, options, reference, |o| match o.mode {
+            Mode::Reference => time_run(gpu, shader, bindings, o),
+            _ => time_run(gpu, floor, bindings, o),
+        })?;
+        Ok(median(p.ratios))
+    }
+}
