@@ -1,11 +1,15 @@
 //! The test models the kit renders, and where they are: the Dabrovic
 //! Sponza (a test fixture of the crates.io package `obj-rs` 0.7.4, which
-//! cargo unpacks in its registry) and the Castle Game Engine's dungeon
-//! (fetched by `scripts/fetch-dungeon.sh`, or Debian's package). The library
-//! does not search the disk by itself: the application says where Sponza
-//! is ([`set_sponza_path`], or [`locate_sponza`] for cargo's registry) or
-//! the environment does (`MRSL_SPONZA`, `MRSL_DUNGEON`). Each model is
-//! loaded once per process and shared.
+//! cargo unpacks in its registry), the Castle Game Engine's dungeon
+//! (fetched by `scripts/fetch-dungeon.sh`, or Debian's package), TORCS's
+//! "forza" track (the `outdoor` scene, `scripts/fetch-outdoor.sh`) and a
+//! link of the Franka Panda robot arm (the `small` scene,
+//! `scripts/fetch-small.sh`). The library does not search the disk by
+//! itself: the application says where Sponza is ([`set_sponza_path`], or
+//! [`locate_sponza`] for cargo's registry) or the environment does
+//! (`MRSL_SPONZA`, `MRSL_DUNGEON`, `MRSL_OUTDOOR`, `MRSL_SMALL`); the
+//! fetched models are also looked for where their scripts put them. Each
+//! model is loaded once per process and shared.
 //!
 //! The chosen paths and the loaded models live in process-wide mutexes: the
 //! tools and the test harness set a path once at start-up and every scene
@@ -107,15 +111,28 @@ pub fn set_dungeon_path(path: PathBuf) {
 /// package installs it.
 pub fn dungeon_candidates() -> Vec<PathBuf> {
     let chosen = DUNGEON_PATH.lock().unwrap_or_else(|e| e.into_inner()).clone();
-    let data_home = std::env::var_os("XDG_DATA_HOME")
+    let mut candidates = fetched_candidates(chosen, "MRSL_DUNGEON", "castle-dungeon/level-dungeon.gltf");
+    candidates.push(PathBuf::from(DUNGEON_IN_PACKAGE));
+    candidates
+}
+
+/// `$XDG_DATA_HOME` (absolute), else `~/.local/share`: where the fetch
+/// scripts put the models, under `mrsl/`.
+fn data_home() -> Option<PathBuf> {
+    std::env::var_os("XDG_DATA_HOME")
         .map(PathBuf::from)
         .filter(|p| p.is_absolute())
-        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".local/share")));
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".local/share")))
+}
+
+/// The places a fetched model is looked for: the path the application
+/// chose, the environment variable `variable`, and `$XDG_DATA_HOME/mrsl/`
+/// followed by `fetched` (where its fetch script puts it).
+fn fetched_candidates(chosen: Option<PathBuf>, variable: &str, fetched: &str) -> Vec<PathBuf> {
     chosen
         .into_iter()
-        .chain(std::env::var_os("MRSL_DUNGEON").map(PathBuf::from))
-        .chain(data_home.map(|d| d.join("mrsl/castle-dungeon/level-dungeon.gltf")))
-        .chain(std::iter::once(PathBuf::from(DUNGEON_IN_PACKAGE)))
+        .chain(std::env::var_os(variable).map(PathBuf::from))
+        .chain(data_home().map(|d| d.join("mrsl").join(fetched)))
         .collect()
 }
 
@@ -129,6 +146,69 @@ pub fn dungeon_path() -> Result<PathBuf, MeshError> {
 pub fn dungeon_shared() -> Result<Arc<Mesh>, MeshError> {
     static CACHE: Mutex<Option<Arc<Mesh>>> = Mutex::new(None);
     shared(&CACHE, || Mesh::load_gltf(dungeon_path()?))
+}
+
+/// The outdoor scene's path the application chose ([`set_outdoor_path`]).
+static OUTDOOR_PATH: Mutex<Option<PathBuf>> = Mutex::new(None);
+
+/// Tells [`outdoor_path`] where TORCS's `forza.acc` is.
+pub fn set_outdoor_path(path: PathBuf) {
+    *OUTDOOR_PATH.lock().unwrap_or_else(|e| e.into_inner()) = Some(path);
+}
+
+/// The places [`outdoor_path`] looks, in order: the path given to
+/// [`set_outdoor_path`], `$MRSL_OUTDOOR`, and where
+/// `scripts/fetch-outdoor.sh` puts it
+/// (`$XDG_DATA_HOME/mrsl/torcs-forza/forza.acc`).
+pub fn outdoor_candidates() -> Vec<PathBuf> {
+    let chosen = OUTDOOR_PATH.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    fetched_candidates(chosen, "MRSL_OUTDOOR", "torcs-forza/forza.acc")
+}
+
+/// The path of the outdoor scene's track: the first of [`outdoor_candidates`] that exists.
+pub fn outdoor_path() -> Result<PathBuf, MeshError> {
+    let searched = outdoor_candidates();
+    searched.iter().find(|p| p.is_file()).cloned().ok_or(MeshError::OutdoorNotFound { searched })
+}
+
+/// TORCS's forza track with its textures, loaded once per process and shared.
+pub fn outdoor_shared() -> Result<Arc<Mesh>, MeshError> {
+    static CACHE: Mutex<Option<Arc<Mesh>>> = Mutex::new(None);
+    shared(&CACHE, || Mesh::load_ac3d(outdoor_path()?))
+}
+
+/// The small scene's path the application chose ([`set_small_path`]).
+static SMALL_PATH: Mutex<Option<PathBuf>> = Mutex::new(None);
+
+/// Tells [`small_path`] where the Franka Panda's `link6.obj` is.
+pub fn set_small_path(path: PathBuf) {
+    *SMALL_PATH.lock().unwrap_or_else(|e| e.into_inner()) = Some(path);
+}
+
+/// The places [`small_path`] looks, in order: the path given to
+/// [`set_small_path`], `$MRSL_SMALL`, and where `scripts/fetch-small.sh`
+/// puts it (`$XDG_DATA_HOME/mrsl/franka-panda/link6.obj`).
+pub fn small_candidates() -> Vec<PathBuf> {
+    let chosen = SMALL_PATH.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    fetched_candidates(chosen, "MRSL_SMALL", "franka-panda/link6.obj")
+}
+
+/// The path of the small scene's model: the first of [`small_candidates`] that exists.
+pub fn small_path() -> Result<PathBuf, MeshError> {
+    let searched = small_candidates();
+    searched.iter().find(|p| p.is_file()).cloned().ok_or(MeshError::SmallNotFound { searched })
+}
+
+/// The Franka Panda's link 6 with its materials, loaded once per process and shared.
+pub fn small_shared() -> Result<Arc<Mesh>, MeshError> {
+    static CACHE: Mutex<Option<Arc<Mesh>>> = Mutex::new(None);
+    shared(&CACHE, || Mesh::load_obj(small_path()?))
+}
+
+/// The generated scene's mesh ([`crate::procedural::city`]), made once per process and shared.
+pub fn generated_shared() -> Result<Arc<Mesh>, MeshError> {
+    static CACHE: Mutex<Option<Arc<Mesh>>> = Mutex::new(None);
+    shared(&CACHE, || Ok(crate::procedural::city()))
 }
 
 /// The mesh in `cache`, else `load`ed into it (a failure is not kept: the

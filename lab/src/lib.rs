@@ -5,15 +5,18 @@
 //!   lavapipe on a machine without a GPU) and texture upload/readback.
 //! - [`gbuffer`]: G-buffers in CPU memory (a leaf module).
 //! - [`scene`]: the built-in scenes: CPU test patterns and a ray-cast demo,
-//!   and the Dabrovic Sponza rasterised on the GPU.
+//!   and the mesh scenes rasterised on the GPU (the Dabrovic Sponza, the
+//!   dungeon, an outdoor race track, a small robot part and a generated
+//!   city: the benchmark suite, see docs/scenes.md).
 //! - [`color`]: the sRGB transfer function.
 //! - [`image_texture`]: images decoded, mipmapped and uploaded (for the
 //!   materials and for the images scene files bind to `texture2d` uniforms).
 //! - [`material`]: surface materials (factors and textures).
-//! - [`mesh`], [`raster`]: OBJ/glTF loading (normals, tangents, MTL) and
-//!   the G-buffer rasteriser (with motion vectors from the previous frame's
-//!   camera); [`fixtures`]: the test models (Sponza, the dungeon), found and
-//!   loaded once.
+//! - [`mesh`], [`raster`]: OBJ/glTF/AC3D loading (normals, tangents, MTL)
+//!   and the G-buffer rasteriser (with motion vectors from the previous
+//!   frame's camera); [`fixtures`]: the test models (Sponza, the dungeon,
+//!   the outdoor and small scenes' models), found and loaded once;
+//!   [`procedural`]: the generated scene's city.
 //! - [`camera`], [`camera_path`]: the pinhole camera, and cameras along a
 //!   path, for sequences of frames.
 //! - [`rig`], [`mesh_scene`]: the light rig (point lights, a sun with a
@@ -29,9 +32,9 @@
 //! The vector maths is glam's, but for `vector::normalize` (see there why).
 //!
 //! Module dependencies run one way: `color` ← `image_texture` ← `material`
-//! ← `mesh` ← `fixtures`, `mesh` ← `camera` ← `raster` ← `rig` ←
-//! `mesh_scene` ← `scene` ← `scene_file`, `fixtures` ← `scene`, and
-//! `camera` ← `camera_path` ← `scene`, with `gpu`, `gbuffer` and `vector`
+//! ← `mesh` ← `procedural` ← `fixtures`, `mesh` ← `camera` ← `raster` ←
+//! `rig` ← `mesh_scene` ← `scene` ← `scene_file`, `fixtures` ← `scene`, and
+//! `camera` ← `camera_path` ← `scene`, with `gpu`, `gbuffer`, `hash` and `vector`
 //! beneath them all; `uniforms` (used from `rig` on) depends on no other
 //! module, `metrics` on `color` alone, and `runtime_dir` on none.
 
@@ -41,11 +44,13 @@ pub mod color;
 pub mod fixtures;
 pub mod gbuffer;
 pub mod gpu;
+mod hash;
 pub mod image_texture;
 pub mod material;
 pub mod mesh;
 pub mod mesh_scene;
 pub mod metrics;
+pub mod procedural;
 pub mod raster;
 pub mod rig;
 pub mod runtime_dir;

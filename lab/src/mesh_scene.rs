@@ -4,7 +4,7 @@
 
 use crate::camera::Camera;
 use crate::gpu::Gpu;
-use crate::mesh::{Mesh, MeshWarning};
+use crate::mesh::{Bounds, Mesh, MeshWarning};
 use crate::raster::{GpuMesh, RasterError, Rasterizer};
 use crate::rig::{DEFAULT_LIGHTS, DEFAULT_SHADOW_MAP_SIZE, LightRig, RigError};
 use crate::uniforms::{Applied, Offered};
@@ -25,10 +25,21 @@ pub struct MeshScene {
 impl MeshScene {
     /// Uploads `mesh`; the rig has [`DEFAULT_LIGHTS`] lights over its bounds.
     pub fn new(gpu: &Gpu, mesh: &Mesh, camera: Camera) -> Result<MeshScene, RasterError> {
+        MeshScene::with_rig(gpu, mesh, camera, |bounds| LightRig::for_bounds(bounds, DEFAULT_LIGHTS))
+    }
+
+    /// Uploads `mesh`, with the rig `rig` makes from its bounds (a unit cube
+    /// around the origin for a mesh without triangles).
+    pub fn with_rig(
+        gpu: &Gpu,
+        mesh: &Mesh,
+        camera: Camera,
+        rig: impl FnOnce(&Bounds) -> LightRig,
+    ) -> Result<MeshScene, RasterError> {
         let rasterizer = Rasterizer::new(gpu)?;
         let uploaded = rasterizer.upload(gpu, mesh)?;
-        let bounds = uploaded.bounds().unwrap_or(crate::mesh::Bounds { min: [-1.0, -1.0, -1.0], max: [1.0, 1.0, 1.0] });
-        let rig = LightRig::for_bounds(&bounds, DEFAULT_LIGHTS);
+        let bounds = uploaded.bounds().unwrap_or(Bounds { min: [-1.0, -1.0, -1.0], max: [1.0, 1.0, 1.0] });
+        let rig = rig(&bounds);
         Ok(MeshScene { rasterizer, mesh: uploaded, camera, rig, shadow_map: None, warnings: mesh.warnings.clone() })
     }
 

@@ -29,6 +29,7 @@
 
 use crate::camera::{Camera, CameraError};
 use crate::gpu::Gpu;
+use crate::hash::hash01;
 use crate::mesh::Bounds;
 use crate::raster::{GpuMesh, RasterError, Rasterizer};
 use crate::uniforms::{Applied, Offered, UniformTypeError};
@@ -70,19 +71,6 @@ pub const DEFAULT_LIGHTS: usize = 32;
 /// Default shadow-map resolution (square).
 pub const DEFAULT_SHADOW_MAP_SIZE: u32 = 1024;
 
-/// A small deterministic hash in [0, 1) (the rig must be the same on every
-/// run and machine; pulling in a random-number crate for 100 numbers is not
-/// worth a dependency).
-fn hash01(k: u32) -> f32 {
-    let mut x = k.wrapping_mul(0x9E37_79B9) ^ 0x85EB_CA6B;
-    x ^= x >> 16;
-    x = x.wrapping_mul(0x7FEB_352D);
-    x ^= x >> 15;
-    x = x.wrapping_mul(0x846C_A68B);
-    x ^= x >> 16;
-    (x >> 8) as f32 / (1u32 << 24) as f32
-}
-
 impl LightRig {
     /// `count` point lights spread over `bounds` and a sun above it.
     ///
@@ -93,35 +81,47 @@ impl LightRig {
     /// the side, far enough (three diagonals) that its rays are almost
     /// parallel, with a field of view just covering the bounding sphere.
     pub fn for_bounds(bounds: &Bounds, count: usize) -> LightRig {
-        let (min, extent) = (bounds.min, bounds.extent());
-        // Long axis: x or z, whichever is longer; rows are offset along the other.
-        let (long, short) = if extent[0] >= extent[2] { (0, 2) } else { (2, 0) };
-        let lights = (0..count)
-            .map(|i| {
-                let row = (i % 2) as f32;
-                let along = ((i / 2) as f32 + 0.5) / count.div_ceil(2) as f32;
-                let jitter = |k: u32| hash01(i as u32 * 4 + k) - 0.5;
-                let mut p = [0.0; 3];
-                p[long] = min[long] + extent[long] * (0.05 + 0.9 * along + 0.02 * jitter(0));
-                p[short] = min[short] + extent[short] * (0.3 + 0.4 * row + 0.05 * jitter(1));
-                p[1] = min[1] + extent[1] * (0.2 + 0.1 * jitter(2));
-                let warm = hash01(i as u32 * 4 + 3);
-                PointLight {
-                    position: p,
-                    range: 0.25 * extent[long].max(extent[short]),
-                    color: [1.0, 0.55 + 0.35 * warm, 0.25 + 0.6 * (1.0 - warm)],
-                    intensity: 2.0,
-                }
-            })
-            .collect();
-        let center = Vec3::from(bounds.center());
-        let radius = (0.5 * bounds.diagonal()).max(1e-3);
-        let distance = 3.0 * bounds.diagonal().max(1e-3);
-        let eye = center + distance * normalize(Vec3::new(0.3, 1.0, 0.2));
-        let fov = 2.0 * (radius / distance).asin().to_degrees() * 1.02;
-        let camera = Camera::look_at(eye.to_array(), center.to_array(), fov);
-        let sun = Sun { camera, color: [3.0, 2.85, 2.6], size: 0.03 * distance };
-        LightRig { lights, sun }
+        LightRig { lights: row_lights(bounds, count), sun: sun_for(bounds) }
+    }
+
+    /// A rig for a scene at any world scale: the lights laid out by
+    /// `layout`, their intensities scaled by one factor so that the
+    /// layout's reference point ([`Layout::reference_point`]) gets the
+    /// summed light ([`light_sum`]) that the centre of Sponza's floor gets
+    /// from [`LightRig::for_bounds`]'s rig; the sun as that rig's (its light
+    /// does not fall off, and its size and distance follow the bounds).
+    pub fn scaled(bounds: &Bounds, count: usize, layout: Layout) -> LightRig {
+        let mut lights = match layout {
+            Layout::Rows => row_lights(bounds, count),
+            Layout::Around => ring_lights(bounds, count),
+        };
+        let reference =
+            light_sum(&row_lights(&REFERENCE_BOUNDS, count), Layout::Rows.reference_point(&REFERENCE_BOUNDS));
+        let here = light_sum(&lights, layout.reference_point(bounds));
+        if here > 0.0 && reference > 0.0 {
+            for light in &mut lights {
+                light.intensity *= reference / here;
+            }
+        }
+        LightRig { lights, sun: sun_for(bounds) }
+    }
+
+    /// Raises every light that is less than `clearance` above the highest
+    /// of `positions` within `radius` of it horizontally to that height
+    /// (lights laid out over uneven ground, such as a race track's hills,
+    /// would otherwise stand in them).
+    pub fn lift_over(&mut self, positions: &[[f32; 3]], radius: f32, clearance: f32) {
+        for light in &mut self.lights {
+            let [x, _, z] = light.position;
+            let ground = positions
+                .iter()
+                .filter(|p| (p[0] - x).powi(2) + (p[2] - z).powi(2) <= radius * radius)
+                .map(|p| p[1])
+                .fold(f32::NEG_INFINITY, f32::max);
+            if ground.is_finite() {
+                light.position[1] = light.position[1].max(ground + clearance);
+            }
+        }
     }
 
     /// The sun's world → clip matrix, column-major (16 values): `clip.xy /
@@ -226,6 +226,131 @@ impl LightRig {
     pub fn sun_distance(&self, p: [f32; 3]) -> f32 {
         Vec3::from(p).distance(Vec3::from(self.sun.camera.eye))
     }
+}
+
+/// How [`LightRig::scaled`] places the point lights.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Layout {
+    /// Two rows over the floor, as [`LightRig::for_bounds`]: for scenes seen
+    /// from inside (a building, a city, a race track).
+    Rows,
+    /// Two rings around the bounding sphere, each light reaching across it:
+    /// for a lone object seen from outside.
+    Around,
+}
+
+impl Layout {
+    /// The distance from a light to the nearest surface the layout puts it
+    /// over: a fifth of the height for [`Layout::Rows`] (their height above
+    /// the floor), 0.6 of the bounding sphere's radius for [`Layout::Around`].
+    pub fn clearance(self, bounds: &Bounds) -> f32 {
+        match self {
+            Layout::Rows => 0.2 * bounds.extent()[1],
+            Layout::Around => 0.6 * 0.5 * bounds.diagonal(),
+        }
+    }
+
+    /// Where [`LightRig::scaled`] matches the light to Sponza's: the centre
+    /// of the floor for [`Layout::Rows`], the centre of the bounds for
+    /// [`Layout::Around`].
+    pub fn reference_point(self, bounds: &Bounds) -> [f32; 3] {
+        let [x, y, z] = bounds.center();
+        match self {
+            Layout::Rows => [x, bounds.min[1], z],
+            Layout::Around => [x, y, z],
+        }
+    }
+}
+
+/// About the Dabrovic Sponza's bounds (docs/scenes.md): the scene whose rig
+/// [`LightRig::scaled`] matches.
+pub const REFERENCE_BOUNDS: Bounds = Bounds { min: [-17.4, -1.0, -7.8], max: [17.4, 15.6, 7.8] };
+
+/// The lights' summed strength at `p` under the falloff of
+/// `examples/sponza_lights.mrsl` (intensity · window(d / range) / (d² + 1),
+/// no cosine). Its `+ 1` is a world unit: the same rig at a hundred times
+/// Sponza's size would light its floor some 10⁴ times less, and at a
+/// hundredth of it, where the falloff is flat, some ten times more, which is
+/// what [`LightRig::scaled`] corrects.
+pub fn light_sum(lights: &[PointLight], p: [f32; 3]) -> f32 {
+    lights
+        .iter()
+        .map(|l| {
+            let d = Vec3::from(l.position).distance(Vec3::from(p));
+            let window = (1.0 - (d / l.range).powi(4)).max(0.0).powi(2);
+            l.intensity * window / (d * d + 1.0)
+        })
+        .sum()
+}
+
+/// [`LightRig::for_bounds`]'s lights: two rows along the longer horizontal axis.
+fn row_lights(bounds: &Bounds, count: usize) -> Vec<PointLight> {
+    let (min, extent) = (bounds.min, bounds.extent());
+    // Long axis: x or z, whichever is longer; rows are offset along the other.
+    let (long, short) = if extent[0] >= extent[2] { (0, 2) } else { (2, 0) };
+    (0..count)
+        .map(|i| {
+            let row = (i % 2) as f32;
+            let along = ((i / 2) as f32 + 0.5) / count.div_ceil(2) as f32;
+            let jitter = |k: u32| hash01(i as u32 * 4 + k) - 0.5;
+            let mut p = [0.0; 3];
+            p[long] = min[long] + extent[long] * (0.05 + 0.9 * along + 0.02 * jitter(0));
+            p[short] = min[short] + extent[short] * (0.3 + 0.4 * row + 0.05 * jitter(1));
+            p[1] = min[1] + extent[1] * (0.2 + 0.1 * jitter(2));
+            PointLight {
+                position: p,
+                range: 0.25 * extent[long].max(extent[short]),
+                color: light_color(i),
+                intensity: 2.0,
+            }
+        })
+        .collect()
+}
+
+/// Warm to cool, by a fixed hash of the light's number.
+fn light_color(i: usize) -> [f32; 3] {
+    let warm = hash01(i as u32 * 4 + 3);
+    [1.0, 0.55 + 0.35 * warm, 0.25 + 0.6 * (1.0 - warm)]
+}
+
+/// [`Layout::Around`]: two rings of lights around the bounding sphere (of
+/// radius r), 1.6 r from its centre, one half above the centre (0.7 r) and
+/// one a little below (0.2 r), the lower ring turned by half a step; each
+/// light reaches 3 r, across the whole object.
+fn ring_lights(bounds: &Bounds, count: usize) -> Vec<PointLight> {
+    let centre = Vec3::from(bounds.center());
+    let radius = (0.5 * bounds.diagonal()).max(1e-6);
+    let per_ring = count.div_ceil(2).max(1) as f32;
+    (0..count)
+        .map(|i| {
+            let ring = (i % 2) as f32;
+            let jitter = |k: u32| hash01(i as u32 * 4 + k) - 0.5;
+            let angle = std::f32::consts::TAU * (((i / 2) as f32 + 0.5 * ring + 0.1 * jitter(0)) / per_ring);
+            let height = if ring == 0.0 { 0.7 } else { -0.2 } + 0.05 * jitter(1);
+            let p = centre + radius * Vec3::new(1.6 * angle.cos(), height, 1.6 * angle.sin());
+            PointLight { position: p.to_array(), range: 3.0 * radius, color: light_color(i), intensity: 2.0 }
+        })
+        .collect()
+}
+
+/// [`LightRig::for_bounds`]'s sun direction (towards the sun).
+pub const SUN_DIRECTION: [f32; 3] = [0.3, 1.0, 0.2];
+
+/// [`LightRig::for_bounds`]'s sun: towards [`SUN_DIRECTION`] (see [`sun_towards`]).
+fn sun_for(bounds: &Bounds) -> Sun {
+    sun_towards(bounds, SUN_DIRECTION)
+}
+
+/// A sun three diagonals from the centre of `bounds` towards `direction`,
+/// its view just covering the bounding sphere, 3% of its distance wide.
+pub fn sun_towards(bounds: &Bounds, direction: [f32; 3]) -> Sun {
+    let center = Vec3::from(bounds.center());
+    let radius = (0.5 * bounds.diagonal()).max(1e-3);
+    let distance = 3.0 * bounds.diagonal().max(1e-3);
+    let eye = center + distance * normalize(Vec3::from(direction));
+    let fov = 2.0 * (radius / distance).asin().to_degrees() * 1.02;
+    let camera = Camera::look_at(eye.to_array(), center.to_array(), fov);
+    Sun { camera, color: [3.0, 2.85, 2.6], size: 0.03 * distance }
 }
 
 /// Why the rig's uniforms could not be set.

@@ -9,18 +9,22 @@
 //! `roughness` and `metallic` (floats in [0, 1]), and `velocity` (float2,
 //! the screen-space motion in pixels: 0 here, where the camera never moves).
 //!
-//! [`Scene::Sponza`] is a real model, rasterised on the GPU by
-//! [`crate::raster`]: build it with [`Scene::render_on`] or
-//! [`Scene::textures_on`]. See docs/scenes.md.
+//! The mesh scenes ([`Scene::Sponza`], [`Scene::Dungeon`],
+//! [`Scene::Outdoor`], [`Scene::Small`], [`Scene::Generated`]: the
+//! benchmark suite) are rasterised on the GPU by [`crate::raster`]: build
+//! them with [`Scene::render_on`] or [`Scene::textures_on`]. See
+//! docs/scenes.md.
 
 use crate::camera::Camera;
 use crate::camera_path::CameraPath;
 pub use crate::gbuffer::{BACKGROUND, ChannelData, GBuffer};
 use crate::gpu::Gpu;
-use crate::mesh::MeshError;
+use crate::mesh::{Mesh, MeshError};
 use crate::mesh_scene::MeshScene;
 use crate::raster::RasterError;
+use crate::rig::{DEFAULT_LIGHTS, Layout, LightRig};
 use glam::Vec3;
+use std::sync::Arc;
 
 // Sponza's default camera (see `Scene::sponza_camera`).
 const SPONZA_EYE: [f32; 3] = [-11.5, 2.2, -0.3];
@@ -31,6 +35,27 @@ const SPONZA_FOV: f32 = 60.0;
 const DUNGEON_EYE: [f32; 3] = [-8.0, 3.0, 10.0];
 const DUNGEON_TARGET: [f32; 3] = [15.0, 0.5, -4.0];
 const DUNGEON_FOV: f32 = 60.0;
+
+// The outdoor scene's default camera (see `Scene::outdoor_camera`).
+const OUTDOOR_EYE: [f32; 3] = [340.6, 7.1, -899.0];
+const OUTDOOR_TARGET: [f32; 3] = [540.4, 9.1, -897.3];
+const OUTDOOR_FOV: f32 = 60.0;
+// Towards its sun: lower than the other scenes' (44 degrees up), on the
+// grandstand's side of the straight, so that shadows fall across the road.
+const OUTDOOR_SUN: [f32; 3] = [0.5, 0.45, 0.7];
+
+// The small scene's default camera (see `Scene::small_camera`).
+const SMALL_EYE: [f32; 3] = [0.294, 0.191, 0.258];
+const SMALL_TARGET: [f32; 3] = [0.042, 0.015, 0.006];
+const SMALL_FOV: f32 = 40.0;
+
+// The generated scene's default camera (see `Scene::generated_camera`).
+const GENERATED_EYE: [f32; 3] = [-60.0, 12.0, -1300.0];
+const GENERATED_TARGET: [f32; 3] = [-60.0, 110.0, 0.0];
+const GENERATED_FOV: f32 = 60.0;
+// Towards its sun: low (30 degrees up) and ahead of the camera, so that the
+// facades it sees are lit and the towers cast long shadows.
+const GENERATED_SUN: [f32; 3] = [0.35, 0.5, -0.8];
 
 /// Which synthetic scene to make.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -50,6 +75,19 @@ pub enum Scene {
     /// and normal maps), rasterised on the GPU from [`Scene::dungeon_camera`];
     /// fetched by `scripts/fetch-dungeon.sh` (see docs/scenes.md).
     Dungeon,
+    /// An outdoor scene with a large sky: TORCS's "forza" race track
+    /// (2.5 km, 129 textured materials, alpha-tested trees), seen from
+    /// above the road ([`Scene::outdoor_camera`]); fetched by
+    /// `scripts/fetch-outdoor.sh`.
+    Outdoor,
+    /// A small object: link 6 of the Franka Panda robot arm, 18 cm long,
+    /// at its native scale against the background ([`Scene::small_camera`]);
+    /// fetched by `scripts/fetch-small.sh`.
+    Small,
+    /// A generated city of towers and spheres, kilometres across
+    /// ([`crate::procedural`], nothing to fetch), seen from above its edge
+    /// ([`Scene::generated_camera`]).
+    Generated,
 }
 
 /// Why a scene could not be built.
@@ -79,16 +117,23 @@ impl Scene {
             }
             ("sponza", []) => Scene::Sponza,
             ("dungeon", []) => Scene::Dungeon,
+            ("outdoor", []) => Scene::Outdoor,
+            ("small", []) => Scene::Small,
+            ("generated", []) => Scene::Generated,
             _ => return None,
         })
     }
 
     /// The names [`Scene::parse`] accepts.
-    pub const NAMES: [&str; 6] = ["demo", "gradient", "steps", "sinusoid", "sponza", "dungeon"];
+    pub const NAMES: [&str; 9] =
+        ["demo", "gradient", "steps", "sinusoid", "sponza", "dungeon", "outdoor", "small", "generated"];
+
+    /// The mesh scenes of the benchmark suite (docs/scenes.md, "The suite").
+    pub const SUITE: [Scene; 5] = [Scene::Sponza, Scene::Dungeon, Scene::Outdoor, Scene::Small, Scene::Generated];
 
     /// Whether the scene is rasterised on the GPU (and so needs [`Scene::render_on`]).
     pub fn needs_gpu(self) -> bool {
-        matches!(self, Scene::Sponza | Scene::Dungeon)
+        Scene::SUITE.contains(&self)
     }
 
     /// The camera the scene is seen from, for scenes that have a free one
@@ -97,6 +142,9 @@ impl Scene {
         match self {
             Scene::Sponza => Some(Scene::sponza_camera()),
             Scene::Dungeon => Some(Scene::dungeon_camera()),
+            Scene::Outdoor => Some(Scene::outdoor_camera()),
+            Scene::Small => Some(Scene::small_camera()),
+            Scene::Generated => Some(Scene::generated_camera()),
             _ => None,
         }
     }
@@ -122,31 +170,73 @@ impl Scene {
         Camera { eye: DUNGEON_EYE, target: DUNGEON_TARGET, up: [0.0, 1.0, 0.0], fov_y_degrees: DUNGEON_FOV }
     }
 
+    /// The outdoor scene's default camera (see docs/scenes.md, "Outdoor").
+    pub fn outdoor_camera() -> Camera {
+        Camera { eye: OUTDOOR_EYE, target: OUTDOOR_TARGET, up: [0.0, 1.0, 0.0], fov_y_degrees: OUTDOOR_FOV }
+    }
+
+    /// The small scene's default camera (see docs/scenes.md, "Small").
+    pub fn small_camera() -> Camera {
+        Camera { eye: SMALL_EYE, target: SMALL_TARGET, up: [0.0, 1.0, 0.0], fov_y_degrees: SMALL_FOV }
+    }
+
+    /// The generated scene's default camera (see docs/scenes.md, "Generated").
+    pub fn generated_camera() -> Camera {
+        Camera { eye: GENERATED_EYE, target: GENERATED_TARGET, up: [0.0, 1.0, 0.0], fov_y_degrees: GENERATED_FOV }
+    }
+
     /// The G-buffer on `gpu`: rasterised for the mesh scenes, made on the
     /// CPU (as [`Scene::render`]) for the others.
     pub fn render_on(self, gpu: &Gpu, width: u32, height: u32) -> Result<GBuffer, SceneError> {
+        if self.needs_gpu() {
+            Ok(crate::raster::read_gbuffer(gpu, &self.textures_on(gpu, width, height)?)?)
+        } else {
+            Ok(self.render(width, height))
+        }
+    }
+
+    /// The mesh scene's mesh (loaded once per process and shared), or
+    /// `None` for the scenes made on the CPU. A fetched model that is not
+    /// there is [`MeshError::DungeonNotFound`], [`MeshError::OutdoorNotFound`]
+    /// or [`MeshError::SmallNotFound`], which name the script that fetches it.
+    pub fn mesh(self) -> Result<Option<Arc<Mesh>>, MeshError> {
+        Ok(Some(match self {
+            Scene::Sponza => crate::fixtures::sponza_shared()?,
+            Scene::Dungeon => crate::fixtures::dungeon_shared()?,
+            Scene::Outdoor => crate::fixtures::outdoor_shared()?,
+            Scene::Small => crate::fixtures::small_shared()?,
+            Scene::Generated => crate::fixtures::generated_shared()?,
+            _ => return Ok(None),
+        }))
+    }
+
+    /// The light rig of a mesh scene `mesh` with `bounds`: Sponza's and the
+    /// dungeon's as [`LightRig::for_bounds`] makes it; the other scenes'
+    /// scaled to their size ([`LightRig::scaled`]): in rows over the city, under a low sun;
+    /// in rows over the track, each light raised to its clearance above the
+    /// ground within 50 m, under a lower sun; around the small object.
+    pub fn rig(self, mesh: &Mesh, bounds: &crate::mesh::Bounds) -> LightRig {
         match self {
-            Scene::Sponza | Scene::Dungeon => {
-                Ok(crate::raster::read_gbuffer(gpu, &self.textures_on(gpu, width, height)?)?)
+            Scene::Small => LightRig::scaled(bounds, DEFAULT_LIGHTS, Layout::Around),
+            Scene::Outdoor => {
+                let mut rig = LightRig::scaled(bounds, DEFAULT_LIGHTS, Layout::Rows);
+                rig.lift_over(&mesh.positions, 50.0, Layout::Rows.clearance(bounds));
+                rig.sun = crate::rig::sun_towards(bounds, OUTDOOR_SUN);
+                rig
             }
-            _ => Ok(self.render(width, height)),
+            Scene::Generated => LightRig {
+                sun: crate::rig::sun_towards(bounds, GENERATED_SUN),
+                ..LightRig::scaled(bounds, DEFAULT_LIGHTS, Layout::Rows)
+            },
+            _ => LightRig::for_bounds(bounds, DEFAULT_LIGHTS),
         }
     }
 
     /// The mesh scenes' mesh on `gpu`, with camera and light rig; `None` for
     /// the scenes made on the CPU.
     pub fn mesh_scene(self, gpu: &Gpu) -> Result<Option<MeshScene>, SceneError> {
-        match self {
-            Scene::Sponza => {
-                let mesh = crate::fixtures::sponza_shared()?;
-                Ok(Some(MeshScene::new(gpu, &mesh, Scene::sponza_camera())?))
-            }
-            Scene::Dungeon => {
-                let mesh = crate::fixtures::dungeon_shared()?;
-                Ok(Some(MeshScene::new(gpu, &mesh, Scene::dungeon_camera())?))
-            }
-            _ => Ok(None),
-        }
+        let (Some(mesh), Some(camera)) = (self.mesh()?, self.camera()) else { return Ok(None) };
+        Ok(Some(MeshScene::with_rig(gpu, &mesh, camera, |bounds| self.rig(&mesh, bounds))?))
     }
 
     /// The G-buffer as textures on `gpu` (the formats of [`GBuffer::upload`]):
@@ -168,7 +258,7 @@ impl Scene {
     /// [`Scene::render_on`] to get those failures as errors.
     pub fn render(self, width: u32, height: u32) -> GBuffer {
         match self {
-            Scene::Sponza | Scene::Dungeon => {
+            Scene::Sponza | Scene::Dungeon | Scene::Outdoor | Scene::Small | Scene::Generated => {
                 let gpu = Gpu::new().unwrap_or_else(|e| panic!("the mesh scenes need a GPU adapter: {e}"));
                 self.render_on(&gpu, width, height).unwrap_or_else(|e| panic!("cannot render the {self:?} scene: {e}"))
             }

@@ -1,7 +1,7 @@
 //! Triangle meshes for the G-buffer rasteriser, one concern a module:
 //! loaders for Wavefront OBJ ([`obj`], through `tobj`, with its MTL
-//! materials in [`mtl`]) and glTF 2.0 / GLB ([`gltf`], through the `gltf`
-//! crate), smooth normals with a crease angle for models that have none
+//! materials in [`mtl`]), glTF 2.0 / GLB ([`gltf`], through the `gltf`
+//! crate) and AC3D text, TORCS's `.acc` included ([`ac3d`], hand-written), smooth normals with a crease angle for models that have none
 //! ([`normals`]) and MikkTSpace tangents for normal maps ([`tangents`]).
 //! The test models (the Dabrovic Sponza, the dungeon) are found and shared
 //! by [`crate::fixtures`].
@@ -20,6 +20,7 @@
 //! read and material features that are not supported become
 //! [`MeshWarning`]s in `Mesh::warnings`, which the tools print once.
 
+mod ac3d;
 mod gltf;
 mod mtl;
 mod normals;
@@ -30,6 +31,8 @@ use std::path::{Path, PathBuf};
 
 use crate::material::Material;
 use glam::Vec3;
+
+pub use ac3d::{SURF_DOUBLE_SIDED, SURF_SHADED, TORCS_ALPHA_CUTOFF};
 
 /// Default crease angle (degrees) for computed normals: faces meeting at a
 /// sharper angle keep their own normal, so boxes stay boxes while Sponza's
@@ -49,7 +52,9 @@ pub enum MeshError {
     Obj { path: PathBuf, message: String },
     #[error("{}: not a valid glTF file: {message}", path.display())]
     Gltf { path: PathBuf, message: String },
-    #[error("{}: unsupported mesh format (expected .obj, .gltf or .glb)", path.display())]
+    #[error("{}:{line}: not a valid AC3D file: {message}", path.display())]
+    Ac3d { path: PathBuf, line: usize, message: String },
+    #[error("{}: unsupported mesh format (expected .obj, .gltf, .glb, .ac or .acc)", path.display())]
     UnsupportedFormat { path: PathBuf },
     #[error("{}: the file has no triangles", path.display())]
     Empty { path: PathBuf },
@@ -66,6 +71,18 @@ pub enum MeshError {
         searched.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
     )]
     DungeonNotFound { searched: Vec<PathBuf> },
+    #[error(
+        "the outdoor scene (forza.acc, TORCS's \"forza\" track from Debian's torcs-data package) was not found; \
+         run scripts/fetch-outdoor.sh in the workspace, or set MRSL_OUTDOOR to the file. Looked at: {}",
+        searched.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+    )]
+    OutdoorNotFound { searched: Vec<PathBuf> },
+    #[error(
+        "the small scene (link6.obj, the Franka Panda arm's link 6 from the PyPI package pybullet) was not found; \
+         run scripts/fetch-small.sh in the workspace, or set MRSL_SMALL to the file. Looked at: {}",
+        searched.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+    )]
+    SmallNotFound { searched: Vec<PathBuf> },
     #[error("invalid mesh: {0}")]
     Invalid(String),
 }
@@ -141,6 +158,11 @@ pub enum MeshWarning {
     /// Tangents could not be generated for a normal-mapped material (its
     /// normal map is then not applied where they are missing).
     Tangents { message: String },
+    /// Parts of the file that are not triangles (AC3D lines) were left out.
+    Skipped { count: usize, what: String },
+    /// The file ended before some of the child objects it declares (AC3D
+    /// `kids`); the objects before were read.
+    MissingObjects { count: usize },
 }
 
 impl std::fmt::Display for MeshWarning {
@@ -164,17 +186,22 @@ impl std::fmt::Display for MeshWarning {
                 write!(f, "material `{material}`: {feature} is not supported and is ignored")
             }
             MeshWarning::Tangents { message } => write!(f, "tangents: {message}"),
+            MeshWarning::Skipped { count, what } => write!(f, "{count} {what} left out"),
+            MeshWarning::MissingObjects { count } => {
+                write!(f, "the file ends before {count} of the child objects it declares; the objects before are kept")
+            }
         }
     }
 }
 
 impl Mesh {
-    /// Loads an `.obj`, `.gltf` or `.glb` file (by extension, case-insensitive).
+    /// Loads an `.obj`, `.gltf`, `.glb`, `.ac` or `.acc` file (by extension, case-insensitive).
     pub fn load(path: impl AsRef<Path>) -> Result<Mesh, MeshError> {
         let path = path.as_ref();
         match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
             Some("obj") => Mesh::load_obj(path),
             Some("gltf" | "glb") => Mesh::load_gltf(path),
+            Some("ac" | "acc") => Mesh::load_ac3d(path),
             _ => Err(MeshError::UnsupportedFormat { path: path.to_path_buf() }),
         }
     }

@@ -193,7 +193,7 @@ fn single_indexed(m: &tobj::Mesh, material: u32) -> (Mesh, bool, usize) {
 /// Triangulates one polygon (vertex indices in order) by ear clipping in the
 /// plane of its Newell normal, appending triangles with the polygon's
 /// winding. Falls back to a fan where the polygon is degenerate.
-fn triangulate(positions: &[[f32; 3]], polygon: &[u32], out: &mut Vec<u32>) {
+pub(super) fn triangulate(positions: &[[f32; 3]], polygon: &[u32], out: &mut Vec<u32>) {
     let n = polygon.len();
     if n == 3 {
         out.extend_from_slice(polygon);
