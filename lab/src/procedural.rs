@@ -231,7 +231,9 @@ fn sphere(mesh: &mut Mesh, centre: Vec3, radius: f32, dome: bool, material: u32)
         let theta = std::f32::consts::PI * r as f32 / 16.0;
         for s in 0..=segments {
             let phi = std::f32::consts::TAU * s as f32 / segments as f32;
-            let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            // The equator exactly at the centre's height (a dome's rim on the ground).
+            let y = if 2 * r == 16 { 0.0 } else { theta.cos() };
+            let n = Vec3::new(theta.sin() * phi.cos(), y, theta.sin() * phi.sin());
             mesh.positions.push((centre + radius * n).to_array());
             mesh.normals.push(n.to_array());
             mesh.uvs.push([s as f32 / segments as f32, r as f32 / 16.0]);

@@ -18,6 +18,7 @@ mod rate_image;
 mod rate_source;
 mod second_driver;
 mod sponza;
+mod suite_scenes;
 mod textures;
 
 pub use harness::*;
@@ -111,6 +112,10 @@ const GPU_TESTS: &[GpuTest] = &[
     ),
     ("rate_image::coarser_rates_shade_less", rate_image::coarser_rates_shade_less),
     ("rate_image::bad_shading_rate_images_are_typed_errors", rate_image::bad_shading_rate_images_are_typed_errors),
+    (
+        "suite_scenes::generated_scene_workload_matches_its_reference",
+        suite_scenes::generated_scene_workload_matches_its_reference,
+    ),
 ];
 
 /// Tests that run on the CPU only.
@@ -126,6 +131,9 @@ const CPU_TESTS: &[(&str, fn())] = &[
     ("sponza::gltf_and_glb_written_to_a_temp_dir_load", sponza::gltf_and_glb_written_to_a_temp_dir_load),
     ("sponza::bad_mesh_files_are_typed_errors", sponza::bad_mesh_files_are_typed_errors),
     ("textures::loaders_report_what_they_skip", textures::loaders_report_what_they_skip),
+    ("suite_scenes::scaled_rigs_keep_sponzas_light_level", suite_scenes::scaled_rigs_keep_sponzas_light_level),
+    ("suite_scenes::ac3d_written_to_a_temp_dir_loads", suite_scenes::ac3d_written_to_a_temp_dir_loads),
+    ("suite_scenes::bad_ac3d_files_are_typed_errors", suite_scenes::bad_ac3d_files_are_typed_errors),
 ];
 
 /// GPU tests over the textured dungeon, which is fetched separately
@@ -143,7 +151,9 @@ fn main() {
     if std::env::var_os(second_driver::SUBSET_VARIABLE).is_some() {
         return second_driver_subset(&args);
     }
-    let gpu = harness::gpu(GPU_TESTS.len() + rate_source::GPU_TESTS.len() + DUNGEON_TESTS.len());
+    let gpu = harness::gpu(
+        GPU_TESTS.len() + rate_source::GPU_TESTS.len() + DUNGEON_TESTS.len() + suite_scenes::FIXTURE_TESTS.len(),
+    );
     let dungeon = mrsl_lab::fixtures::dungeon_path();
     if let (Some(_), Err(e)) = (gpu, &dungeon) {
         println!("SKIPPING {} render test(s) over the dungeon (reported as ignored below): {e}", DUNGEON_TESTS.len());
@@ -166,6 +176,8 @@ fn main() {
         }),
         _ => Trial::test(name, || Ok(())).with_ignored_flag(true),
     }));
+    // The outdoor and small scenes' tests, fetched separately as the dungeon is.
+    trials.extend(suite_scenes::fixture_trials(gpu));
     trials.extend(CPU_TESTS.iter().map(|&(name, test)| {
         Trial::test(name, move || {
             test();
