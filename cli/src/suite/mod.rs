@@ -13,7 +13,7 @@ mod report;
 
 use crate::ablation::refining_nothing;
 use crate::setup::{Resources, WORKLOAD_PROGRAM, bind_scene, compile_program};
-use crate::timing::{median, paired, time_run};
+use crate::timing::{median, paired, time_run, warm_up};
 use anyhow::{Context, Result, anyhow, bail};
 use mrsl_abi::shading_rate::DEFAULT_RATE_TILE;
 use mrsl_lab::gpu::Gpu;
@@ -212,6 +212,7 @@ fn measure_scene(
     let reference_options = DispatchOptions::new(Mode::Reference);
     time_run(gpu, &mut shader, &bindings, reference_options)?;
     let reference = gpu.read_rgba32f(first_output)?;
+    warm_up(|| time_run(gpu, &mut shader, &bindings, reference_options.uninstrumented()))?;
     let reference_walls: Vec<f64> = (0..runs)
         .map(|_| time_run(gpu, &mut shader, &bindings, reference_options.uninstrumented()))
         .collect::<Result<_>>()?;
