@@ -29,10 +29,10 @@ pub fn time_run(gpu: &Gpu, shader: &mut Shader, bindings: &Bindings, options: Di
 
 /// Runs `time` until the device is warm: at least [`WARM_UP_MIN`] runs,
 /// then until two consecutive runs agree within 10%, at most
-/// [`WARM_UP_MAX`]. On lavapipe the first seconds after a scene is loaded
-/// run at about half speed (measured: the reference at 960x540 took 340 ms
-/// for its first six runs, then 175-180 ms), which one warm-up run does not
-/// cover and which would weigh on the first mode measured.
+/// [`WARM_UP_MAX`]. The first runs after a scene is loaded can be slow
+/// (once measured on lavapipe: the reference at 960x540 took 340 ms for
+/// six runs, then 175-180 ms), which one warm-up run does not cover and
+/// which would weigh on the first mode measured.
 pub fn warm_up(mut time: impl FnMut() -> Result<f64>) -> Result<()> {
     let mut last = time()?;
     for run in 1..WARM_UP_MAX {
