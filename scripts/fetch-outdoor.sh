@@ -1,7 +1,7 @@
 #!/bin/sh
 # Fetches the `outdoor` scene (see docs/scenes.md, "Outdoor"): the "forza"
 # road course of the racing game TORCS, from Debian's torcs-data package
-# (version 1.3.7+dfsg-5, about 333 MB to download, 21 MB kept), into $1,
+# (version 1.3.7+dfsg-5, 333 MB to download, 20 MB kept), into $1,
 # else $XDG_DATA_HOME/mrsl/torcs-forza (default
 # ~/.local/share/mrsl/torcs-forza), where mrslc and the tests find it.
 # Only the track's model (forza.acc), its textures and its readme (the

@@ -1,7 +1,7 @@
 //! Scene files: a mesh, a camera, an image size and uniform values, in TOML.
 //!
 //! ```toml
-//! mesh = "sponza"              # or a path to .obj, .gltf or .glb, relative to this file
+//! mesh = "sponza"              # or a path to .obj, .gltf, .glb, .ac or .acc, relative to this file
 //! size = [960, 540]            # optional: the image size (`mrslc render --size` wins)
 //! crease_angle = 45            # optional: degrees, for models without normals
 //!
@@ -171,7 +171,12 @@ impl SceneFile {
             }
         }
         let mesh = match table.get("mesh") {
-            None => return Err(key_error("mesh", "missing: name a .obj, .gltf or .glb file, or \"sponza\"".into())),
+            None => {
+                return Err(key_error(
+                    "mesh",
+                    "missing: name a .obj, .gltf, .glb, .ac or .acc file, or \"sponza\"".into(),
+                ));
+            }
             Some(toml::Value::String(s)) if s == "sponza" => MeshSource::Sponza,
             Some(toml::Value::String(s)) => {
                 let base = path.parent().unwrap_or(Path::new(""));
