@@ -36,7 +36,8 @@ pub const SURF_SHADED: u32 = 0x10;
 /// is drawn with alpha testing at [`TORCS_ALPHA_CUTOFF`] (its trees, bushes
 /// and fences); every other texture is opaque.
 const TORCS_MASKED: [&str; 3] = ["tree", "trans-", "arbor"];
-/// TORCS's alpha cut-off for the textures of [`TORCS_MASKED`].
+/// TORCS's alpha cut-off for its foliage: base textures whose names contain
+/// `tree`, `trans-` or `arbor`.
 pub const TORCS_ALPHA_CUTOFF: f32 = 0.65;
 
 /// Deepest object hierarchy read (deeper is an error, not a stack overflow).
