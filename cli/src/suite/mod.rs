@@ -25,7 +25,8 @@ use serde::Serialize;
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// The scenes `--suite` runs unless `--scene` names others.
+/// The scenes `--suite` runs unless `--scene` names others: the names of
+/// `mrsl_lab::scene::Scene::SUITE`.
 pub const SUITE: [&str; 5] = ["sponza", "dungeon", "outdoor", "small", "generated"];
 
 pub struct SuiteArgs {
@@ -224,7 +225,17 @@ fn measure_scene(
             continue;
         }
         let floor = floors.iter_mut().find(|(b, _)| Some(*b) == floor_block(mode)).map(|(_, s)| s);
+        let at = Instant::now();
         let (run, background_pixels) = bound.measure_mode(mode, floor)?;
+        eprintln!(
+            "suite: {scene_name} {}x{} {mode}: {:.2}x, MSSIM {:.4}, forced {:.2} ({:.0} s)",
+            size.0,
+            size.1,
+            run.speedup,
+            run.metrics.mssim,
+            run.forced_ratio,
+            at.elapsed().as_secs_f64()
+        );
         background = background.max(background_pixels);
         modes.push(run);
     }
@@ -325,5 +336,16 @@ impl Bound<'_> {
             _ => time_run(gpu, floor, bindings, o),
         })?;
         Ok(median(p.ratios))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_suite_is_the_labs() {
+        let scenes: Vec<Scene> = SUITE.iter().map(|name| Scene::parse(name).unwrap()).collect();
+        assert_eq!(scenes, Scene::SUITE);
     }
 }
