@@ -34,7 +34,6 @@ const WELL_KNOWN_UNIFORMS: &[(&str, &str)] = &[
     ("ambient", "float"),
     ("blocker_edge", "float"),
     ("camera_pos", "float3"),
-    ("checker_scale", "float"),
     ("curvature_threshold", "float"),
     ("diffuse_threshold", "float"),
     ("light_count", "int"),
