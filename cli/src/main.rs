@@ -121,9 +121,10 @@ struct Bench {
     /// The controller's target shaded fraction.
     #[arg(long, default_value_t = 0.5)]
     target_fraction: f64,
-    /// Instead of the sweep: time the fine pass of the block mode given by
-    /// --modes (coarse4x4 unless given) with one part removed at a time,
-    /// paired with the full kernel, on the first scene (writes ablation.md).
+    /// Instead of the sweep: time the adaptive kernel of the mode given by
+    /// --modes (coarse2x2, coarse4x4 or hierarchical; coarse4x4 unless
+    /// given) with one part removed at a time, paired with the full kernel,
+    /// on the first scene (writes ablation.md).
     #[arg(long, conflicts_with = "suite")]
     ablation: bool,
     /// Instead of the sweep: every mode at its defaults over the scene suite
@@ -348,7 +349,7 @@ fn bench(b: &Bench) -> Result<ExitCode> {
         let mode = match modes.as_slice() {
             [mode] => *mode,
             _ if modes == mrsl_runtime::Mode::ALL => mrsl_runtime::Mode::Coarse4x4,
-            _ => bail!("--ablation takes one block mode in --modes (coarse2x2 or coarse4x4)"),
+            _ => bail!("--ablation takes one mode in --modes (coarse2x2, coarse4x4 or hierarchical)"),
         };
         let args = ablation::AblationArgs {
             program: b.program.clone(),

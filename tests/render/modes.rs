@@ -339,9 +339,13 @@ pub fn hierarchical_interpolates_a_gradient_from_level_zero(gpu: &Gpu) {
     let err = max_abs_diff(&out.pixels, &reference.pixels);
     assert!(err <= 5e-7, "hierarchical gradient error {err}");
     let ramp = &out.stats.effects[0];
-    // Level 0 (64 x 64 pixels) plus the last two columns and rows, whose
-    // pixels lack one neighbour of every pair and so are shaded.
-    assert!(ramp.pixel_evaluations >= 64 * 64 && ramp.shaded_fraction <= 0.07, "{ramp:?}");
+    // Level 0 (64 x 64 pixels, 6.25%) plus the last two columns and rows,
+    // whose pixels lack one neighbour of every pair and so are shaded
+    // (0.6% more), plus the corner where the ramp is smallest (0.05): the
+    // variance test is relative to the values, and there the ramp changes
+    // by more than sqrt(similarity) = 3% of itself between neighbours two
+    // pixels apart (measured 7.4% in all).
+    assert!(ramp.pixel_evaluations >= 64 * 64 && ramp.shaded_fraction <= 0.08, "{ramp:?}");
     // The work-list counters (queue atomics) and the per-pixel statistics
     // (counted in the final pass from the records) are independent tallies of
     // the same pixels: everything shaded beyond level 0.

@@ -11,10 +11,11 @@
 
 mod report;
 
-use crate::ablation::refining_nothing;
+use crate::ablation::{refining_nothing, shading_nothing};
 use crate::setup::{Resources, WORKLOAD_PROGRAM, bind_scene, compile_program};
 use crate::timing::{median, paired, time_run, warm_up};
 use anyhow::{Context, Result, anyhow, bail};
+use mrsl_abi::CompiledProgram;
 use mrsl_abi::shading_rate::DEFAULT_RATE_TILE;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::metrics::Metrics;
@@ -74,7 +75,7 @@ pub struct ModeRun {
     pub efficiency: f64,
     /// Every predicate forced true: its time / the reference's.
     pub forced_ratio: f64,
-    /// The block modes with nothing refined (the fixed cost): time / the reference's.
+    /// With none of the adaptive work (block and hierarchical modes, the fixed cost): time / the reference's.
     pub floor_ratio: Option<f64>,
 }
 
@@ -206,8 +207,10 @@ fn measure_scene(
     }
     // The block modes' floors, made before the bindings borrow the scene.
     let mut floors = vec![];
-    for block in Mode::ALL.into_iter().filter_map(floor_block) {
-        floors.push((block, floor_shader(gpu, program, &mut scene, block)?));
+    for mode in Mode::ALL {
+        if let Some(floor) = floor_program(program, mode) {
+            floors.push((mode, floor_shader(gpu, &floor, &mut scene)?));
+        }
     }
     let bindings = resources.bindings(program, &scene.channels);
     let reference_options = DispatchOptions::new(Mode::Reference);
@@ -224,7 +227,7 @@ fn measure_scene(
             unsupported.push((mode, e.to_string()));
             continue;
         }
-        let floor = floors.iter_mut().find(|(b, _)| Some(*b) == floor_block(mode)).map(|(_, s)| s);
+        let floor = floors.iter_mut().find(|(m, _)| *m == mode).map(|(_, s)| s);
         let at = Instant::now();
         let (run, background_pixels) = bound.measure_mode(mode, floor)?;
         eprintln!(
@@ -251,27 +254,23 @@ fn measure_scene(
     })
 }
 
-/// The block size of the modes whose floor is measured: the block modes,
-/// whose fine kernel [`refining_nothing`] edits. (The other modes' kernels
-/// decide refinement in other places; their floors are not measured.)
-fn floor_block(mode: Mode) -> Option<u32> {
+/// The program with `mode` doing none of its adaptive work, where the
+/// suite measures a floor: the block modes' fine kernel refining nothing
+/// ([`refining_nothing`]), the hierarchical kernel shading nothing past
+/// level 0 ([`shading_nothing`]). (The other modes decide refinement in
+/// several kernels; their floors are not measured.)
+fn floor_program(program: &CompiledProgram, mode: Mode) -> Option<CompiledProgram> {
     match mode {
-        Mode::Coarse2x2 => Some(2),
-        Mode::Coarse4x4 => Some(4),
+        Mode::Coarse2x2 => refining_nothing(program, 2),
+        Mode::Coarse4x4 => refining_nothing(program, 4),
+        Mode::Hierarchical => shading_nothing(program),
         _ => None,
     }
 }
 
-/// The program with the block fine kernel of `block` refining nothing, on
-/// the scene's uniforms.
-fn floor_shader(
-    gpu: &Gpu,
-    program: &mrsl::Program,
-    scene: &mut crate::setup::BoundScene,
-    block: u32,
-) -> Result<Shader> {
-    let floor = refining_nothing(program, block).context("the block fine kernel has no refinement to remove")?;
-    let mut shader = Shader::new(&gpu.device, &floor)?;
+/// [`floor_program`]'s shader for `mode`, on the scene's uniforms.
+fn floor_shader(gpu: &Gpu, floor: &CompiledProgram, scene: &mut crate::setup::BoundScene) -> Result<Shader> {
+    let mut shader = Shader::new(&gpu.device, floor)?;
     scene.prepare(gpu, &mut shader)?;
     Ok(shader)
 }

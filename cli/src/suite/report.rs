@@ -20,8 +20,9 @@ pub fn markdown(suite: &Suite) -> String {
         "# mrsl scene suite\n\nProgram `{}`, every mode at its defaults (no per-scene tuning), on {} ({}, {}{}); \
          adapters present: {}. Each ratio is the median over {} pairs of a run of the mode and a run of the reference \
          beside it (alternately before and after); speedup = 1 / that ratio. Quality against the reference image of the \
-         same program. Efficiency = speedup x coarse shaded fraction. Forced: every predicate true. Floor: the block \
-         fine kernel with nothing refined (the fixed cost of the adaptive machinery). Took {:.0} s.\n",
+         same program. Efficiency = speedup x coarse shaded fraction. Forced: every predicate true. Floor: the fixed \
+         cost of the adaptive machinery (the block fine kernel with nothing refined; the hierarchical kernel shading \
+         nothing past level 0). Took {:.0} s.\n",
         suite.program,
         d.name,
         d.backend,

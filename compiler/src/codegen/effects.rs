@@ -579,10 +579,13 @@ impl<'b> Writer<'_, '_, 'b> {
     /// the pair's other position. That value equals what `mrsl_d<k>` would
     /// recompute there wherever the kernel's value of every effect at a
     /// position is what `mrsl_at_<effect>` computes there: in every kernel
-    /// but the record modes', whose pixels may hold an interpolated or
-    /// reconstructed value while their neighbour functions evaluate
-    /// (docs/language.md, section 9); there only an operand that reads no
-    /// effect is taken from the caller.
+    /// but the checkerboard's, whose pixels may hold a reconstructed value
+    /// while its neighbour functions evaluate; there only an operand that
+    /// reads no effect is taken from the caller. The hierarchical kernel
+    /// takes the pixel's own value (evaluated, or interpolated where the
+    /// pixel did not shade the effect) by definition (docs/language.md,
+    /// section 9): it saves an evaluation of the effect per difference, and
+    /// under forced refinement the value is the evaluated one.
     pub(super) fn reuses_operand_here(&self, k: usize) -> bool {
         match self.derivatives() {
             Derivatives::Here => true,
@@ -591,11 +594,7 @@ impl<'b> Writer<'_, '_, 'b> {
     }
 
     pub(super) fn derivatives(&self) -> Derivatives {
-        if matches!(self.kind, KernelKind::Hierarchical | KernelKind::Checkerboard) {
-            Derivatives::HereWithoutEffects
-        } else {
-            Derivatives::Here
-        }
+        if matches!(self.kind, KernelKind::Checkerboard) { Derivatives::HereWithoutEffects } else { Derivatives::Here }
     }
 
     /// Effects this kernel needs at other positions (for derivatives).

@@ -1,9 +1,10 @@
 //! The hierarchical (DACS) kernel: one module with every entry point of the
 //! mode, in dispatch order. Level 0 shades its lattice of pixels. Each
 //! classified level then decides, per pixel of its lattice and per coarse
-//! effect, whether the mean of its previous-level neighbours is good enough
-//! (no key discontinuity, no refine flag among them, small variance) or the
-//! pixel must be shaded; pixels to shade are compacted into the level's work
+//! effect, whether the mean of its previous-level neighbours on its side of
+//! every key the effect reads is good enough (at least two of them, no
+//! refine flag among them, a small variance relative to their values) or
+//! the pixel must be shaded; pixels to shade are compacted into the level's work
 //! list, whose count the `hier_args_*` entry point turns into the indirect
 //! dispatch of `hier_shade_*`. `hier_final` reads the records per pixel.
 //! The lattices, work-list capacities and queue layout are the runtime's
@@ -245,19 +246,18 @@ impl Writer<'_, '_, '_> {
         let c = self.checked();
         let iface = self.i.interface;
         let (fw, mw) = (self.i.layout.hierarchical.flag_words, self.i.layout.hierarchical.mask_words);
-        let [head, note, pairs, keys, end] =
-            cut(include_str!("templates/classify.wgsl"), &["IN_IMAGE", "PAIRS", "KEYS", "EFFECTS"]);
+        let [head, keys, effects, end] =
+            cut(include_str!("templates/classify.wgsl"), &["BACKGROUND", "KEYS", "EFFECTS"]);
         self.template(0, head, &[]);
         self.background_record(1);
-        self.neighbour_pairs("n", &[], note, ["pair_a", "pair_b"]);
-        self.template(0, pairs, &[]);
+        self.template(0, keys, &[]);
         for key in self.keys_of(&self.coarse_live()) {
             let name = key.name;
             let differs = key.differs(&format!("k_{name}"), &key.load("q[k]"));
             let values: &super::writer::Values = &[("NAME", &name), ("LOAD", &key.loader()), ("DIFFERS", &differs)];
             self.template(0, include_str!("templates/classify_key.wgsl"), values);
         }
-        self.template(0, keys, &[]);
+        self.template(0, effects, &[]);
         for w in 0..mw {
             self.line(1, format!("var mask{w} = 0u;"));
         }
@@ -265,8 +265,13 @@ impl Writer<'_, '_, '_> {
         for e in self.coarse_live() {
             let info = &c.effects[e.index()];
             let (word, mask) = bit(self.coarse_index[&e]);
-            self.template(0, head_effect, &[("NAME", &info.name)]);
-            let mut need = vec![self.discontinuity(e)];
+            let on_side: String = self.i.graph.keys[e.index()]
+                .iter()
+                .map(|i| format!(" && !across_{}[k]", c.inputs[i.index()].name))
+                .collect();
+            self.template(0, head_effect, &[("NAME", &info.name), ("ON_SIDE", &on_side)]);
+            // `disc` first: the ablation's edits find the test by it.
+            let mut need = vec!["disc".to_string()];
             if let Some(b) = iface.refine_bit[e.index()] {
                 // The program's own predicate, as evaluated at the neighbours.
                 let (word, mask) = bit(b);
@@ -280,13 +285,19 @@ impl Writer<'_, '_, '_> {
                 self.line(2, format!("let mean = ({} + {} + {} + {}) / total;", w(0), w(1), w(2), w(3)));
                 let dev = |j: usize| format!("select({zero}, (v{j} - mean) * (v{j} - mean), ok[{j}])");
                 self.line(2, format!("let variance = ({} + {} + {} + {}) / total;", dev(0), dev(1), dev(2), dev(3)));
-                let spread = match info.ty.components() {
-                    1 => "variance",
-                    2 => "max(variance.x, variance.y)",
-                    3 => "max(max(variance.x, variance.y), variance.z)",
-                    _ => "max(max(variance.x, variance.y), max(variance.z, variance.w))",
+                // The variance relative to the values' size (the largest
+                // square among the neighbours), so one similarity holds for
+                // a distance of hundreds of units and a colour of 0.01.
+                let sq = |j: usize| format!("select({zero}, v{j} * v{j}, ok[{j}])");
+                self.line(2, format!("let scale = max(max({}, {}), max({}, {}));", sq(0), sq(1), sq(2), sq(3)));
+                let spread = |v: &str| match info.ty.components() {
+                    1 => v.to_string(),
+                    2 => format!("max({v}.x, {v}.y)"),
+                    3 => format!("max(max({v}.x, {v}.y), {v}.z)"),
+                    _ => format!("max(max({v}.x, {v}.y), max({v}.z, {v}.w))"),
                 };
-                need.push(format!("!({spread} <= {CONTROL}.similarity)"));
+                let (spread, scale) = (spread("variance"), spread("scale"));
+                need.push(format!("!({spread} <= {CONTROL}.similarity * {scale})"));
                 "mean"
             } else {
                 // Integer, bool and matrix values are copied only when every neighbour agrees.

@@ -120,7 +120,7 @@ enum Piece {
 enum Derivatives {
     /// From the caller, always.
     Here,
-    /// From the caller where the operand reads no effect (the record modes).
+    /// From the caller where the operand reads no effect (the checkerboard kernel).
     HereWithoutEffects,
 }
 

@@ -1,21 +1,17 @@
 // Decides, per coarse effect, whether pixel `p` interpolates its four previous-level
-// neighbours `n` (those inside the image) or is shaded; queues it for shading if any.
+// neighbours `n` (those inside the image and on its side of every key the effect
+// reads) or is shaded; queues it for shading if any effect is.
 fn mrsl_classify(p: vec2<i32>, n: array<vec2<i32>, 4>, level: u32) {
     let size = vec2<i32>(mrsl_ctl.size);
-    var ok: array<bool, 4>;
+    var inside: array<bool, 4>;
     var q: array<vec2<i32>, 4>;
-    var total = 0.0;
-{{#IN_IMAGE}}
-    // Neighbours come in opposite pairs (0, 1) and (2, 3); at a border only complete pairs
-    // are used, so interpolation stays centred (exact for linear values). A pixel with no
-    // complete pair is shaded.
-{{#PAIRS}}
-    ok = array<bool, 4>(pair_a, pair_a, pair_b, pair_b);
+{{#BACKGROUND}}
     for (var k = 0; k < 4; k++) {
-        q[k] = select(p, n[k], ok[k]);
-        total += select(0.0, 1.0, ok[k]);
+        inside[k] = all(n[k] >= vec2<i32>(0)) && all(n[k] < size);
+        q[k] = select(p, n[k], inside[k]);
     }
-    var disc = mrsl_ctl.force_refine != 0u || total == 0.0;
+    let all_inside = inside[0] && inside[1] && inside[2] && inside[3];
+    let force = mrsl_ctl.force_refine != 0u;
 {{#KEYS}}
 {{#EFFECTS}}
     if (({{ANY_MASK}}) != 0u) {
@@ -23,4 +19,3 @@ fn mrsl_classify(p: vec2<i32>, n: array<vec2<i32>, 4>, level: u32) {
         mrsl_work[mrsl_work_offset(level) + slot] = u32(p.y) * mrsl_ctl.size.x + u32(p.x);
     }
 }
-

@@ -1,5 +1,6 @@
+    // The neighbours across key `{{NAME}}`.
     let k_{{NAME}} = {{LOAD}}(p);
-    var disc_{{NAME}} = false;
+    var across_{{NAME}}: array<bool, 4>;
     for (var k = 0; k < 4; k++) {
-        disc_{{NAME}} = disc_{{NAME}} || (ok[k] && {{DIFFERS}});
+        across_{{NAME}}[k] = inside[k] && {{DIFFERS}};
     }

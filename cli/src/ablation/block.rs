@@ -1,0 +1,193 @@
+//! The block modes' ablation variants: edits of the coarse 2x2 or 4x4 fine
+//! kernel, each removing one part of the fine pass.
+
+use super::{Variant, edit_lines, indent};
+use mrsl_abi::{CompiledProgram, KernelKind};
+
+/// The statistics atomics, their barrier and the rate-image store: the
+/// blocks a dispatch with `DispatchOptions::statistics` off skips, removed
+/// from the text (the full kernel and the other variants run with them).
+pub(super) fn no_instrumentation(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        (l.trim_start() == "if (mrsl_ctl.statistics != 0u) {").then(|| format!("{}if (false) {{", indent(l)))
+    })
+}
+
+/// No coarse effect is evaluated per pixel: every one is resampled (and
+/// in the compacted kernel, no pixel is listed for evaluation).
+pub(super) fn nothing_refined(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        if t.starts_with("if (mrsl_is_refined(mrsl_b, ") && t.contains("mrsl_cq[") {
+            return Some(String::new());
+        }
+        if let Some((todo, _)) = t.strip_prefix("var mrsl_todo_").and_then(|r| r.split_once(" = ")) {
+            // The block fine kernel's loops over a lane's refined pixels.
+            return Some(format!("{}var mrsl_todo_{todo} = 0u;", indent(l)));
+        }
+        (t.starts_with("if (mrsl_is_refined(mrsl_b, ") && t.ends_with(")) {"))
+            .then(|| format!("{}if (false) {{", indent(l)))
+    })
+}
+
+/// No coarse effect is evaluated per pixel, but the evaluation branches stay
+/// in the kernel behind a per-pixel condition only the run time knows to be
+/// false (no pixel has a negative position): what a branch that no lane
+/// takes still costs where a SIMD machine cannot tell it is untaken.
+fn nothing_refined_at_run_time(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        if let Some((todo, pixels)) = t.strip_prefix("var mrsl_todo_").and_then(|r| r.split_once(" = ")) {
+            let pixels = pixels.strip_suffix(';')?;
+            return Some(format!("{}var mrsl_todo_{todo} = ({pixels}) & select(0u, 3u, mrsl_first.x < 0);", indent(l)));
+        }
+        let cond = t.strip_prefix("if (mrsl_is_refined(mrsl_b, ")?.strip_suffix(")) {")?;
+        Some(format!("{}if (mrsl_is_refined(mrsl_b, {cond}) && mrsl_pos.x < 0) {{", indent(l)))
+    })
+}
+
+/// The key loads and comparisons of the resolve: every corner on each
+/// pixel's side of every key (`side_<key>` all true), or
+/// in the kernels that refine a whole block at an edge, `disc_<key>` false.
+fn no_key_tests(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        if let Some(name) = t.strip_prefix("let side_").and_then(|r| r.split(' ').next()) {
+            return Some(format!("{}let side_{name} = vec4<bool>(true);", indent(l)));
+        }
+        let name = t.strip_prefix("let disc_")?.split(' ').next()?;
+        Some(format!("{}let disc_{name} = false;", indent(l)))
+    })
+}
+
+/// The corners' refine-flag words of the resolve (read as zero).
+fn no_flag_reads(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        let (lhs, rhs) = t.strip_prefix("let f")?.split_once(" = ")?;
+        // Read from the buffer, or from the lane's preloaded corners (`c.w<word>`).
+        let read = rhs.starts_with("mrsl_interface[") || rhs.starts_with("c.w");
+        (read && lhs.contains('_')).then(|| format!("{}let f{lhs} = 0u;", indent(l)))
+    })
+}
+
+/// The resampling of the coarse effects (they read zero): each resampling
+/// function of the preloaded corners returns its type's zero value, and
+/// elsewhere the calls are dropped.
+fn no_resampling(w: &str) -> Option<String> {
+    let returned = std::cell::RefCell::new(None::<String>);
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        if t.starts_with("fn mrsl_resample_") && t.contains("c: MrslCorners") {
+            *returned.borrow_mut() = t.rsplit_once("-> ").map(|(_, ty)| ty.trim_end_matches(" {").to_string());
+            return None;
+        }
+        if t.starts_with("return ")
+            && let Some(ty) = returned.borrow_mut().take()
+        {
+            return Some(format!("{}return {ty}();", indent(l)));
+        }
+        let resamples = t.ends_with("(mrsl_b);") || t.ends_with("(mrsl_b, mrsl_c);");
+        (t.contains(" = mrsl_resample_") && resamples && !t.starts_with("let ")).then(String::new)
+    })
+}
+
+/// Everything the fine pass does per pixel.
+pub(super) fn no_fine_work(w: &str) -> Option<String> {
+    edit_lines(w, |l| match l.trim_start() {
+        // The guard of each pixel (a block fine kernel's lane has several).
+        t if t.starts_with("if (all(") && t.ends_with(" < mrsl_grid())) {") => {
+            Some(format!("{}if (false && {}", indent(l), &t["if (".len()..]))
+        }
+        "let mrsl_in = all(mrsl_pos < mrsl_grid());" => Some(format!("{}let mrsl_in = false;", indent(l))),
+        // The block fine kernel's pixels (`mrsl_in<k>`): nothing is stored,
+        // so nothing is computed.
+        t if t.starts_with("let mrsl_in") && t.ends_with(" < mrsl_grid());") => {
+            let name = t["let ".len()..].split(' ').next()?;
+            Some(format!("{}let {name} = false;", indent(l)))
+        }
+        _ => None,
+    })
+}
+
+/// The variants. Removing the key tests or the flag reads from the full
+/// kernel would also change what is refined, so those parts are measured
+/// within the fixed cost (nothing refined), where they decide nothing.
+pub(super) const VARIANTS: [Variant; 7] = [
+    Variant {
+        name: "no instrumentation",
+        removes: "the statistics atomics, their barrier and the rate-image store (`DispatchOptions::statistics` off)",
+        edits: &[no_instrumentation],
+    },
+    Variant {
+        name: "nothing refined (fixed cost)",
+        removes: "the per-pixel re-evaluation of refined coarse effects: every pixel resolves and resamples",
+        edits: &[nothing_refined],
+    },
+    Variant {
+        name: "nothing refined at run time",
+        removes: "the same re-evaluations, but their branches stay, untaken by a per-pixel test: what a SIMD machine runs of a branch no lane takes",
+        edits: &[nothing_refined_at_run_time],
+    },
+    Variant {
+        name: "fixed cost, no key tests",
+        removes: "also the discontinuity-key loads and comparisons of the resolve",
+        edits: &[nothing_refined, no_key_tests],
+    },
+    Variant {
+        name: "fixed cost, no flag reads",
+        removes: "also the corners' refine-flag words of the resolve",
+        edits: &[nothing_refined, no_flag_reads],
+    },
+    Variant {
+        name: "fixed cost, no resampling",
+        removes: "also the resampling of the coarse effects (they read zero)",
+        edits: &[nothing_refined, no_resampling],
+    },
+    Variant {
+        name: "no fine pass work",
+        removes: "everything the fine pass does per pixel (left: the coarse pass and the launches)",
+        edits: &[no_fine_work],
+    },
+];
+
+/// `program` with the block fine kernel of size `block` refining nothing
+/// ([`nothing_refined`]): the block mode's fixed cost, which `bench --suite`
+/// reports as its floor. `None` when the kernel has nothing to edit.
+pub fn refining_nothing(program: &CompiledProgram, block: u32) -> Option<CompiledProgram> {
+    let fine = program.kernel(KernelKind::Fine, block)?;
+    let wgsl = nothing_refined(&fine.wgsl)?;
+    Some(super::with_kernel(program, (KernelKind::Fine, Some(block)), &wgsl))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::apply;
+    use super::*;
+    use crate::setup::WORKLOAD_PROGRAM;
+
+    /// Every variant edits the kernel the code generator writes for the
+    /// workload, so a template change that breaks an edit fails here.
+    #[test]
+    fn every_variant_edits_the_workload_kernel() {
+        let program = mrsl::compile(WORKLOAD_PROGRAM, &mrsl::Options::default()).unwrap();
+        for block in [2, 4] {
+            let fine = &program.kernel(KernelKind::Fine, block).unwrap().wgsl;
+            for v in &VARIANTS {
+                let edited = apply(v, fine).unwrap_or_else(|| panic!("{}: no line to edit", v.name));
+                assert_ne!(&edited, fine, "{}", v.name);
+                mrsl::validate_wgsl(&edited).unwrap_or_else(|e| panic!("{} (block {block}): {e}", v.name));
+            }
+            // The compacted kernel takes the edits that apply to it too.
+            let compacted =
+                mrsl::compile(WORKLOAD_PROGRAM, &mrsl::Options { compact: true, ..Default::default() }).unwrap();
+            let fine = &compacted.kernel(KernelKind::Fine, block).unwrap().wgsl;
+            let unlisted = nothing_refined(fine).expect("the compacted kernel lists pixels");
+            assert!(!unlisted.contains("atomicAdd(&mrsl_cq_n["), "nothing refined still lists pixels");
+            for edit in [nothing_refined, no_fine_work, no_instrumentation] {
+                let edited = edit(fine).expect("the compacted kernel has the lines");
+                mrsl::validate_wgsl(&edited).unwrap();
+            }
+        }
+    }
+}

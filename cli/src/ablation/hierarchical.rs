@@ -1,0 +1,137 @@
+//! The hierarchical (DACS) mode's ablation variants: edits of the
+//! hierarchical kernel, each removing one part of the machinery (level 0,
+//! the classification, the work lists and their shading, the final pass).
+//!
+//! The edits match the lines `compiler/src/codegen/hierarchical.rs` and its
+//! templates write: the classification's `if (disc ...) {` per effect, the
+//! level entry points' calls of `mrsl_classify` and `mrsl_shade`, the final
+//! pass's pixel guard.
+
+use super::block::{no_fine_work, no_instrumentation};
+use super::{Variant, edit_lines, indent};
+use mrsl_abi::{CompiledProgram, KernelKind};
+
+/// The classification's test per effect (`if (disc || ... ) {`), made false:
+/// every pixel of levels 1 to 4 interpolates every effect, nothing is
+/// queued, the work-list shading dispatches are empty. The tests' own work
+/// goes too (nothing reads their results).
+pub(super) fn nothing_shaded(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        (t.starts_with("if (disc") && t.ends_with(") {")).then(|| format!("{}if (false) {{", indent(l)))
+    })
+}
+
+/// The same tests kept but made false at run time (no image is zero pixels
+/// wide): the classification's key, flag and variance tests are paid, and
+/// still nothing is queued.
+fn nothing_shaded_at_run_time(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        let cond = t.strip_prefix("if (disc")?.strip_suffix(") {")?;
+        Some(format!("{}if ((disc{cond}) && mrsl_ctl.size.x == 0u) {{", indent(l)))
+    })
+}
+
+/// Level 0's shading (its record's mask is still written).
+fn no_level0_shading(w: &str) -> Option<String> {
+    edit_lines(w, |l| (l.trim_start() == "mrsl_shade(p);").then(String::new))
+}
+
+/// The classification of levels 1 to 4: their entry points return at once.
+fn no_classification(w: &str) -> Option<String> {
+    edit_lines(w, |l| l.trim_start().starts_with("mrsl_classify(p, array<vec2<i32>, 4>(").then(String::new))
+}
+
+/// The shading of the work lists (pixels are still queued and counted).
+fn no_work_list_shading(w: &str) -> Option<String> {
+    edit_lines(w, |l| l.trim_start().starts_with("mrsl_shade(vec2<i32>(i32(index % ").then(String::new))
+}
+
+/// Everything: every entry point returns at once, so what is left is the
+/// launches (passes, dispatches, indirect arguments) and their barriers.
+fn launches_only(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        (t.starts_with("fn hier_") && t.ends_with(" {"))
+            .then(|| format!("{l}\n    if (mrsl_ctl.size.x != 0u) {{ return; }}"))
+    })
+}
+
+/// The variants. "Nothing shaded" is the mode's floor: what it costs where
+/// no pixel past level 0 needs shading; the ones after it take a further
+/// part out of that floor.
+pub(super) const VARIANTS: [Variant; 8] = [
+    Variant {
+        name: "no instrumentation",
+        removes: "the statistics atomics, their barrier and the refine-mask store (`DispatchOptions::statistics` off)",
+        edits: &[no_instrumentation],
+    },
+    Variant {
+        name: "no work-list shading",
+        removes: "the shading of the pixels levels 1-4 queue (they are still classified, queued and counted)",
+        edits: &[no_work_list_shading],
+    },
+    Variant {
+        name: "nothing shaded (floor)",
+        removes: "every shading past level 0: levels 1-4 interpolate every effect, nothing is queued",
+        edits: &[nothing_shaded],
+    },
+    Variant {
+        name: "floor with its tests",
+        removes: "the same shading, but the classification's key, flag and variance tests are still paid",
+        edits: &[nothing_shaded_at_run_time],
+    },
+    Variant {
+        name: "floor, no level 0",
+        removes: "also level 0's shading (1/16 of the pixels)",
+        edits: &[nothing_shaded, no_level0_shading],
+    },
+    Variant {
+        name: "floor, no classification",
+        removes: "also the classification of levels 1-4 (left: level 0 and the final pass)",
+        edits: &[nothing_shaded, no_classification],
+    },
+    Variant {
+        name: "no final pass work",
+        removes: "everything the final pass does per pixel (record reads, fine effects, output stores)",
+        edits: &[no_fine_work],
+    },
+    Variant {
+        name: "launches only",
+        removes: "all the work: every entry point returns at once (left: passes, dispatches, indirect arguments)",
+        edits: &[launches_only],
+    },
+];
+
+/// `program` with the hierarchical kernel shading nothing past level 0
+/// ([`nothing_shaded`]): the mode's fixed cost, which `bench --suite`
+/// reports as its floor. `None` when the program has no hierarchical kernel.
+pub fn shading_nothing(program: &CompiledProgram) -> Option<CompiledProgram> {
+    let kernel = program.kernels.iter().find(|k| k.kind == KernelKind::Hierarchical)?;
+    let wgsl = nothing_shaded(&kernel.wgsl)?;
+    Some(super::with_kernel(program, (KernelKind::Hierarchical, None), &wgsl))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::apply;
+    use super::*;
+    use crate::setup::WORKLOAD_PROGRAM;
+
+    /// Every variant edits the hierarchical kernel the code generator writes
+    /// for the workload into valid WGSL, so a template change that breaks an
+    /// edit fails here.
+    #[test]
+    fn every_variant_edits_the_workload_kernel() {
+        let program = mrsl::compile(WORKLOAD_PROGRAM, &mrsl::Options::default()).unwrap();
+        let kernel = &program.kernels.iter().find(|k| k.kind == KernelKind::Hierarchical).unwrap().wgsl;
+        for v in &VARIANTS {
+            let edited = apply(v, kernel).unwrap_or_else(|| panic!("{}: no line to edit", v.name));
+            assert_ne!(&edited, kernel, "{}", v.name);
+            mrsl::validate_wgsl(&edited).unwrap_or_else(|e| panic!("{}: {e}", v.name));
+        }
+        let floor = nothing_shaded(kernel).unwrap();
+        assert!(!floor.contains("if (disc"), "the floor still tests an effect");
+    }
+}
