@@ -86,11 +86,15 @@ pub fn pixel_workgroups(size: (u32, u32)) -> (u32, u32) {
 }
 
 /// Pixels `start, start + step, start + 2 step, ...` along each axis: the
-/// grid one hierarchical entry point is dispatched over (one invocation each).
+/// grid one hierarchical entry point is dispatched over (one invocation
+/// each). With `odd_only`, only the points whose lattice coordinates (i, j)
+/// have an odd sum: invocation (g, j) is point (2 g + (j + 1) mod 2, j), so
+/// a dispatch is half as wide and no lane idles on an even point.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Lattice {
     pub start: u32,
     pub step: u32,
+    pub odd_only: bool,
 }
 
 impl Lattice {
@@ -99,29 +103,37 @@ impl Lattice {
         if n > self.start { (n - self.start - 1) / self.step + 1 } else { 0 }
     }
 
-    /// Lattice points of a `size` image.
+    /// Lattice points of a `size` image (every point, `odd_only` or not).
     pub fn points(self, size: (u32, u32)) -> u64 {
         u64::from(self.count(size.0)) * u64::from(self.count(size.1))
     }
 
+    /// Invocations along x and y: the points along each axis, along x half
+    /// of them (rounded up) with `odd_only`.
+    pub fn invocations(self, size: (u32, u32)) -> (u32, u32) {
+        let x = self.count(size.0);
+        (if self.odd_only { x.div_ceil(2) } else { x }, self.count(size.1))
+    }
+
     /// Workgroups of [`COARSE_WORKGROUP`]² invocations covering the lattice (at least one).
     pub fn workgroups(self, size: (u32, u32)) -> (u32, u32) {
-        let groups = |n: u32| self.count(n).div_ceil(COARSE_WORKGROUP).max(1);
-        (groups(size.0), groups(size.1))
+        let (x, y) = self.invocations(size);
+        let groups = |n: u32| n.div_ceil(COARSE_WORKGROUP).max(1);
+        (groups(x), groups(y))
     }
 }
 
 /// Level 0 of the hierarchical mode: every 4th pixel in both directions, always shaded.
-pub const HIERARCHICAL_LEVEL0: Lattice = Lattice { start: 0, step: 4 };
+pub const HIERARCHICAL_LEVEL0: Lattice = Lattice { start: 0, step: 4, odd_only: false };
 
 /// The dispatch lattices of hierarchical levels 1 to 4. Levels 2 and 4 use
 /// only the lattice points with an odd coordinate sum; the work lists still
 /// reserve a word per point, so each list's capacity is its lattice's size.
 pub const HIERARCHICAL_LEVELS: [Lattice; 4] = [
-    Lattice { start: 2, step: 4 },
-    Lattice { start: 0, step: 2 },
-    Lattice { start: 1, step: 2 },
-    Lattice { start: 0, step: 1 },
+    Lattice { start: 2, step: 4, odd_only: false },
+    Lattice { start: 0, step: 2, odd_only: true },
+    Lattice { start: 1, step: 2, odd_only: false },
+    Lattice { start: 0, step: 1, odd_only: true },
 ];
 
 /// Words of the hierarchical work lists (levels 1 to 4 one after another).
@@ -182,12 +194,15 @@ mod tests {
                     mark(x * 4, y * 4);
                 }
             }
-            for (index, level) in HIERARCHICAL_LEVELS.iter().enumerate() {
-                let odd_only = index % 2 == 1;
-                for j in 0..level.count(size.1) {
-                    for i in 0..level.count(size.0) {
-                        if !odd_only || (i + j) % 2 == 1 {
-                            mark(level.start + i * level.step, level.start + j * level.step);
+            // As the kernel maps invocations to points (`Lattice` docs).
+            for level in &HIERARCHICAL_LEVELS {
+                let (nx, ny) = level.invocations(size);
+                for j in 0..ny {
+                    for g in 0..nx {
+                        let i = if level.odd_only { 2 * g + (j + 1) % 2 } else { g };
+                        let (x, y) = (level.start + i * level.step, level.start + j * level.step);
+                        if x < size.0 && y < size.1 {
+                            mark(x, y);
                         }
                     }
                 }

@@ -274,7 +274,7 @@ impl Extent {
         match self {
             Extent::HierarchicalLevels => geometry::work_list_words(size),
             Extent::Lattice { start, step, odd_only } => {
-                let points = Lattice { start, step }.points(size);
+                let points = Lattice { start, step, odd_only }.points(size);
                 if odd_only { points / 2 } else { points }
             }
             Extent::Fixed { count } => count,
@@ -348,8 +348,14 @@ pub enum Workgroups {
     /// One per [`geometry::COARSE_WORKGROUP`]² coarse samples of `block`
     /// ([`geometry::coarse_workgroups`]).
     SampleGrid { block: u32 },
-    /// Over a lattice of pixels ([`Lattice::workgroups`]).
-    Lattice { start: u32, step: u32 },
+    /// Over a lattice of pixels ([`Lattice::workgroups`]); with `odd_only`,
+    /// over the half of its points with an odd coordinate sum.
+    Lattice {
+        start: u32,
+        step: u32,
+        #[serde(default)]
+        odd_only: bool,
+    },
     /// A single workgroup.
     One,
     /// One per [`geometry::RATE_LIST_TILES`]² shading-rate tiles
@@ -375,7 +381,7 @@ impl Workgroups {
         Some(match self {
             Workgroups::Tiles => geometry::pixel_workgroups(size),
             Workgroups::SampleGrid { block } => geometry::coarse_workgroups(size, block),
-            Workgroups::Lattice { start, step } => Lattice { start, step }.workgroups(size),
+            Workgroups::Lattice { start, step, odd_only } => Lattice { start, step, odd_only }.workgroups(size),
             Workgroups::One => (1, 1),
             Workgroups::RateTiles => geometry::rate_list_workgroups(size, context.rate_tile),
             Workgroups::CheckerboardQuads => geometry::checkerboard_workgroups(size, context.forced),

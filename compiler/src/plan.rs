@@ -95,17 +95,16 @@ fn block_steps(layout: &Layout, mode: Mode, steps: &mut Vec<Step>) -> Counts {
 fn hierarchical_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
     let kernel = KernelRef::new(KernelKind::Hierarchical, None);
     let level0 = HIERARCHICAL_LEVEL0;
-    let mut levels = vec![dispatch(entry::HIER_LEVEL0, Workgroups::Lattice { start: level0.start, step: level0.step })];
-    for (index, lattice) in HIERARCHICAL_LEVELS.iter().enumerate() {
-        let (start, step) = (lattice.start, lattice.step);
-        levels.push(dispatch(entry::HIER_CLASSIFY[index], Workgroups::Lattice { start, step }));
+    let lattice = |l: geometry::Lattice| Workgroups::Lattice { start: l.start, step: l.step, odd_only: l.odd_only };
+    let mut levels = vec![dispatch(entry::HIER_LEVEL0, lattice(level0))];
+    for (index, level) in HIERARCHICAL_LEVELS.iter().enumerate() {
+        let (start, step, odd_only) = (level.start, level.step, level.odd_only);
+        levels.push(dispatch(entry::HIER_CLASSIFY[index], lattice(*level)));
         levels.push(Dispatch {
             entry: entry::HIER_ARGS[index].into(),
             arguments: Some(ResourceId::LevelArguments),
             workgroups: Workgroups::One,
         });
-        // Levels 2 and 4 queue only the lattice points with an odd coordinate sum.
-        let odd_only = index % 2 == 1;
         levels.push(dispatch(
             entry::HIER_SHADE[index],
             Workgroups::Indirect {

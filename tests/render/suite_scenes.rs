@@ -66,8 +66,17 @@ fn mean_of_surfaces(reference: &Output, gpu: &Gpu, scene: &MeshScene, size: (u32
 /// The workload over `scene` in every mode: the reference is finite and lit
 /// (the mean over the surfaces above `lit`), every mode with every
 /// predicate forced is bit-identical to it, and the adaptive modes at the
-/// program's defaults shade less than everything and stay above `bar` dB.
-fn every_mode_matches_the_reference(gpu: &Gpu, scene: Scene, lit: f32, bar: f64) {
+/// program's defaults shade less than everything and stay above their bars
+/// (`bars`: coarse 4x4's, then the hierarchical mode's, in dB).
+///
+/// The bars are 3 dB below what lavapipe (Mesa 22.3) measures at 192x108,
+/// for other drivers' rounding. At that size a pixel spans a large part of
+/// a surface: the hierarchical mode interpolates along an edge from the
+/// neighbours on the pixel's side, and across a few pixels the lights'
+/// falloff is far from linear, which costs it up to 7 dB there against
+/// shading at every edge (its rule until 2 December 2026); at 1920x1080 it
+/// stays above MSSIM 0.99 on every scene (docs/evaluation.md).
+fn every_mode_matches_the_reference(gpu: &Gpu, scene: Scene, lit: f32, bars: (f64, f64)) {
     let mut mesh_scene = scene.mesh_scene(gpu).unwrap().expect("a mesh scene");
     let plain = scene.mesh_scene(gpu).unwrap().expect("a mesh scene");
     let run = workload(gpu, &mut mesh_scene, SIZE);
@@ -79,7 +88,7 @@ fn every_mode_matches_the_reference(gpu: &Gpu, scene: Scene, lit: f32, bar: f64)
         let forced = run(mode, true);
         assert!(forced.pixels == reference.pixels, "{scene:?} {mode}: forced refinement differs from the reference");
     }
-    for mode in [Mode::Coarse4x4, Mode::Hierarchical] {
+    for (mode, bar) in [(Mode::Coarse4x4, bars.0), (Mode::Hierarchical, bars.1)] {
         let out = run(mode, false);
         let db = psnr(&out.pixels, &reference.pixels);
         eprintln!(
@@ -95,8 +104,7 @@ fn every_mode_matches_the_reference(gpu: &Gpu, scene: Scene, lit: f32, bar: f64)
 /// with a third of the frame sky; the workload in every mode with forced
 /// refinement bit-identical to the reference, and its adaptive modes close.
 /// (Measured on lavapipe, Mesa 22.3, at 192x108: coarse4x4 56.0 dB at
-/// shaded fraction 0.495, hierarchical 57.3 dB at 0.487; the bar is 3 dB
-/// below the lower, for other drivers' rounding, as in the Sponza tests.)
+/// shaded fraction 0.495, hierarchical 50.0 dB at 0.429.)
 pub fn generated_scene_workload_matches_its_reference(gpu: &Gpu) {
     let mesh = mrsl_lab::procedural::city();
     assert!(mesh == mrsl_lab::procedural::city(), "the city differs between two calls");
@@ -107,7 +115,7 @@ pub fn generated_scene_workload_matches_its_reference(gpu: &Gpu) {
     let scene = Scene::Generated.mesh_scene(gpu).unwrap().unwrap();
     let sky = sky_fraction(gpu, &scene, SIZE);
     assert!(sky > 0.3 && sky < 0.7, "sky fraction {sky}");
-    every_mode_matches_the_reference(gpu, Scene::Generated, 0.05, 53.0);
+    every_mode_matches_the_reference(gpu, Scene::Generated, 0.05, (53.0, 47.0));
 }
 
 /// The rigs of the new scenes give the reference point of their layout the
@@ -315,7 +323,7 @@ pub fn bad_ac3d_files_are_typed_errors() {
 /// 2.5 km wide; from the default camera more than 30% of the frame is sky,
 /// and the workload is lit in every mode, forced refinement bit-identical
 /// to the reference. (Measured on lavapipe at 192x108: coarse4x4 52.9 dB at
-/// shaded fraction 0.572, hierarchical 69.8 dB at 0.602; the bar 3 dB below.)
+/// shaded fraction 0.572, hierarchical 59.0 dB at 0.520.)
 pub fn outdoor_scene_has_a_large_sky_and_matches_its_reference(gpu: &Gpu) {
     let mesh = mrsl_lab::fixtures::outdoor_shared().unwrap();
     mesh.validate().unwrap();
@@ -327,7 +335,7 @@ pub fn outdoor_scene_has_a_large_sky_and_matches_its_reference(gpu: &Gpu) {
     let scene = Scene::Outdoor.mesh_scene(gpu).unwrap().unwrap();
     let sky = sky_fraction(gpu, &scene, SIZE);
     assert!(sky > 0.3, "sky fraction {sky}");
-    every_mode_matches_the_reference(gpu, Scene::Outdoor, 0.05, 49.8);
+    every_mode_matches_the_reference(gpu, Scene::Outdoor, 0.05, (49.8, 55.9));
 }
 
 /// The Franka Panda's link 6 at its native scale (18 cm): its triangles and
@@ -335,7 +343,7 @@ pub fn outdoor_scene_has_a_large_sky_and_matches_its_reference(gpu: &Gpu) {
 /// height against the background, and the workload is lit in every mode,
 /// forced refinement bit-identical to the reference. (Measured on lavapipe
 /// at 192x108: coarse4x4 35.4 dB at shaded fraction 0.400, hierarchical
-/// 50.4 dB at 0.404; the bar 3 dB below the lower.)
+/// 48.4 dB at 0.390.)
 pub fn small_scene_fills_half_the_frame_and_matches_its_reference(gpu: &Gpu) {
     let mesh = mrsl_lab::fixtures::small_shared().unwrap();
     mesh.validate().unwrap();
@@ -351,7 +359,7 @@ pub fn small_scene_fills_half_the_frame_and_matches_its_reference(gpu: &Gpu) {
     assert!((0.4..0.75).contains(&height), "the object spans {height} of the frame's height");
     let (normal, _) = floats(&g, "normal");
     assert!(normal.iter().all(|v| v.is_finite()));
-    every_mode_matches_the_reference(gpu, Scene::Small, 0.05, 32.4);
+    every_mode_matches_the_reference(gpu, Scene::Small, 0.05, (32.4, 45.4));
 }
 
 /// A GPU test over a fetched model.

@@ -27,9 +27,6 @@ use std::fmt::Display;
 /// picks its pixels and the neighbours it interpolates from.
 struct Classified {
     what: &'static str,
-    /// Only lattice points with an odd coordinate sum: the others belong to
-    /// a coarser level.
-    odd_only: bool,
     neighbours: [(i32, i32); 4],
 }
 
@@ -37,32 +34,27 @@ fn classified_levels() -> [Classified; 4] {
     [
         Classified {
             what: "every 4th pixel offset by (2, 2), from its diagonal neighbours at distance 2",
-            odd_only: false,
             neighbours: diagonal_neighbours(2),
         },
         Classified {
             what: "the remaining pixels of the 2-grid, from axis neighbours at distance 2",
-            odd_only: true,
             neighbours: axis_neighbours(2),
         },
-        Classified {
-            what: "odd pixels, from diagonal neighbours at distance 1",
-            odd_only: false,
-            neighbours: diagonal_neighbours(1),
-        },
-        Classified {
-            what: "the rest, from axis neighbours at distance 1",
-            odd_only: true,
-            neighbours: axis_neighbours(1),
-        },
+        Classified { what: "odd pixels, from diagonal neighbours at distance 1", neighbours: diagonal_neighbours(1) },
+        Classified { what: "the rest, from axis neighbours at distance 1", neighbours: axis_neighbours(1) },
     ]
 }
 
-/// The pixel of lattice point `gid.xy`, as WGSL.
+/// The pixel of invocation `gid.xy`, as WGSL: lattice point `gid.xy`, or
+/// with `odd_only` point (2 gid.x + (gid.y + 1) mod 2, gid.y) (see [`Lattice`]).
 fn lattice_pixel(lattice: Lattice) -> String {
+    let point = match lattice.odd_only {
+        false => "vec2<i32>(gid.xy)",
+        true => "vec2<i32>(i32(2u * gid.x + ((gid.y + 1u) & 1u)), i32(gid.y))",
+    };
     let scaled = match lattice.step {
-        1 => "vec2<i32>(gid.xy)".to_string(),
-        step => format!("vec2<i32>(gid.xy) * {step}"),
+        1 => point.to_string(),
+        step => format!("{point} * {step}"),
     };
     match lattice.start {
         0 => scaled,
@@ -108,7 +100,6 @@ impl Writer<'_, '_, '_> {
             // indirect arguments (x, y, z).
             let queue = (index as u32 + 1) * QUEUE_WORDS_PER_LEVEL;
             let neighbours = neighbours(level.neighbours);
-            let valid = if level.odd_only { "((gid.x + gid.y) & 1u) == 1u" } else { "true" };
             self.template(
                 0,
                 include_str!("templates/level.wgsl"),
@@ -118,7 +109,6 @@ impl Writer<'_, '_, '_> {
                     ("CLASSIFY_WORKGROUP", &lattice_workgroup()),
                     ("CLASSIFY", &entry::HIER_CLASSIFY[index]),
                     ("PIXEL", &lattice_pixel(*lattice)),
-                    ("VALID", &valid),
                     ("NEIGHBOURS", &neighbours),
                     ("ARGS", &entry::HIER_ARGS[index]),
                     ("QUEUE", &queue),

@@ -10,7 +10,6 @@ fn mrsl_classify(p: vec2<i32>, n: array<vec2<i32>, 4>, level: u32) {
         inside[k] = all(n[k] >= vec2<i32>(0)) && all(n[k] < size);
         q[k] = select(p, n[k], inside[k]);
     }
-    let all_inside = inside[0] && inside[1] && inside[2] && inside[3];
     let force = mrsl_ctl.force_refine != 0u;
 {{#KEYS}}
 {{#EFFECTS}}

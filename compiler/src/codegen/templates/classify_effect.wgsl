@@ -1,22 +1,20 @@
     // `{{NAME}}`
     {
         // The neighbours it interpolates: its complete opposite pairs (0, 1) and (2, 3)
-        // (centred: exact for linear values); where a key leaves no pair complete, the
-        // two on p's side. With fewer, or none complete at the image border, p is shaded.
-        var ok: array<bool, 4>;
+        // of neighbours on p's side of every key it reads, so that interpolation stays
+        // centred (exact for linear values). With no complete pair, p is shaded.
+        var on_side: array<bool, 4>;
         for (var k = 0; k < 4; k++) {
-            ok[k] = inside[k]{{ON_SIDE}};
+            on_side[k] = inside[k]{{ON_SIDE}};
         }
-        let pair_a = ok[0] && ok[1];
-        let pair_b = ok[2] && ok[3];
-        if (pair_a || pair_b) {
-            ok = array<bool, 4>(pair_a, pair_a, pair_b, pair_b);
-        }
+        let pair_a = on_side[0] && on_side[1];
+        let pair_b = on_side[2] && on_side[3];
+        var ok = array<bool, 4>(pair_a, pair_a, pair_b, pair_b);
         var total = 0.0;
         for (var k = 0; k < 4; k++) {
             total += select(0.0, 1.0, ok[k]);
         }
-        let disc = force || total < 2.0 || !(pair_a || pair_b || all_inside);
+        let disc = force || !(pair_a || pair_b);
         let v0 = mrsl_hget_{{NAME}}(q[0]);
         let v1 = mrsl_hget_{{NAME}}(q[1]);
         let v2 = mrsl_hget_{{NAME}}(q[2]);

@@ -2,7 +2,7 @@
 @compute @workgroup_size({{CLASSIFY_WORKGROUP}})
 fn {{CLASSIFY}}(@builtin(global_invocation_id) gid: vec3<u32>) {
     let p = {{PIXEL}};
-    if (any(p >= vec2<i32>(mrsl_ctl.size)) || !({{VALID}})) { return; }
+    if (any(p >= vec2<i32>(mrsl_ctl.size))) { return; }
     mrsl_classify(p, {{NEIGHBOURS}}, {{LEVEL}}u);
 }
 
