@@ -227,8 +227,10 @@ pub struct Channel {
     pub ty: ValueType,
     pub group: u32,
     pub binding: u32,
-    /// The texture format the tools create for it; any format of the same
-    /// sample type with enough components is accepted.
+    /// The texture format the tools create for it. The runtime also accepts
+    /// other colour formats of the same sample type: at least the type's
+    /// components for one or two, exactly 4 for three or four
+    /// (docs/runtime.md, section 4).
     pub format: TextureFormat,
     /// The sample type of the binding.
     pub sample_type: SampleType,

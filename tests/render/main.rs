@@ -40,6 +40,7 @@ const GPU_TESTS: &[GpuTest] = &[
     ("binding::textured_materials_are_lit_over_a_mesh_scene", binding::textured_materials_are_lit_over_a_mesh_scene),
     ("binding::mismatches_without_defaults_are_typed_errors", binding::mismatches_without_defaults_are_typed_errors),
     ("errors::binding_mismatches_are_typed_errors", errors::binding_mismatches_are_typed_errors),
+    ("errors::engine_textures_are_checked_before_recording", errors::engine_textures_are_checked_before_recording),
     (
         "frames::velocity_is_the_projection_difference_of_a_camera_move",
         frames::velocity_is_the_projection_difference_of_a_camera_move,
