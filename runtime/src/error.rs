@@ -39,6 +39,15 @@ pub enum Error {
     UnknownUniform(String),
     #[error("uniform `{name}` is `{ty}` ({expected} components), but {found} values were given")]
     UniformComponents { name: String, ty: String, expected: usize, found: usize },
+    /// A value the uniform's scalar type does not hold as given: `reason`
+    /// says why (not an integer, out of range, not 0 or 1, not finite).
+    #[error("uniform `{name}` is `{ty}`, but {} {reason}", value_at(ty, *index, *value))]
+    UniformValue { name: String, ty: String, index: usize, value: f64, reason: &'static str },
+    /// A typed setter (`Shader::set_uniform_u32`, ...) for another scalar type.
+    #[error(
+        "uniform `{name}` is `{ty}`, but {given} values were given: use the setter of its scalar type (set_uniform_f32, set_uniform_i32, set_uniform_u32, set_uniform_bool) or set_uniform"
+    )]
+    UniformType { name: String, ty: String, given: &'static str },
     #[error("texture `{0}` is not bound")]
     MissingTexture(String),
     #[error(
@@ -88,4 +97,13 @@ pub enum Error {
     BadTileSize(u32),
     #[error("rate option `{name}` is {value}, but it must be a finite number >= 0")]
     BadRateOption { name: &'static str, value: f32 },
+}
+
+/// Where a uniform's value at fault is: "its value V" for a scalar,
+/// "component K, V," for a vector, matrix or array.
+fn value_at(ty: &str, index: usize, value: f64) -> String {
+    match ty.parse::<mrsl_abi::ValueType>() {
+        Ok(t) if t.components() == 1 => format!("its value {value}"),
+        _ => format!("component {index}, {value},"),
+    }
 }

@@ -59,6 +59,13 @@ pub fn binding_mismatches_are_typed_errors(gpu: &Gpu) {
         Err(Error::UniformComponents { expected: 16, found: 3, .. })
     ));
     shader.set_uniform("lights", &[0.5; 16]).unwrap();
+    // Values the type does not hold, and typed setters of another type.
+    assert!(matches!(
+        shader.set_uniform("gain", &[f64::INFINITY]),
+        Err(Error::UniformValue { index: 0, reason: "is not a finite number", .. })
+    ));
+    assert!(matches!(shader.set_uniform_u32("gain", &[1]), Err(Error::UniformType { given: "u32", .. })));
+    shader.set_uniform_f32("gain", &[1.0]).unwrap();
     // Output of the wrong format.
     let wrong = gpu.output_texture("color", (16, 8), wgpu::TextureFormat::Rgba8Unorm);
     bindings.outputs.insert("color".into(), &wrong);
