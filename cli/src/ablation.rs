@@ -65,7 +65,7 @@ fn indent(line: &str) -> &str {
     &line[..line.len() - line.trim_start().len()]
 }
 
-/// The statistics atomics, their barrier and the rate-image store: the
+/// The statistics atomics, their barrier and the refine-mask store: the
 /// blocks a dispatch with `DispatchOptions::statistics` off skips, removed
 /// from the text (the full kernel and the other variants run with them).
 fn no_instrumentation(w: &str) -> Option<String> {
@@ -177,7 +177,7 @@ fn no_fine_work(w: &str) -> Option<String> {
 const VARIANTS: [Variant; 7] = [
     Variant {
         name: "no instrumentation",
-        removes: "the statistics atomics, their barrier and the rate-image store (`DispatchOptions::statistics` off)",
+        removes: "the statistics atomics, their barrier and the refine-mask store (`DispatchOptions::statistics` off)",
         edits: &[no_instrumentation],
     },
     Variant {

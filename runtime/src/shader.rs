@@ -419,10 +419,13 @@ impl Shader {
     }
 
     /// The per-pixel refine mask of the last dispatch of a mode with coarse
-    /// effects: x bit k set when coarse effect k (`layout().stats.counters[k]`)
+    /// effects: x bit k set when coarse effect k (`layout().stats.counters[k]`,
+    /// in dependency order, not the declaration order of `Stats::effects`)
     /// was evaluated per pixel, y bit k when it was taken from the dynamic
-    /// mode's 2x2 level. `None` before any such dispatch; a dispatch with
-    /// `DispatchOptions::statistics` off leaves it as it was.
+    /// mode's 2x2 level; [`Layout::refine_mask_bit`] gives an effect's bit and
+    /// [`Layout::decode_refine_mask`] a texel's effects by name. `None` before
+    /// any such dispatch; a dispatch with `DispatchOptions::statistics` off
+    /// leaves it as it was.
     pub fn refine_mask(&self) -> Option<&wgpu::Texture> {
         self.pool.texture(ResourceId::RefineMask)
     }

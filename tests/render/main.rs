@@ -69,6 +69,7 @@ const GPU_TESTS: &[GpuTest] = &[
         modes::statistics_off_changes_nothing_but_the_instrumentation,
     ),
     ("modes::keys_refine_only_the_effects_that_read_them", modes::keys_refine_only_the_effects_that_read_them),
+    ("modes::refine_masks_decode_to_the_counted_effects", modes::refine_masks_decode_to_the_counted_effects),
     ("modes::compacted_fine_pass_equals_the_plain_one", modes::compacted_fine_pass_equals_the_plain_one),
     ("modes::silhouettes_are_never_blended", modes::silhouettes_are_never_blended),
     ("modes::odd_sizes_cover_every_pixel", modes::odd_sizes_cover_every_pixel),
