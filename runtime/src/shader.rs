@@ -51,8 +51,10 @@ pub struct DispatchOptions {
     /// Count per-pixel re-evaluations ([`Shader::read_stats`]) and write the
     /// per-pixel refine mask ([`Shader::refine_mask`]). On by default; turn it
     /// off for frames that are only displayed or timed: the counters are
-    /// workgroup atomics and a barrier per tile, under 2% of a coarse 4x4
-    /// frame on lavapipe in the ablations of docs/evaluation.md.
+    /// workgroup atomics and a barrier per tile, whose cost depends on the
+    /// program and scene (on lavapipe 8% to 35% of a coarse 4x4 frame in the
+    /// ablation of docs/evaluation.md, 18% for the demo at 640x360;
+    /// docs/runtime.md, section 5).
     pub statistics: bool,
 }
 
