@@ -18,6 +18,23 @@ pub const LAYOUT_FORMAT: &str = "mrsl-layout/6";
 /// mode's 2x2 level; the statistics' background count is exact regardless.
 pub const BACKGROUND_MARK: [u32; 2] = [0, u32::MAX];
 
+/// One texel of the refine mask decoded by effect name
+/// ([`Layout::decode_refine_mask`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum RefineMaskTexel<'a> {
+    /// A background pixel: no coarse effect was evaluated, refined or
+    /// resampled there. (In a program of 32 or more coarse effects, a shaded
+    /// pixel that took all of them from the 2x2 level holds the same texel;
+    /// see [`BACKGROUND_MARK`].)
+    Background,
+    /// A shaded pixel: the coarse effects it evaluated itself (`.x`: per
+    /// pixel, shaded at that pixel in the hierarchical mode, in a shaded quad
+    /// or in place in the checkerboard mode) and those it took from the
+    /// dynamic mode's 2x2 level (`.y`), each in declaration order. A coarse
+    /// effect in neither was resampled from coarse samples.
+    Shaded { per_pixel: Vec<&'a str>, from_2x2: Vec<&'a str> },
+}
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Layout {
     /// The format version, [`LAYOUT_FORMAT`].
@@ -67,6 +84,35 @@ impl Layout {
             Some(other) => Err(format!("layout format `{other}` is not supported (expected `{LAYOUT_FORMAT}`)")),
             None => Err(format!("no `format` field (expected `{LAYOUT_FORMAT}`)")),
         }
+    }
+
+    /// The refine-mask bit of coarse effect `effect`, the same in the
+    /// texel's `.x` (evaluated per pixel) and `.y` (taken from the dynamic
+    /// mode's 2x2 level): its index in `stats.counters`, which follows the
+    /// effects' dependency order rather than their declaration order (that
+    /// of `Stats::effects`). `None` for a name that is not a live coarse
+    /// effect, or one past the mask's 32 bits.
+    pub fn refine_mask_bit(&self, effect: &str) -> Option<u32> {
+        let bit = self.stats.counters.iter().position(|c| c == effect)?;
+        u32::try_from(bit).ok().filter(|&b| b < 32)
+    }
+
+    /// Decodes one texel of the refine mask (the `rg32uint` texture
+    /// `Shader::refine_mask` returns) into effect names, in declaration
+    /// order (the order of `Layout::effects` and of `Stats::effects`).
+    /// [`BACKGROUND_MARK`] decodes as [`RefineMaskTexel::Background`].
+    pub fn decode_refine_mask(&self, texel: [u32; 2]) -> RefineMaskTexel<'_> {
+        if texel == BACKGROUND_MARK {
+            return RefineMaskTexel::Background;
+        }
+        let set = |word: u32| -> Vec<&str> {
+            self.effects
+                .iter()
+                .filter(|e| self.refine_mask_bit(&e.name).is_some_and(|bit| word >> bit & 1 == 1))
+                .map(|e| e.name.as_str())
+                .collect()
+        };
+        RefineMaskTexel::Shaded { per_pixel: set(texel[0]), from_2x2: set(texel[1]) }
     }
 
     /// The layout as pretty-printed JSON, as `mrslc compile` writes it.
@@ -227,8 +273,10 @@ pub struct Channel {
     pub ty: ValueType,
     pub group: u32,
     pub binding: u32,
-    /// The texture format the tools create for it; any format of the same
-    /// sample type with enough components is accepted.
+    /// The texture format the tools create for it. The runtime also accepts
+    /// other colour formats of the same sample type: at least the type's
+    /// components for one or two, exactly 4 for three or four
+    /// (docs/runtime.md, section 4).
     pub format: TextureFormat,
     /// The sample type of the binding.
     pub sample_type: SampleType,

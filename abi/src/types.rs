@@ -209,6 +209,24 @@ impl TextureFormat {
             _ => Scalar::Float,
         }
     }
+
+    /// The storage formats a `fine out` of type `ty` may declare with
+    /// `@format(..)` (docs/language.md, section 3.5), in the order the
+    /// compiler lists them; empty for a type that cannot be an output. A
+    /// format must hold every component: single-channel formats only for
+    /// scalars, two-channel ones for at most two components.
+    pub fn for_output(ty: &ValueType) -> Vec<TextureFormat> {
+        use TextureFormat as F;
+        let any = match ty {
+            ValueType::Scalar(Scalar::Float) => vec![F::R32Float, F::Rgba16Float, F::Rgba32Float, F::Rgba8Unorm],
+            ValueType::Vector(Scalar::Float, _) => vec![F::Rgba32Float, F::Rgba16Float, F::Rgba8Unorm, F::Rg32Float],
+            ValueType::Scalar(Scalar::Uint) | ValueType::Vector(Scalar::Uint, _) => vec![F::R32Uint, F::Rgba32Uint],
+            ValueType::Scalar(Scalar::Int) | ValueType::Vector(Scalar::Int, _) => vec![F::R32Sint, F::Rgba32Sint],
+            _ => vec![],
+        };
+        let n = ty.components();
+        any.into_iter().filter(|f| f.components() >= n.min(4) || f.components() == 4).collect()
+    }
 }
 
 impl fmt::Display for TextureFormat {
@@ -272,5 +290,18 @@ mod tests {
         }
         assert!("bgra8unorm".parse::<TextureFormat>().is_err());
         assert!(serde_json::from_str::<TextureFormat>("\"rgba8snorm\"").is_err());
+    }
+
+    #[test]
+    fn output_formats_hold_every_component() {
+        let names = |ty: &str| -> Vec<&str> {
+            TextureFormat::for_output(&ty.parse().unwrap()).into_iter().map(TextureFormat::name).collect()
+        };
+        assert_eq!(names("float"), ["r32float", "rgba16float", "rgba32float", "rgba8unorm"]);
+        assert_eq!(names("float2"), ["rgba32float", "rgba16float", "rgba8unorm", "rg32float"]);
+        assert_eq!(names("float3"), ["rgba32float", "rgba16float", "rgba8unorm"]);
+        assert_eq!(names("uint"), ["r32uint", "rgba32uint"]);
+        assert_eq!(names("int3"), ["rgba32sint"]);
+        assert!(names("bool").is_empty() && names("float4x4").is_empty());
     }
 }

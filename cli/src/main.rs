@@ -47,10 +47,13 @@ enum Command {
     },
     /// Compile a program to WGSL kernels and a layout description.
     ///
-    /// Writes the kernels of the modes asked for (all by default), named
-    /// <name>.KIND.bB.wgsl for the kinds that exist per block size and
-    /// <name>.KIND.wgsl for the others, and <name>.layout.json, which holds
-    /// every binding and the plan of each mode, into the output directory.
+    /// Writes the kernels of the modes asked for (all by default: 11
+    /// kernels), named <name>.KIND.bB.wgsl for the kinds that exist per
+    /// block size (coarse and fine at 2 and 4, dynamic_coarse at 2,
+    /// dynamic_fine at 4) and <name>.KIND.wgsl for the others (reference,
+    /// hierarchical, checkerboard, rate_coarse, rate_fine), and
+    /// <name>.layout.json, which holds every binding and the plan of each
+    /// mode, into the output directory.
     Compile {
         /// The .mrsl program.
         file: PathBuf,
@@ -492,6 +495,7 @@ fn report(color: Color, diagnostics: &[Diagnostic], name: &str, source: &str) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use clap::CommandFactory;
 
     #[test]
     fn render_writes_beside_the_output_unless_told() {
@@ -564,6 +568,10 @@ mod tests {
         };
         let source = std::fs::read_to_string(demo).unwrap();
         let all = compile(&[]);
+        // As many as `compile --help` says.
+        assert_eq!(all.kernels.len(), Options::default().kernels().len());
+        let help = Cli::command().find_subcommand("compile").unwrap().get_long_about().unwrap().to_string();
+        assert!(help.contains(&format!("all by default: {} kernels", all.kernels.len())), "{help}");
         let expected = mrsl::compile(&source, &Options { file_name: demo.into(), ..Options::default() }).unwrap();
         assert_eq!(all.layout.plan, expected.layout.plan);
         assert_eq!(all.layout.plan.modes.len(), mrsl::Mode::ALL.len());

@@ -2,17 +2,17 @@
 //!
 //! Run with `cargo bench -p mrsl --bench compile [-- FILTER]`. Groups:
 //!
-//! * `examples`: full [`mrsl::compile`] (default options: the nine kernels,
-//!   coarse and fine for block sizes 2 and 4, reference, dynamic coarse and
-//!   fine, hierarchical and checkerboard, each validated by naga) of every
-//!   `examples/*.mrsl`.
+//! * `examples`: full [`mrsl::compile`] (default options: the eleven
+//!   kernels, coarse and fine for block sizes 2 and 4, reference, dynamic
+//!   coarse and fine, hierarchical, checkerboard, rate-image coarse and
+//!   fine, each validated by naga) of every `examples/*.mrsl`.
 //! * `generated`: a generated program of N effects (N = 25 .. 400) mixing
 //!   refining coarse effects, chains, blocker/shadow pairs, fine effects and one
 //!   output, measured at several depths: `check` (front end only), `interface`
 //!   (slot allocation alone, on a pre-built checked program and graph),
 //!   `compile_reference` (one mode: the reference kernel), `compile_coarse4x4`
-//!   (one mode: the coarse and fine 4x4 kernels), `compile_default` (the nine
-//!   kernels), and `naga_validate` (naga parsing + validation of the nine
+//!   (one mode: the coarse and fine 4x4 kernels), `compile_default` (the eleven
+//!   kernels), and `naga_validate` (naga parsing + validation of the eleven
 //!   kernels alone, one after the other: the part of `compile_default` that is
 //!   not mrsl's own code).
 //! * `growth`: the same program at N = 1,000 and 3,000 (`check`,
@@ -265,7 +265,7 @@ fn bench_generated(c: &mut Criterion) {
             });
         }
 
-        // naga's share of `compile_default`: parsing and validating the nine kernels.
+        // naga's share of `compile_default`: parsing and validating the eleven kernels.
         let kernels: Vec<String> = mrsl::compile(&source, &default)
             .expect("generated program compiles")
             .compiled
@@ -273,7 +273,8 @@ fn bench_generated(c: &mut Criterion) {
             .into_iter()
             .map(|k| k.wgsl)
             .collect();
-        eprintln!("generated/{n}: {} bytes of WGSL in 9 kernels", kernels.iter().map(String::len).sum::<usize>());
+        let bytes = kernels.iter().map(String::len).sum::<usize>();
+        eprintln!("generated/{n}: {bytes} bytes of WGSL in {} kernels", kernels.len());
         group.bench_with_input(BenchmarkId::new("naga_validate", n), &kernels, |bench, kernels| {
             bench.iter(|| {
                 for wgsl in kernels {
@@ -309,7 +310,7 @@ fn bench_growth(c: &mut Criterion) {
     group.finish();
 }
 
-/// The derivative chain of each length, all nine kernels.
+/// The derivative chain of each length, all eleven kernels.
 fn bench_chain(c: &mut Criterion) {
     let options = mrsl::Options::default();
     let mut group = c.benchmark_group("chain");

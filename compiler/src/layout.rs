@@ -212,7 +212,7 @@ pub fn build(
                 .collect(),
         },
         refine_mask: ResourceBinding {
-            name: "mrsl_rate".into(),
+            name: "mrsl_refine_mask".into(),
             group: GROUP_STAGE,
             binding: 2 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
             kind: ResourceKind::RefineMask,

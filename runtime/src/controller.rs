@@ -19,7 +19,9 @@ use crate::Stats;
 pub enum Target {
     /// Fraction of the reference's shading work (see [`Stats::shaded_fraction`]).
     ShadedFraction(f64),
-    /// Milliseconds of GPU time for the shading passes ([`crate::Timings::total_ms`]).
+    /// Milliseconds of GPU time for the shading passes ([`crate::Timings::total_ms`]):
+    /// needs a GPU's timestamps (on lavapipe they do not measure the shader
+    /// work; pass a wall time to `update` there).
     PassTimeMs(f64),
 }
 

@@ -6,10 +6,31 @@
 pub enum Error {
     #[error("G-buffer channel `{0}` is not bound")]
     MissingChannel(String),
+    /// `accepted` says in words which other formats the channel takes.
     #[error(
-        "G-buffer channel `{channel}` has format {found:?}, but the program reads it as `{ty}` (expected {expected}, or a format with the same sample type and at least {components} components)"
+        "G-buffer channel `{channel}` has format {found:?}, but the program reads it as `{ty}`: bind {expected:?} (the layout's format) or {accepted}"
     )]
-    ChannelFormat { channel: String, ty: String, expected: String, components: u32, found: wgpu::TextureFormat },
+    ChannelFormat {
+        channel: String,
+        ty: String,
+        expected: wgpu::TextureFormat,
+        accepted: String,
+        found: wgpu::TextureFormat,
+    },
+    #[error(
+        "G-buffer channel `{channel}` has the depth/stencil format {found:?}, which is not accepted as a channel (the kernels read channels as colour textures): in an engine pass, write what the program reads as `{ty}` into a {expected:?} texture (depth itself fits an R32Float channel, `in float depth`), or reconstruct it from depth (a position, for example) and bind that"
+    )]
+    ChannelDepthFormat { channel: String, ty: String, expected: wgpu::TextureFormat, found: wgpu::TextureFormat },
+    #[error(
+        "G-buffer channel `{channel}` was not created with TextureUsages::{missing}, which the kernels need to read it: add it to the texture's usage"
+    )]
+    ChannelUsage { channel: String, missing: &'static str },
+    /// A channel's or output's texture is not a single-sample 2D texture of
+    /// one layer (and, for an output, one mip level); `found` says what it is.
+    #[error(
+        "{what} `{name}` is {found}, but the kernels bind a single-sample 2D texture of one layer (and, for an output, one mip level)"
+    )]
+    TextureShape { what: &'static str, name: String, found: String },
     #[error("{what} `{name}` is {found_width}x{found_height}, but the target is {width}x{height}")]
     SizeMismatch { what: &'static str, name: String, width: u32, height: u32, found_width: u32, found_height: u32 },
     #[error("uniform `{0}` has no default and was not set")]
@@ -18,15 +39,32 @@ pub enum Error {
     UnknownUniform(String),
     #[error("uniform `{name}` is `{ty}` ({expected} components), but {found} values were given")]
     UniformComponents { name: String, ty: String, expected: usize, found: usize },
+    /// A value the uniform's scalar type does not hold as given: `reason`
+    /// says why (not an integer, out of range, not 0 or 1, not finite).
+    #[error("uniform `{name}` is `{ty}`, but {} {reason}", value_at(ty, *index, *value))]
+    UniformValue { name: String, ty: String, index: usize, value: f64, reason: &'static str },
+    /// A typed setter (`Shader::set_uniform_u32`, ...) for another scalar type.
+    #[error(
+        "uniform `{name}` is `{ty}`, but {given} values were given: use the setter of its scalar type (set_uniform_f32, set_uniform_i32, set_uniform_u32, set_uniform_bool) or set_uniform"
+    )]
+    UniformType { name: String, ty: String, given: &'static str },
     #[error("texture `{0}` is not bound")]
     MissingTexture(String),
+    #[error(
+        "texture `{0}` was not created with TextureUsages::TEXTURE_BINDING, which the kernels need to sample it: add it to the texture's usage"
+    )]
+    TextureUsage(String),
     #[error("sampler `{0}` is not bound")]
     MissingSampler(String),
     #[error("output `{0}` is not bound")]
     MissingOutput(String),
-    #[error("output `{name}` must be a {expected:?} storage texture, found {found:?}")]
-    OutputFormat { name: String, expected: wgpu::TextureFormat, found: wgpu::TextureFormat },
-    #[error("output `{0}` was not created with TextureUsages::STORAGE_BINDING")]
+    /// `hint` says how to fix it: the `@format` that declares the found
+    /// format, where the language has one for the output's type.
+    #[error("output `{name}` must be a {expected:?} storage texture, found {found:?}: {hint}")]
+    OutputFormat { name: String, expected: wgpu::TextureFormat, found: wgpu::TextureFormat, hint: String },
+    #[error(
+        "output `{0}` was not created with TextureUsages::STORAGE_BINDING, which the kernels need to write it: add it to the texture's usage"
+    )]
     OutputUsage(String),
     #[error("target size {width}x{height} is not supported: {reason}")]
     BadSize { width: u32, height: u32, reason: String },
@@ -59,4 +97,13 @@ pub enum Error {
     BadTileSize(u32),
     #[error("rate option `{name}` is {value}, but it must be a finite number >= 0")]
     BadRateOption { name: &'static str, value: f32 },
+}
+
+/// Where a uniform's value at fault is: "its value V" for a scalar,
+/// "component K, V," for a vector, matrix or array.
+fn value_at(ty: &str, index: usize, value: f64) -> String {
+    match ty.parse::<mrsl_abi::ValueType>() {
+        Ok(t) if t.components() == 1 => format!("its value {value}"),
+        _ => format!("component {index}, {value},"),
+    }
 }

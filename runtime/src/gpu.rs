@@ -22,6 +22,12 @@ pub fn wgpu_format(format: TextureFormat) -> wgpu::TextureFormat {
     }
 }
 
+/// The layout format of a wgpu format, if the layout has it (the formats a
+/// program can declare for its outputs and the exact channel formats).
+pub fn layout_format(format: wgpu::TextureFormat) -> Option<TextureFormat> {
+    TextureFormat::ALL.into_iter().find(|f| wgpu_format(*f) == format)
+}
+
 /// Maps `buffer` and copies its contents out (waits for the GPU).
 pub fn read_buffer<T: bytemuck::Pod>(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<T>, Error> {
     let slice = buffer.slice(..);

@@ -41,7 +41,7 @@ mod validate;
 
 pub use error::Error;
 pub use gpu::wgpu_format;
-pub use mrsl_abi::{CompiledProgram, KernelKind, Layout, Mode, Plan, ReadError};
+pub use mrsl_abi::{CompiledProgram, KernelKind, Layout, Mode, Plan, ReadError, RefineMaskTexel};
 pub use rate_source::{Combiner, ExternalRates, Foveation, Preset, RateInputs, RateOptions, RateSource};
 pub use shader::{Bindings, DispatchOptions, Shader};
 pub use stats::{EffectStats, Stats, Timings};

@@ -10,7 +10,7 @@ use crate::pool::ResourcePool;
 use crate::uniforms::UniformValues;
 use crate::{Mode, Stats};
 use mrsl_abi::plan::{DispatchContext, ModePlan, Pass, SampleCount, Stage, Step, Workgroups};
-use mrsl_abi::{CompiledProgram, Control, GROUP_ARGS, KernelKind, KernelRef, Layout, Plan, ResourceId};
+use mrsl_abi::{CompiledProgram, Control, GROUP_ARGS, KernelKind, KernelRef, Layout, Plan, ResourceId, Scalar};
 use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
@@ -51,8 +51,10 @@ pub struct DispatchOptions {
     /// Count per-pixel re-evaluations ([`Shader::read_stats`]) and write the
     /// per-pixel refine mask ([`Shader::refine_mask`]). On by default; turn it
     /// off for frames that are only displayed or timed: the counters are
-    /// workgroup atomics and a barrier per tile, under 2% of a coarse 4x4
-    /// frame on lavapipe in the ablations of docs/evaluation.md.
+    /// workgroup atomics and a barrier per tile, whose cost depends on the
+    /// program and scene (on lavapipe 8% to 35% of a coarse 4x4 frame in the
+    /// ablation of docs/evaluation.md, 18% for the demo at 640x360;
+    /// docs/runtime.md, section 5).
     pub statistics: bool,
 }
 
@@ -245,9 +247,39 @@ impl Shader {
     }
 
     /// Sets a uniform's value: its components in order (matrices column by
-    /// column, bools as 0/1). Uniforms not set take their declared default.
+    /// column, arrays element by element, bools as 0/1). Uniforms not set
+    /// take their declared default. Each value must be one the uniform's
+    /// scalar type holds: a finite float within f32's range; for `int` and
+    /// `uint` an integer within i32's or u32's range; for `bool` 0 or 1
+    /// ([`Error::UniformValue`] otherwise, and the uniform keeps its value).
     pub fn set_uniform(&mut self, name: &str, values: &[f64]) -> Result<(), Error> {
         self.uniform_values.set(self.layout.uniforms.as_ref(), name, values)
+    }
+
+    /// Sets a `float` uniform (vector, matrix or array of floats) from f32
+    /// values, as [`Shader::set_uniform`] does; a uniform of another scalar
+    /// type is [`Error::UniformType`].
+    pub fn set_uniform_f32(&mut self, name: &str, values: &[f32]) -> Result<(), Error> {
+        let values: Vec<f64> = values.iter().map(|&v| f64::from(v)).collect();
+        self.uniform_values.set_typed(self.layout.uniforms.as_ref(), name, (Scalar::Float, "f32"), &values)
+    }
+
+    /// Sets an `int` uniform (or vector or array of ints); see [`Shader::set_uniform_f32`].
+    pub fn set_uniform_i32(&mut self, name: &str, values: &[i32]) -> Result<(), Error> {
+        let values: Vec<f64> = values.iter().map(|&v| f64::from(v)).collect();
+        self.uniform_values.set_typed(self.layout.uniforms.as_ref(), name, (Scalar::Int, "i32"), &values)
+    }
+
+    /// Sets a `uint` uniform (or vector or array of uints); see [`Shader::set_uniform_f32`].
+    pub fn set_uniform_u32(&mut self, name: &str, values: &[u32]) -> Result<(), Error> {
+        let values: Vec<f64> = values.iter().map(|&v| f64::from(v)).collect();
+        self.uniform_values.set_typed(self.layout.uniforms.as_ref(), name, (Scalar::Uint, "u32"), &values)
+    }
+
+    /// Sets a `bool` uniform (or vector or array of bools); see [`Shader::set_uniform_f32`].
+    pub fn set_uniform_bool(&mut self, name: &str, values: &[bool]) -> Result<(), Error> {
+        let values: Vec<f64> = values.iter().map(|&v| f64::from(u8::from(v))).collect();
+        self.uniform_values.set_typed(self.layout.uniforms.as_ref(), name, (Scalar::Bool, "bool"), &values)
     }
 
     /// Whether [`Shader::encode`] can run `mode`: the device runs its kernels
@@ -389,10 +421,13 @@ impl Shader {
     }
 
     /// The per-pixel refine mask of the last dispatch of a mode with coarse
-    /// effects: x bit k set when coarse effect k (`layout().stats.counters[k]`)
+    /// effects: x bit k set when coarse effect k (`layout().stats.counters[k]`,
+    /// in dependency order, not the declaration order of `Stats::effects`)
     /// was evaluated per pixel, y bit k when it was taken from the dynamic
-    /// mode's 2x2 level. `None` before any such dispatch; a dispatch with
-    /// `DispatchOptions::statistics` off leaves it as it was.
+    /// mode's 2x2 level; [`Layout::refine_mask_bit`] gives an effect's bit and
+    /// [`Layout::decode_refine_mask`] a texel's effects by name. `None` before
+    /// any such dispatch; a dispatch with `DispatchOptions::statistics` off
+    /// leaves it as it was.
     pub fn refine_mask(&self) -> Option<&wgpu::Texture> {
         self.pool.texture(ResourceId::RefineMask)
     }

@@ -8,12 +8,13 @@ use mrsl_abi::{Layout, Rate};
 
 /// GPU time of the passes, from timestamp queries.
 ///
-/// `total_ms` spans from the first pass's beginning to the last pass's end:
-/// the number to compare between modes. The split between passes is only as
-/// good as the device's timestamps: lavapipe writes a timestamp when its
-/// queue thread reaches it, while a dispatch may still run on its worker
-/// threads, so there a pass's time can show up in the next pass's (see
-/// docs/evaluation.md).
+/// `total_ms` spans from the first pass's beginning to the last pass's end.
+/// All of it is only as good as the device's timestamps: on a GPU it is the
+/// passes' time, the number to compare between modes; on a CPU device such
+/// as lavapipe, which writes a timestamp when its queue thread reaches it
+/// while the dispatches run on its worker threads, it does not measure the
+/// shader work (a 7 ms pass can read as 0.05 ms). Measure wall time there
+/// (docs/runtime.md, section 9).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Timings {
     pub coarse_ms: f64,

@@ -59,6 +59,13 @@ pub fn binding_mismatches_are_typed_errors(gpu: &Gpu) {
         Err(Error::UniformComponents { expected: 16, found: 3, .. })
     ));
     shader.set_uniform("lights", &[0.5; 16]).unwrap();
+    // Values the type does not hold, and typed setters of another type.
+    assert!(matches!(
+        shader.set_uniform("gain", &[f64::INFINITY]),
+        Err(Error::UniformValue { index: 0, reason: "is not a finite number", .. })
+    ));
+    assert!(matches!(shader.set_uniform_u32("gain", &[1]), Err(Error::UniformType { given: "u32", .. })));
+    shader.set_uniform_f32("gain", &[1.0]).unwrap();
     // Output of the wrong format.
     let wrong = gpu.output_texture("color", (16, 8), wgpu::TextureFormat::Rgba8Unorm);
     bindings.outputs.insert("color".into(), &wrong);
@@ -92,6 +99,96 @@ pub fn binding_mismatches_are_typed_errors(gpu: &Gpu) {
     bindings.size = (16, 8);
     // And with everything right, it runs.
     dispatch(gpu, &mut shader, &bindings).unwrap();
+}
+
+/// What an engine's own textures get wrong, found before anything is
+/// recorded, each a typed error naming the binding and saying what to do:
+/// a channel or output without the usage its binding needs, a channel
+/// format of the right kind but not the right count (a 3-component format
+/// for a `float3`), a depth format as a channel, an array or multisampled
+/// texture, an output format that an `@format` would declare.
+pub fn engine_textures_are_checked_before_recording(gpu: &Gpu) {
+    let program = compile(PROGRAM);
+    let size = (16, 8);
+    let gbuffer = Scene::Demo.render(size.0, size.1);
+    let channels = gbuffer.upload(gpu);
+    let get = |name: &str| &channels.iter().find(|(n, _)| n == name).unwrap().1;
+    let output = gpu.output_texture("color", size, wgpu::TextureFormat::Rgba32Float);
+    let mut shader = Shader::new(&gpu.device, &program).unwrap();
+    shader.set_uniform("lights", &[0.5; 16]).unwrap();
+    let mut bindings = Bindings { size, ..Default::default() };
+    bindings.channels.insert("material".into(), get("material"));
+    bindings.outputs.insert("color".into(), &output);
+    let texture = |format, usage| gpu.texture_2d("engine", size, format, usage);
+    let sampled = wgpu::TextureUsages::TEXTURE_BINDING;
+    let error = |bindings: &Bindings, shader: &mut Shader| match dispatch(gpu, shader, bindings) {
+        Err(e) => (e.to_string(), e),
+        Ok(()) => panic!("expected an error"),
+    };
+
+    // A G-buffer texture created without TEXTURE_BINDING (the trial's first finding).
+    let unsampled = texture(wgpu::TextureFormat::Rgba32Float, wgpu::TextureUsages::COPY_DST);
+    bindings.channels.insert("normal".into(), &unsampled);
+    let (text, e) = error(&bindings, &mut shader);
+    assert_eq!(e, Error::ChannelUsage { channel: "normal".into(), missing: "TEXTURE_BINDING" });
+    assert!(text.contains("`normal`") && text.contains("add it to the texture's usage"), "{text}");
+    // A 3-component format for a float3: the message says exactly 4 are needed.
+    let packed = texture(wgpu::TextureFormat::Rg11b10Ufloat, sampled);
+    bindings.channels.insert("normal".into(), &packed);
+    let (text, e) = error(&bindings, &mut shader);
+    assert!(matches!(e, Error::ChannelFormat { ref channel, .. } if channel == "normal"), "{e:?}");
+    assert!(text.contains("exactly 4 components") && text.contains("bind Rgba32Float"), "{text}");
+    // A depth format: not accepted as a channel, and what to do instead.
+    let depth = texture(wgpu::TextureFormat::Depth32Float, sampled);
+    bindings.channels.insert("normal".into(), &depth);
+    let (text, e) = error(&bindings, &mut shader);
+    assert!(matches!(e, Error::ChannelDepthFormat { ref channel, .. } if channel == "normal"), "{e:?}");
+    assert!(text.contains("not accepted as a channel") && text.contains("reconstruct it from depth"), "{text}");
+    // A texture array of two layers.
+    let layered = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("layered"),
+        size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 2 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba32Float,
+        usage: sampled,
+        view_formats: &[],
+    });
+    bindings.channels.insert("normal".into(), &layered);
+    let (text, e) = error(&bindings, &mut shader);
+    assert!(matches!(e, Error::TextureShape { ref name, .. } if name == "normal"), "{e:?}");
+    assert!(text.contains("2 layers"), "{text}");
+    bindings.channels.insert("normal".into(), get("normal"));
+
+    // An output the language could declare in this format: the hint says how.
+    let half = gpu.output_texture("color", size, wgpu::TextureFormat::Rgba16Float);
+    bindings.outputs.insert("color".into(), &half);
+    let (text, e) = error(&bindings, &mut shader);
+    assert!(matches!(e, Error::OutputFormat { ref name, .. } if name == "color"), "{e:?}");
+    assert!(text.contains("`@format(rgba16float) fine out float4 color`"), "{text}");
+    // An output without STORAGE_BINDING.
+    let unwritable = texture(wgpu::TextureFormat::Rgba32Float, sampled | wgpu::TextureUsages::COPY_SRC);
+    bindings.outputs.insert("color".into(), &unwritable);
+    assert_eq!(error(&bindings, &mut shader).1, Error::OutputUsage("color".into()));
+    bindings.outputs.insert("color".into(), &output);
+    dispatch(gpu, &mut shader, &bindings).unwrap();
+
+    // A sampled texture created without TEXTURE_BINDING.
+    let textured = compile(
+        "in float2 uv;\nuniform texture2d albedo_map;\nuniform sampler linear;\n\
+         fine out float4 color = sample(albedo_map, linear, uv);",
+    );
+    let mut shader = Shader::new(&gpu.device, &textured).unwrap();
+    let storage_only = texture(wgpu::TextureFormat::Rgba8Unorm, wgpu::TextureUsages::STORAGE_BINDING);
+    let view = storage_only.create_view(&Default::default());
+    let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor::default());
+    let mut bindings = Bindings { size, ..Default::default() };
+    bindings.channels.insert("uv".into(), get("uv"));
+    bindings.textures.insert("albedo_map".into(), &view);
+    bindings.samplers.insert("linear".into(), &sampler);
+    bindings.outputs.insert("color".into(), &output);
+    assert_eq!(error(&bindings, &mut shader).1, Error::TextureUsage("albedo_map".into()));
 }
 
 pub fn unknown_modes_are_named() {

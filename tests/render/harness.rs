@@ -126,7 +126,11 @@ pub fn dispatch_in_turn<const N: usize>(
         for f in &block.fields {
             if f.default.is_none() {
                 let n = f.ty.components();
-                let values: Vec<f64> = (0..n).map(|i| 0.25 + 0.5 * ((i * 7919) % 13) as f64 / 13.0).collect();
+                // Floats in [0.25, 0.75); integers and bools 0 (what those floats were cast to
+                // before set_uniform checked values against their type).
+                let float = f.ty.scalar() == mrsl_abi::Scalar::Float;
+                let value = |i: u32| if float { 0.25 + 0.5 * ((i * 7919) % 13) as f64 / 13.0 } else { 0.0 };
+                let values: Vec<f64> = (0..n).map(value).collect();
                 shader.set_uniform(&f.name, &values)?;
             }
         }

@@ -40,6 +40,7 @@ const GPU_TESTS: &[GpuTest] = &[
     ("binding::textured_materials_are_lit_over_a_mesh_scene", binding::textured_materials_are_lit_over_a_mesh_scene),
     ("binding::mismatches_without_defaults_are_typed_errors", binding::mismatches_without_defaults_are_typed_errors),
     ("errors::binding_mismatches_are_typed_errors", errors::binding_mismatches_are_typed_errors),
+    ("errors::engine_textures_are_checked_before_recording", errors::engine_textures_are_checked_before_recording),
     (
         "frames::velocity_is_the_projection_difference_of_a_camera_move",
         frames::velocity_is_the_projection_difference_of_a_camera_move,
@@ -68,6 +69,7 @@ const GPU_TESTS: &[GpuTest] = &[
         modes::statistics_off_changes_nothing_but_the_instrumentation,
     ),
     ("modes::keys_refine_only_the_effects_that_read_them", modes::keys_refine_only_the_effects_that_read_them),
+    ("modes::refine_masks_decode_to_the_counted_effects", modes::refine_masks_decode_to_the_counted_effects),
     ("modes::compacted_fine_pass_equals_the_plain_one", modes::compacted_fine_pass_equals_the_plain_one),
     ("modes::silhouettes_are_never_blended", modes::silhouettes_are_never_blended),
     ("modes::odd_sizes_cover_every_pixel", modes::odd_sizes_cover_every_pixel),

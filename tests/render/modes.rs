@@ -476,3 +476,55 @@ pub fn statistics_off_changes_nothing_but_the_instrumentation(gpu: &Gpu) {
         assert!(masks.contains(&0), "{mode}: no pixel resampled everything");
     }
 }
+
+/// Three coarse effects whose refine-mask bits (`stats.counters`, in
+/// dependency order) are not in their declaration order.
+const DECODED: &str = "
+in float3 normal;
+coarse effect float shade = lit * 0.5 + rim;
+coarse effect float lit {
+    lit = saturate(normal.y);
+    if (fwidth(lit) > 0.05) refine;
+}
+coarse effect float rim {
+    rim = 1.0 - saturate(normal.z);
+    if (fwidth(rim) > 0.2) refine;
+}
+fine out float4 color = float4(shade, lit, rim, 1.0);
+";
+
+/// `Layout::decode_refine_mask` names the bits of a real refine mask: in
+/// every coarse mode, the pixels whose decoded texel names an effect as
+/// evaluated per pixel are exactly those the statistics count for that
+/// effect by name, although the mask's bit order is not the declaration
+/// order of `Stats::effects`.
+pub fn refine_masks_decode_to_the_counted_effects(gpu: &Gpu) {
+    use mrsl_runtime::RefineMaskTexel;
+    let program = compile(DECODED);
+    let layout = &program.layout;
+    assert_ne!(layout.stats.counters, ["shade", "lit", "rim"], "the test wants the two orders to differ");
+    let size = (64, 40);
+    let gbuffer = Scene::Demo.render(size.0, size.1);
+    let tile = mrsl_abi::shading_rate::DEFAULT_RATE_TILE;
+    let rates = mrsl_lab::shading_rate::pattern(mrsl_abi::shading_rate::rate_image_size(size, tile));
+    let mut partly_refined = 0;
+    for mode in COARSE_MODES {
+        let [run] = dispatch_in_turn(gpu, &program, &gbuffer, &rates, [DispatchOptions::new(mode)]).unwrap();
+        let stats = run.stats.unwrap();
+        let mut counted = std::collections::HashMap::<&str, u64>::new();
+        for (&x, &y) in run.refine_masks.unwrap().iter().zip(&run.refine_masks_y.unwrap()) {
+            match layout.decode_refine_mask([x, y]) {
+                RefineMaskTexel::Shaded { per_pixel, .. } => {
+                    per_pixel.into_iter().for_each(|name| *counted.entry(name).or_default() += 1)
+                }
+                RefineMaskTexel::Background => panic!("{mode}: the program has no background rule"),
+            }
+        }
+        for e in stats.effects.iter().filter(|e| e.rate == mrsl_abi::Rate::Coarse) {
+            let decoded = counted.get(e.name.as_str()).copied().unwrap_or(0);
+            assert_eq!(decoded, e.pixel_evaluations, "{mode}: `{}` in the decoded mask and the statistics", e.name);
+            partly_refined += usize::from(0 < decoded && decoded < u64::from(size.0 * size.1));
+        }
+    }
+    assert!(partly_refined > 0, "no effect was refined at some pixels only: the test proves little");
+}

@@ -4,7 +4,7 @@
 use super::{Variant, edit_lines, indent};
 use mrsl_abi::{CompiledProgram, KernelKind};
 
-/// The statistics atomics, their barrier and the rate-image store: the
+/// The statistics atomics, their barrier and the refine-mask store: the
 /// blocks a dispatch with `DispatchOptions::statistics` off skips, removed
 /// from the text (the full kernel and the other variants run with them).
 pub(super) fn no_instrumentation(w: &str) -> Option<String> {
@@ -116,7 +116,7 @@ pub(super) fn no_fine_work(w: &str) -> Option<String> {
 pub(super) const VARIANTS: [Variant; 7] = [
     Variant {
         name: "no instrumentation",
-        removes: "the statistics atomics, their barrier and the rate-image store (`DispatchOptions::statistics` off)",
+        removes: "the statistics atomics, their barrier and the refine-mask store (`DispatchOptions::statistics` off)",
         edits: &[no_instrumentation],
     },
     Variant {

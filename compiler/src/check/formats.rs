@@ -4,20 +4,10 @@
 use crate::types::{Scalar, Type};
 use mrsl_abi::TextureFormat;
 
-/// Storage-texture formats an output of type `ty` may be written to.
+/// Storage-texture formats an output of type `ty` may be written to (the
+/// contract's table, [`TextureFormat::for_output`]).
 pub(super) fn formats_for(ty: &Type) -> Vec<TextureFormat> {
-    use TextureFormat as F;
-    // A format must hold every component: single-channel formats only for
-    // scalars, two-channel ones for at most two components.
-    let n = ty.components();
-    let any = match ty {
-        Type::Scalar(Scalar::Float) => vec![F::R32Float, F::Rgba16Float, F::Rgba32Float, F::Rgba8Unorm],
-        Type::Vector(Scalar::Float, _) => vec![F::Rgba32Float, F::Rgba16Float, F::Rgba8Unorm, F::Rg32Float],
-        Type::Scalar(Scalar::Uint) | Type::Vector(Scalar::Uint, _) => vec![F::R32Uint, F::Rgba32Uint],
-        Type::Scalar(Scalar::Int) | Type::Vector(Scalar::Int, _) => vec![F::R32Sint, F::Rgba32Sint],
-        _ => vec![],
-    };
-    any.into_iter().filter(|f| f.components() >= n.min(4) || f.components() == 4).collect()
+    ty.value_type().map(|v| TextureFormat::for_output(&v)).unwrap_or_default()
 }
 
 /// The format called `format`, if an output of type `ty` may be written to it.

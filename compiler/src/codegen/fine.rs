@@ -443,7 +443,7 @@ impl<'b> Writer<'_, '_, 'b> {
 
     /// The fine kernels' `main` after `mrsl_tile_pixel`: the pixel's
     /// prologue resolves it (where the entry point has not: [`Scope`]) and, with
-    /// statistics on, writes the rate image and counts the coarse effects
+    /// statistics on, writes the refine mask and counts the coarse effects
     /// it re-evaluates; then the effects (see [`Writer::pixel_main`]).
     pub(super) fn fine_main(&mut self) {
         let counted = self.counts_stats();

@@ -13,7 +13,7 @@
 //!   to re-evaluate it (a corner flagged it, a discontinuity key differs, or
 //!   a shared slot holds another effect) or to resample the passed values;
 //!   then it evaluates fine effects and stores the outputs, and counts
-//!   re-evaluations in the statistics and the rate image.
+//!   re-evaluations in the statistics and the refine mask.
 //! - **reference** (`reference_main`): every effect per pixel, what a fully
 //!   refined image must equal.
 //! - **dynamic coarse** (`dynamic_coarse_main`): the dynamic mode's second

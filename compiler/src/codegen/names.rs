@@ -313,7 +313,7 @@ pub(super) const FIXED: &[&str] = &[
     // resources.wgsl, uniforms.wgsl, stats.wgsl, positions.wgsl: bindings and position helpers
     "MrslControl",
     "MrslUniforms",
-    "mrsl_rate",
+    "mrsl_refine_mask",
     "mrsl_pixel",
     "mrsl_pair_x",
     "mrsl_pair_y",

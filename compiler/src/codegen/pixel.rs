@@ -17,7 +17,7 @@ use mrsl_abi::KernelKind;
 use mrsl_abi::geometry::{FINE_PIXELS_PER_LANE, TILE};
 
 /// The condition of the instrumentation a dispatch runs only with statistics
-/// on (control field `statistics`): the rate image and the counters.
+/// on (control field `statistics`): the refine mask and the counters.
 pub(super) fn statistics_enabled() -> String {
     format!("{CONTROL}.statistics != 0u")
 }
@@ -34,7 +34,7 @@ pub(super) enum Scope {
 
 impl Writer<'_, '_, '_> {
     /// Whether the kernel counts per-pixel re-evaluations of coarse effects
-    /// (statistics and rate image): the per-pixel kernels that can reuse
+    /// (statistics and refine mask): the per-pixel kernels that can reuse
     /// coarse values, when there are live coarse effects.
     pub(super) fn counts_stats(&self) -> bool {
         let per_pixel_reuse =
@@ -42,7 +42,7 @@ impl Writer<'_, '_, '_> {
         per_pixel_reuse && !self.coarse_live().is_empty()
     }
 
-    /// The statistics counters (global and per workgroup) and the rate image.
+    /// The statistics counters (global and per workgroup) and the refine mask.
     pub(super) fn stats_bindings(&mut self) {
         let l = self.i.layout;
         let [head, tail] = cut(include_str!("templates/stats.wgsl"), &["BUFFER"]);
@@ -53,8 +53,8 @@ impl Writer<'_, '_, '_> {
             tail,
             &[
                 ("COUNTERS", &self.workgroup_counters()),
-                ("RATE_GROUP", &l.refine_mask.group),
-                ("RATE_BINDING", &l.refine_mask.binding),
+                ("MASK_GROUP", &l.refine_mask.group),
+                ("MASK_BINDING", &l.refine_mask.binding),
             ],
         );
     }
@@ -101,7 +101,7 @@ impl Writer<'_, '_, '_> {
 
     /// The kernel's main entry point, one lane per pixel of a tile (after
     /// `mrsl_tile_pixel`). Inside the image, `prologue` runs (refine
-    /// decisions, rate image, statistics), then every live effect in
+    /// decisions, refine mask, statistics), then every live effect in
     /// dependency order: coarse ones as `coarse` writes them (at an
     /// indentation), the others evaluated; then the outputs are stored.
     ///
@@ -231,7 +231,7 @@ impl Writer<'_, '_, '_> {
     }
 
     /// Opens the block of instrumentation a dispatch runs only with
-    /// statistics on (control field `statistics`): the rate image and the
+    /// statistics on (control field `statistics`): the refine mask and the
     /// counters. Timed runs leave it out; the branch is uniform.
     pub(super) fn statistics_on(&mut self, indent: usize) {
         self.line(indent, format!("if ({}) {{", statistics_enabled()));

@@ -204,3 +204,38 @@ fn the_cost_model_counts_the_value_alone_for_per_pixel_evaluations() {
     // The predicate evaluates `heavy` at four neighbours (two per difference).
     assert!(shade >= shade_value + 4 * heavy, "{shade} {shade_value} {heavy}");
 }
+
+/// The refine mask's bit k is coarse effect `stats.counters[k]`, which
+/// follows the dependency order, not the declaration order of
+/// `Layout::effects` (and `Stats::effects`); `Layout::refine_mask_bit` and
+/// `Layout::decode_refine_mask` name the bits so that engines need not know.
+#[test]
+fn refine_mask_bits_are_decoded_by_effect_name() {
+    use mrsl_abi::{BACKGROUND_MARK, RefineMaskTexel};
+    let source = "in float3 normal;\n\
+                  coarse effect float shade = lit * 0.5;\n\
+                  coarse effect float lit = saturate(normal.y);\n\
+                  coarse effect float rim = 1.0 - saturate(normal.z);\n\
+                  coarse effect float unused = normal.x;\n\
+                  fine out float4 color = float4(shade, lit, rim, 1.0);\n";
+    let program = mrsl::compile(source, &Options::for_modes(&[mrsl::Mode::Coarse4x4])).unwrap();
+    let layout = &program.layout;
+    let declared: Vec<&str> = ["shade", "lit", "rim"].into();
+    assert_ne!(layout.stats.counters, declared, "the test wants the two orders to differ");
+    for (k, name) in layout.stats.counters.iter().enumerate() {
+        assert_eq!(layout.refine_mask_bit(name), Some(k as u32), "{name}");
+    }
+    // Only live coarse effects have a bit.
+    for name in ["unused", "color", "normal", "nope"] {
+        assert_eq!(layout.refine_mask_bit(name), None, "{name}");
+    }
+    let bit = |name| 1u32 << layout.refine_mask_bit(name).unwrap();
+    // Bits beyond the program's coarse effects are ignored.
+    let texel = [bit("rim") | bit("shade") | 1 << 20, bit("lit")];
+    assert_eq!(
+        layout.decode_refine_mask(texel),
+        RefineMaskTexel::Shaded { per_pixel: vec!["shade", "rim"], from_2x2: vec!["lit"] }
+    );
+    assert_eq!(layout.decode_refine_mask([0, 0]), RefineMaskTexel::Shaded { per_pixel: vec![], from_2x2: vec![] });
+    assert_eq!(layout.decode_refine_mask(BACKGROUND_MARK), RefineMaskTexel::Background);
+}
