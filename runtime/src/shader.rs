@@ -44,7 +44,8 @@ pub struct DispatchOptions {
     /// the output must then equal the reference.
     pub force_refine: bool,
     /// Hierarchical mode: a pixel is interpolated only while the variance of
-    /// its four neighbours' values (each component, linear) is at most this.
+    /// its neighbours' values (the largest component's) is at most this
+    /// times the largest square of those values (a relative spread).
     pub similarity: f32,
     /// Rate-image mode: pixels per side of a shading-rate tile (8 or 16).
     pub rate_tile: u32,
@@ -59,7 +60,8 @@ pub struct DispatchOptions {
 }
 
 impl DispatchOptions {
-    /// Default similarity threshold of the hierarchical mode (variance, linear units).
+    /// Default similarity threshold of the hierarchical mode (a relative
+    /// variance: a standard deviation of about 3% of the values).
     pub const DEFAULT_SIMILARITY: f32 = 1e-3;
 
     pub fn new(mode: Mode) -> DispatchOptions {
