@@ -427,6 +427,8 @@ fn controller_run(
     let mut controller = ThresholdController::new(Target::ShadedFraction(args.target_fraction), start, (1e-9, 1e3));
     let bar = progress_bar(args.path_frames, "controller [{bar:30}] {pos}/{len} {msg} ({elapsed})")?;
     let mut frames = vec![];
+    // A CPU device's timestamps do not measure the shader work (docs/runtime.md, section 9).
+    let timestamps_meaningful = gpu.adapter_info.device_type != wgpu::DeviceType::Cpu;
     let mut bench = Bench { gpu, shader, runs: 1 };
     for i in 0..args.path_frames {
         let camera = CameraPath::Walk.camera(&mesh.camera, i, args.path_frames);
@@ -442,7 +444,7 @@ fn controller_run(
             knob: "similarity".into(),
             threshold,
             shaded_fraction: m.stats.shaded_fraction,
-            time_ms: m.gpu_ms.unwrap_or(m.wall_ms),
+            time_ms: if timestamps_meaningful { m.gpu_ms.unwrap_or(m.wall_ms) } else { m.wall_ms },
             target: args.target_fraction,
         });
         controller.update(m.stats.shaded_fraction);

@@ -35,12 +35,14 @@ pub struct Point {
     /// compiler's cost model (the layout's `operations` per evaluation times
     /// the evaluations counted): how many times fewer operations it shades.
     pub fewer_operations: f64,
-    /// Median GPU time of the shading passes (timestamp span), if the device has timestamps.
+    /// Median GPU time of the shading passes (timestamp span), if the device
+    /// has timestamps. Only a GPU's measure the shader work: on a CPU device
+    /// such as lavapipe they do not (docs/runtime.md, section 9), and the
+    /// wall times are what to compare.
     pub gpu_ms: Option<f64>,
     /// Medians of the per-pass timestamps ([`mrsl_runtime::Timings`]): the
     /// coarse passes (4x4 and the dynamic mode's 2x2, or the hierarchical
-    /// levels) and the fine or final pass. On lavapipe the split is not
-    /// reliable (see docs/evaluation.md); `gpu_ms` is.
+    /// levels) and the fine or final pass; meaningful where `gpu_ms` is.
     pub coarse_pass_ms: Option<f64>,
     pub fine_pass_ms: Option<f64>,
     pub rmse: f64,
