@@ -48,6 +48,30 @@ fn no_work_list_shading(w: &str) -> Option<String> {
     edit_lines(w, |l| l.trim_start().starts_with("mrsl_shade(vec2<i32>(i32(index % ").then(String::new))
 }
 
+/// The final pass's record reads (its coarse values read as zero).
+fn no_final_record_reads(w: &str) -> Option<String> {
+    // The type each `mrsl_hget_<e>` returns, from its signature.
+    let types: std::collections::HashMap<String, String> = w
+        .lines()
+        .filter_map(|l| {
+            let rest = l.strip_prefix("fn mrsl_hget_")?;
+            let (name, sig) = rest.split_once('(')?;
+            Some((name.to_string(), sig.rsplit_once("-> ")?.1.trim_end_matches(" {").to_string()))
+        })
+        .collect();
+    let final_pass = std::cell::Cell::new(false);
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        if t.starts_with("fn hier_final(") {
+            final_pass.set(true);
+        }
+        let (lhs, rhs) = t.strip_prefix("let ")?.split_once(" = mrsl_hget_")?;
+        let name = rhs.strip_suffix("(mrsl_pos);")?;
+        let ty = types.get(name)?;
+        final_pass.get().then(|| format!("{}let {lhs} = {ty}();", indent(l)))
+    })
+}
+
 /// Everything: every entry point returns at once, so what is left is the
 /// launches (passes, dispatches, indirect arguments) and their barriers.
 fn launches_only(w: &str) -> Option<String> {
@@ -61,7 +85,12 @@ fn launches_only(w: &str) -> Option<String> {
 /// The variants. "Nothing shaded" is the mode's floor: what it costs where
 /// no pixel past level 0 needs shading; the ones after it take a further
 /// part out of that floor.
-pub(super) const VARIANTS: [Variant; 8] = [
+pub(super) const VARIANTS: [Variant; 9] = [
+    Variant {
+        name: "no final record reads",
+        removes: "the final pass's reads of the coarse values from the records (they read as zero)",
+        edits: &[no_final_record_reads],
+    },
     Variant {
         name: "no instrumentation",
         removes: "the statistics atomics, their barrier and the refine-mask store (`DispatchOptions::statistics` off)",
