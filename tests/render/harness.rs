@@ -95,6 +95,40 @@ pub fn run_at_rates(
     Ok(Output { pixels, stats: stats?, width: gbuffer.width })
 }
 
+/// Renders `mode` with `shader` over a scene's G-buffer `channels`, the
+/// sampled `textures` and `samplers` by name, into a new `rgba32float`
+/// output `color` (the rate-image mode at 8x8 tiles with every rate beside
+/// every other), and reads back the image and the statistics: how the render
+/// tests over mesh scenes run a program.
+pub fn render_color(
+    gpu: &Gpu,
+    shader: &mut Shader,
+    channels: &[(String, wgpu::Texture)],
+    textures: &[(&str, &wgpu::TextureView)],
+    samplers: &[(&str, &wgpu::Sampler)],
+    size: (u32, u32),
+    options: DispatchOptions,
+) -> Output {
+    let color = gpu.output_texture("color", size, wgpu::TextureFormat::Rgba32Float);
+    let shading_rate = mrsl_lab::shading_rate::upload_pattern(gpu, size, 8);
+    let mut bindings = Bindings { size, shading_rate: Some(&shading_rate), ..Default::default() };
+    for (name, texture) in channels {
+        bindings.channels.insert(name.clone(), texture);
+    }
+    for (name, view) in textures {
+        bindings.textures.insert(name.to_string(), view);
+    }
+    for (name, sampler) in samplers {
+        bindings.samplers.insert(name.to_string(), sampler);
+    }
+    bindings.outputs.insert("color".into(), &color);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options).unwrap();
+    gpu.queue.submit([encoder.finish()]);
+    let stats = shader.read_stats(&gpu.device).unwrap();
+    Output { pixels: gpu.read_rgba32f(&color).unwrap(), stats, width: size.0 }
+}
+
 /// What one of [`dispatch_in_turn`]'s dispatches left.
 pub struct Dispatched {
     /// The first output, as RGBA floats.

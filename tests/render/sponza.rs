@@ -2,7 +2,7 @@
 //! every mode, and the pieces that make it (mesh loaders, the rasteriser,
 //! scene files) checked on small inputs with known answers.
 
-use crate::{Output, compile, psnr_of as psnr};
+use crate::{Output, compile, psnr_of as psnr, render_color};
 use mrsl_lab::camera::Camera;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::mesh::{Mesh, MeshError};
@@ -608,25 +608,9 @@ pub fn sponza_lights_workload_matches_its_reference(gpu: &Gpu) {
         for name in ["light_pos", "light_color", "light_count", "sun_pos", "sun_view_proj", "sun_focal", "sun_size"] {
             assert!(set.iter().any(|s| s == name), "the rig did not set `{name}`: {set:?}");
         }
-        let color = gpu.output_texture("color", SIZE, wgpu::TextureFormat::Rgba32Float);
-        let mut bindings = Bindings { size: SIZE, ..Default::default() };
-        for (name, texture) in &channels {
-            bindings.channels.insert(name.clone(), texture);
-        }
-        for (name, view) in &views {
-            bindings.textures.insert(name.to_string(), view);
-        }
-        bindings.samplers.insert("linear".into(), &sampler);
-        bindings.outputs.insert("color".into(), &color);
-        // The rate-image mode gets every rate beside every other.
-        let shading_rate = mrsl_lab::shading_rate::upload_pattern(gpu, SIZE, 8);
-        bindings.shading_rate = Some(&shading_rate);
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let textures: Vec<(&str, &wgpu::TextureView)> = views.iter().map(|(name, view)| (*name, view)).collect();
         let options = DispatchOptions { force_refine, ..DispatchOptions::new(mode) };
-        shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options).unwrap();
-        gpu.queue.submit([encoder.finish()]);
-        let stats = shader.read_stats(&gpu.device).unwrap();
-        Output { pixels: gpu.read_rgba32f(&color).unwrap(), stats, width: SIZE.0 }
+        render_color(gpu, &mut shader, &channels, &textures, &[("linear", &sampler)], SIZE, options)
     };
     let reference = run(Mode::Reference, false);
     // The image is lit: no NaN, and both the lights and the sun reach it.

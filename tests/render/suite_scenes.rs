@@ -5,7 +5,7 @@
 //! they are there (listed as ignored, after a line saying why, where not).
 
 use crate::sponza::{floats, temp_dir};
-use crate::{Output, compile, psnr_of as psnr};
+use crate::{Output, compile, psnr_of as psnr, render_color};
 use libtest_mimic::Trial;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::mesh::{Mesh, MeshError, MeshWarning, TORCS_ALPHA_CUTOFF};
@@ -13,7 +13,7 @@ use mrsl_lab::mesh_scene::MeshScene;
 use mrsl_lab::raster;
 use mrsl_lab::rig::{DEFAULT_LIGHTS, Layout, LightRig, REFERENCE_BOUNDS, light_sum};
 use mrsl_lab::scene::{BACKGROUND, ChannelData, Scene};
-use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader};
+use mrsl_runtime::{DispatchOptions, Mode, Shader};
 
 const SIZE: (u32, u32) = (192, 108);
 
@@ -25,25 +25,12 @@ fn workload<'a>(gpu: &'a Gpu, scene: &'a mut MeshScene, size: (u32, u32)) -> imp
     let shadow_map = scene.shadow_map(gpu).unwrap().create_view(&Default::default());
     let scene: &MeshScene = scene;
     let channels = scene.gbuffer(gpu, &scene.camera, size).unwrap();
-    let shading_rate = mrsl_lab::shading_rate::upload_pattern(gpu, size, 8);
     move |mode: Mode, force_refine: bool| {
         let mut shader = Shader::new(&gpu.device, &program).unwrap();
         let applied = scene.set_uniforms(&mut shader, &scene.camera).unwrap();
         assert_eq!(applied.warnings, [], "the workload declares the rig's uniforms with the rig's types");
-        let color = gpu.output_texture("color", size, wgpu::TextureFormat::Rgba32Float);
-        let mut bindings = Bindings { size, ..Default::default() };
-        for (name, texture) in &channels {
-            bindings.channels.insert(name.clone(), texture);
-        }
-        bindings.textures.insert("shadow_map".into(), &shadow_map);
-        bindings.outputs.insert("color".into(), &color);
-        bindings.shading_rate = Some(&shading_rate);
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let options = DispatchOptions { force_refine, ..DispatchOptions::new(mode) };
-        shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options).unwrap();
-        gpu.queue.submit([encoder.finish()]);
-        let stats = shader.read_stats(&gpu.device).unwrap();
-        Output { pixels: gpu.read_rgba32f(&color).unwrap(), stats, width: size.0 }
+        render_color(gpu, &mut shader, &channels, &[("shadow_map", &shadow_map)], &[], size, options)
     }
 }
 

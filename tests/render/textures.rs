@@ -6,7 +6,7 @@
 //! based deferred example over a textured scene in every mode.
 
 use crate::sponza::{base64, floats, temp_dir};
-use crate::{Output, compile, worst_ulps};
+use crate::{Output, compile, render_color, worst_ulps};
 use mrsl_lab::camera::Camera;
 use mrsl_lab::color::srgb_to_linear;
 use mrsl_lab::gpu::Gpu;
@@ -535,22 +535,8 @@ pub fn pbr_example_renders_textured_content_in_every_mode(gpu: &Gpu) {
         for name in ["light_pos", "light_color", "light_count", "sun_pos", "sun_view_proj", "sun_focal", "camera_pos"] {
             assert!(set.set.iter().any(|s| s == name), "the rig did not set `{name}`: {set:?}");
         }
-        let color = gpu.output_texture("color", size, wgpu::TextureFormat::Rgba32Float);
-        let mut bindings = Bindings { size, ..Default::default() };
-        for (name, texture) in &channels {
-            bindings.channels.insert(name.clone(), texture);
-        }
-        bindings.textures.insert("shadow_map".into(), &shadow_view);
-        bindings.outputs.insert("color".into(), &color);
-        // The rate-image mode gets every rate beside every other.
-        let shading_rate = mrsl_lab::shading_rate::upload_pattern(gpu, size, 8);
-        bindings.shading_rate = Some(&shading_rate);
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let options = DispatchOptions { force_refine, ..DispatchOptions::new(mode) };
-        shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options).unwrap();
-        gpu.queue.submit([encoder.finish()]);
-        let stats = shader.read_stats(&gpu.device).unwrap();
-        Output { pixels: gpu.read_rgba32f(&color).unwrap(), stats, width: size.0 }
+        render_color(gpu, &mut shader, &channels, &[("shadow_map", &shadow_view)], &[], size, options)
     };
     let reference = run(Mode::Reference, false);
     assert!(reference.pixels.iter().all(|p| p.iter().all(|v| v.is_finite())));
