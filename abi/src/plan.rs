@@ -25,6 +25,78 @@ pub struct Plan {
     pub modes: Vec<ModePlan>,
     /// Every runtime-owned resource a step names, each once.
     pub resources: Vec<ResourceDesc>,
+    /// The numbers [`Workgroups`] and [`Extent`] are evaluated with, the
+    /// limits sizes are checked against, and where indirect arguments bind:
+    /// what a runtime in another language reads instead of restating
+    /// [`geometry`].
+    #[serde(default)]
+    pub constants: PlanConstants,
+}
+
+/// The dispatch geometry's numbers ([`geometry`]) as the plan carries them.
+/// The formulas that use them are the ones documented on [`Workgroups`],
+/// [`Extent`], [`geometry::sample_grid`] and [`Lattice`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanConstants {
+    /// Pixels per side of a [`Workgroups::Tiles`] workgroup ([`geometry::TILE`]).
+    pub tile: u32,
+    /// Invocations per side of a [`Workgroups::SampleGrid`] or
+    /// [`Workgroups::Lattice`] workgroup ([`geometry::COARSE_WORKGROUP`]).
+    pub coarse_workgroup: u32,
+    /// Shading-rate tiles per side of a [`Workgroups::RateTiles`] workgroup
+    /// ([`geometry::RATE_LIST_TILES`]).
+    pub rate_list_tiles: u32,
+    /// Shaded quads per [`Workgroups::CheckerboardQuads`] workgroup
+    /// ([`geometry::CHECKERBOARD_QUADS_PER_WORKGROUP`]).
+    pub checkerboard_quads_per_workgroup: u32,
+    /// The lattices of hierarchical levels 1 to 4, whose points
+    /// [`Extent::HierarchicalLevels`] counts ([`geometry::HIERARCHICAL_LEVELS`]).
+    pub hierarchical_levels: Vec<LatticeDesc>,
+    /// The largest image side ([`geometry::MAX_SIDE`]).
+    pub max_side: u32,
+    /// The largest storage binding in bytes ([`geometry::MAX_STORAGE_BINDING_BYTES`]).
+    pub max_storage_binding_bytes: u64,
+    /// The largest side of a texture ([`geometry::MAX_TEXTURE_SIDE`]).
+    pub max_texture_side: u32,
+    /// The most layers of a texture array ([`geometry::MAX_TEXTURE_LAYERS`]).
+    pub max_texture_layers: u32,
+    /// The most workgroups along one axis of a dispatch ([`MAX_WORKGROUPS_PER_DIMENSION`]).
+    pub max_workgroups_per_dimension: u32,
+    /// The bind group and binding of a [`Dispatch::arguments`] buffer
+    /// ([`crate::GROUP_ARGS`], [`crate::BINDING_ARGS`]).
+    pub arguments_group: u32,
+    pub arguments_binding: u32,
+}
+
+/// A [`Lattice`] as data.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LatticeDesc {
+    pub start: u32,
+    pub step: u32,
+    pub odd_only: bool,
+}
+
+impl Default for PlanConstants {
+    /// The numbers of this version of [`geometry`].
+    fn default() -> PlanConstants {
+        PlanConstants {
+            tile: geometry::TILE,
+            coarse_workgroup: geometry::COARSE_WORKGROUP,
+            rate_list_tiles: geometry::RATE_LIST_TILES,
+            checkerboard_quads_per_workgroup: geometry::CHECKERBOARD_QUADS_PER_WORKGROUP,
+            hierarchical_levels: geometry::HIERARCHICAL_LEVELS
+                .iter()
+                .map(|l| LatticeDesc { start: l.start, step: l.step, odd_only: l.odd_only })
+                .collect(),
+            max_side: geometry::MAX_SIDE,
+            max_storage_binding_bytes: geometry::MAX_STORAGE_BINDING_BYTES,
+            max_texture_side: geometry::MAX_TEXTURE_SIDE,
+            max_texture_layers: geometry::MAX_TEXTURE_LAYERS,
+            max_workgroups_per_dimension: MAX_WORKGROUPS_PER_DIMENSION,
+            arguments_group: crate::GROUP_ARGS,
+            arguments_binding: crate::BINDING_ARGS,
+        }
+    }
 }
 
 impl Plan {
@@ -461,6 +533,19 @@ mod tests {
         assert_eq!(Extent::HierarchicalLevels.count(size), geometry::work_list_words(size));
         assert_eq!(Extent::Fixed { count: 20 }.count(size), 20);
         assert_eq!(Extent::SampleGrid { block: 1 }.grid(size), Some(size));
+    }
+
+    /// The constants travel with the plan under their own names, and a plan
+    /// written without them reads as this version's.
+    #[test]
+    fn the_plan_carries_the_geometry_constants() {
+        let plan = Plan { modes: vec![], resources: vec![], constants: PlanConstants::default() };
+        let json = serde_json::to_value(&plan).unwrap();
+        assert_eq!(json["constants"]["tile"], geometry::TILE);
+        assert_eq!(json["constants"]["hierarchical_levels"][1]["odd_only"], true);
+        assert_eq!(json["constants"]["arguments_group"], crate::GROUP_ARGS);
+        let old: Plan = serde_json::from_str(r#"{"modes": [], "resources": []}"#).unwrap();
+        assert_eq!(old, plan);
     }
 
     #[test]

@@ -263,7 +263,7 @@ pub fn build(
         outputs,
         effects,
         // Filled in from the modes by `plan::build`.
-        plan: Plan { modes: vec![], resources: vec![] },
+        plan: Plan { modes: vec![], resources: vec![], constants: Default::default() },
     }
 }
 

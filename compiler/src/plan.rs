@@ -22,7 +22,7 @@ pub fn build(layout: &Layout, modes: &[Mode]) -> Plan {
     ids.sort();
     ids.dedup();
     let resources = ids.into_iter().map(|id| resource(layout, id)).collect();
-    Plan { modes, resources }
+    Plan { modes, resources, constants: Default::default() }
 }
 
 /// The steps and counts of one mode.
