@@ -117,6 +117,15 @@ impl Gpu {
         })
     }
 
+    /// Reads mip level `level` of a texture back as rows of raw texel bytes,
+    /// tightly packed ([`mrsl_runtime::gpu::read_texture_level`]).
+    pub fn read_texture_level(&self, texture: &wgpu::Texture, level: u32) -> Result<Vec<u8>, Error> {
+        mrsl_runtime::gpu::read_texture_level(&self.device, &self.queue, texture, level).map_err(|e| match e {
+            mrsl_runtime::Error::Readback(message) => Error::Readback(message),
+            other => Error::Readback(other.to_string()),
+        })
+    }
+
     /// Reads an `rgba32float` texture as RGBA pixels.
     pub fn read_rgba32f(&self, texture: &wgpu::Texture) -> Result<Vec<[f32; 4]>, Error> {
         Ok(bytemuck::pod_collect_to_vec(&self.read_texture(texture)?))

@@ -48,8 +48,23 @@ pub fn read_buffer<T: bytemuck::Pod>(device: &wgpu::Device, buffer: &wgpu::Buffe
 /// Copies a single-level 2D texture out and returns its texels row by row,
 /// tightly packed (waits for the GPU). The texture needs `COPY_SRC`.
 pub fn read_texture(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture) -> Result<Vec<u8>, Error> {
+    read_texture_level(device, queue, texture, 0)
+}
+
+/// Copies mip level `level` of a 2D texture out and returns its texels row
+/// by row, tightly packed (waits for the GPU). The texture needs `COPY_SRC`.
+pub fn read_texture_level(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    level: u32,
+) -> Result<Vec<u8>, Error> {
+    if level >= texture.mip_level_count() {
+        return Err(Error::Readback(format!("the texture has no mip level {level}")));
+    }
     let bytes_per_texel = texture.format().block_copy_size(None).unwrap_or(4);
-    let (width, height) = (texture.width(), texture.height());
+    let size = texture.size().mip_level_size(level, texture.dimension());
+    let (width, height) = (size.width, size.height);
     let row = width * bytes_per_texel;
     // Rows of a texture-to-buffer copy are padded to 256 bytes.
     let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
@@ -61,7 +76,12 @@ pub fn read_texture(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::
     });
     let mut encoder = device.create_command_encoder(&Default::default());
     encoder.copy_texture_to_buffer(
-        texture.as_image_copy(),
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: level,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
         wgpu::TexelCopyBufferInfo {
             buffer: &buffer,
             layout: wgpu::TexelCopyBufferLayout {
@@ -70,7 +90,7 @@ pub fn read_texture(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::
                 rows_per_image: Some(height),
             },
         },
-        texture.size(),
+        size,
     );
     queue.submit([encoder.finish()]);
     let padded_rows: Vec<u8> = read_buffer(device, &buffer)?;

@@ -258,6 +258,14 @@ impl Shader {
         self.uniform_values.set(self.layout.uniforms.as_ref(), name, values)
     }
 
+    /// The value set for uniform `name` by one of the setters, components in
+    /// the order [`Shader::set_uniform`] takes them; `None` for a uniform not
+    /// set (it takes its declared default) or not declared. Lets a tool
+    /// record what it bound, say to hand it to another runtime.
+    pub fn uniform(&self, name: &str) -> Option<&[f64]> {
+        self.uniform_values.get(name)
+    }
+
     /// Sets a `float` uniform (vector, matrix or array of floats) from f32
     /// values, as [`Shader::set_uniform`] does; a uniform of another scalar
     /// type is [`Error::UniformType`].

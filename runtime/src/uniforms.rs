@@ -51,6 +51,11 @@ impl UniformValues {
         self.set(block, name, values)
     }
 
+    /// The value set for `name`, if one was (not its default).
+    pub fn get(&self, name: &str) -> Option<&[f64]> {
+        self.values.get(name).map(Vec::as_slice)
+    }
+
     /// The block's bytes, from set values and defaults.
     pub fn bytes(&self, block: &UniformBlock) -> Result<Vec<u8>, Error> {
         let mut bytes = vec![0u8; block.size as usize];
@@ -227,6 +232,8 @@ mod tests {
             Err(Error::UnknownUniform(_))
         ));
         assert_eq!(values.values["light_count"], [16.0]);
+        assert_eq!(values.get("light_count"), Some(&[16.0][..]));
+        assert_eq!(values.get("gain"), None, "never set: the default applies");
     }
 
     /// Valid values are written as before: ints and uints exactly, bools as 0 or 1.
