@@ -21,6 +21,8 @@ pub struct RenderArgs {
     pub force_refine: bool,
     /// Compare each mode's first output with the reference: metrics and an error image.
     pub compare: bool,
+    /// `--raw`: each output's texels beside its PNG.
+    pub raw: bool,
     /// The hierarchical mode's similarity threshold.
     pub similarity: f32,
     /// The rate-image mode's rate source.

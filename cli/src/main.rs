@@ -12,11 +12,13 @@ mod ablation;
 mod args;
 mod bench;
 mod frames;
+mod gbuffer;
 mod legend;
 mod output;
 mod rates;
 mod render;
 mod report;
+mod serve;
 mod setup;
 mod suite;
 mod timing;
@@ -86,6 +88,44 @@ enum Command {
     /// quality_vs_time.sponza.png and controller.png into out/
     /// (docs/evaluation.md explains every figure).
     Bench(Bench),
+    /// Export a scene's G-buffer, and with a program everything else it binds
+    /// as `render` binds it, for another runtime (docs/gbuffer-format.md).
+    ///
+    /// Writes DIR/gbuffer.json (format mrsl-gbuffer/1: the channels, the
+    /// uniforms the scene and --set set, the textures with their mip levels,
+    /// the samplers) and one file of raw texels per channel and mip level,
+    /// rows tightly packed, in the texture's format.
+    Gbuffer(Gbuffer),
+    /// Serve the playground on a local HTTP server (docs/runtime.md, "The playground").
+    ///
+    /// Prints `playground: http://HOST:PORT/` once it listens, and runs
+    /// until stopped.
+    Serve {
+        /// The address to listen on (the server has no authentication: keep it local).
+        #[arg(long, default_value = "127.0.0.1")]
+        host: String,
+        /// The port (0: any free port).
+        #[arg(long, default_value_t = 8421)]
+        port: u16,
+    },
+}
+
+#[derive(clap::Args)]
+struct Gbuffer {
+    /// The .mrsl program whose uniforms, textures and samplers to export (default: none, the G-buffer alone).
+    program: Option<PathBuf>,
+    /// Scene, as for `render`.
+    #[arg(long, default_value = "demo")]
+    scene: String,
+    /// Image size, WIDTHxHEIGHT (default: the scene file's, else 960x540; at most 3840x2160 pixels).
+    #[arg(long, value_parser = args::parse_size)]
+    size: Option<(u32, u32)>,
+    /// Output directory (created if missing).
+    #[arg(short = 'o', long = "out")]
+    out_dir: PathBuf,
+    /// Set a uniform: NAME=VALUE or NAME=X,Y,Z (repeatable), after the scene's.
+    #[arg(long = "set", value_parser = args::parse_set)]
+    sets: Vec<(String, Vec<f64>)>,
 }
 
 #[derive(clap::Args)]
@@ -193,6 +233,11 @@ struct Render {
     /// Rate-image mode with --frames: decide without the motion vectors (no motion terms, no reprojection).
     #[arg(long)]
     no_motion: bool,
+    /// Also write each output of each mode as raw texels, OUT/PROGRAM.MODE.OUTPUT.bin:
+    /// rows tightly packed, little-endian, in the output's format (rgba32float: 16
+    /// bytes a pixel), the values the PNG was made from.
+    #[arg(long, conflicts_with = "frames")]
+    raw: bool,
     /// Render N frames along the scene's camera path (Sponza's walk, or a scene file's
     /// camera_path), writing PROGRAM.MODE.fNNN.png, the rate-image mode's rates per
     /// frame and PROGRAM.frames.json; the rate-image mode takes its rates from the
@@ -279,6 +324,8 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         Command::Render(r) => Ok(written(render::render(&r.args()))),
         Command::Bench(b) => bench(b),
         Command::Compile { file, out_dir, emit, mode, block } => compile(cli.color, file, out_dir, *emit, mode, block),
+        Command::Gbuffer(g) => Ok(written(gbuffer_command(g))),
+        Command::Serve { host, port } => serve::serve(host, *port).map(|()| ExitCode::SUCCESS),
     }
 }
 
@@ -313,6 +360,7 @@ impl Render {
             stats: self.stats,
             force_refine: self.force_refine,
             compare: self.compare,
+            raw: self.raw,
             similarity: self.similarity,
             uniform_rate: self.uniform_rate,
             rates: mrsl_runtime::rate_source::RateOptions {
@@ -324,6 +372,29 @@ impl Render {
             frames: self.frames,
         }
     }
+}
+
+/// `mrslc gbuffer`: the export's files into the output directory; returns their paths.
+fn gbuffer_command(g: &Gbuffer) -> Result<Vec<PathBuf>> {
+    let program = match &g.program {
+        Some(path) => Some(setup::compile_program(Some(path), ("", ""), &[])?.1),
+        None => None,
+    };
+    let name = g.program.as_ref().and_then(|p| p.file_name()).map(|n| n.to_string_lossy().into_owned());
+    let program = program.as_ref().zip(name.as_deref()).map(|(program, name)| gbuffer::ProgramRef { name, program });
+    let gpu = mrsl_lab::gpu::Gpu::new()?;
+    let export = gbuffer::export(&gpu, &g.scene, g.size, program, &g.sets)?;
+    for warning in &export.manifest.warnings {
+        eprintln!("warning: {warning}");
+    }
+    std::fs::create_dir_all(&g.out_dir).map_err(|e| anyhow!("cannot create {}: {e}", g.out_dir.display()))?;
+    let mut paths = vec![];
+    for (file, bytes) in export.into_files()? {
+        let path = g.out_dir.join(file);
+        output::write(&path, bytes)?;
+        paths.push(path);
+    }
+    Ok(paths)
 }
 
 /// `mrslc bench`: the sweep, or with `--ablation` the ablation.

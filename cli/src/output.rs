@@ -37,12 +37,17 @@ pub fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
 /// radiance): `rgba32float` as RGB, `r32float` as grey, `rgba8unorm` as
 /// stored values over 255; alpha is not kept.
 pub fn save_output(gpu: &Gpu, texture: &wgpu::Texture, path: &Path) -> Result<()> {
+    save_texels(texture, &gpu.read_texture(texture)?, path)
+}
+
+/// [`save_output`] of `texture`'s texels already read back (`bytes`, rows
+/// tightly packed).
+pub fn save_texels(texture: &wgpu::Texture, bytes: &[u8], path: &Path) -> Result<()> {
     let (w, h) = (texture.width(), texture.height());
-    let bytes = gpu.read_texture(texture)?;
     let pixels: Vec<[f32; 4]> = match texture.format() {
-        wgpu::TextureFormat::Rgba32Float => bytemuck::pod_collect_to_vec(&bytes),
+        wgpu::TextureFormat::Rgba32Float => bytemuck::pod_collect_to_vec(bytes),
         wgpu::TextureFormat::R32Float => {
-            bytemuck::pod_collect_to_vec::<u8, f32>(&bytes).into_iter().map(|v| [v, v, v, 1.0]).collect()
+            bytemuck::pod_collect_to_vec::<u8, f32>(bytes).into_iter().map(|v| [v, v, v, 1.0]).collect()
         }
         wgpu::TextureFormat::Rgba8Unorm => bytes
             .chunks_exact(4)

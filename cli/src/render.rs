@@ -4,8 +4,8 @@
 
 use crate::args::RenderArgs;
 use crate::legend::{self, Legend};
-use crate::output::{save_heatmap, save_image, save_output, with_suffix};
-use crate::setup::{BoundScene, DEMO_PROGRAM, Resources, bind_scene, compile_program};
+use crate::output::{save_heatmap, save_image, save_texels, with_suffix};
+use crate::setup::{BoundProgram, BoundScene, DEMO_PROGRAM, Resources, bind_program, bind_scene, compile_program};
 use crate::timing::{PAIRS, median, paired, time_run};
 use anyhow::{Context, Result, anyhow, bail};
 use mrsl_lab::gpu::Gpu;
@@ -89,15 +89,14 @@ fn open(args: &RenderArgs) -> Result<Session> {
     if args.frames.is_some() && scene.path.is_none() {
         bail!(crate::frames::no_path(&args.scene));
     }
-    let mut shader = Shader::new(&gpu.device, &program)?;
-    shader.set_timestamp_period(&gpu.queue);
     // The scene's uniforms, then the command line's.
-    let textures = scene.prepare(&gpu, &mut shader).map_err(|e| anyhow!("{}: {e}", args.scene))?.warn();
-    let channels = std::mem::take(&mut scene.channels);
-    for (name, values) in &args.sets {
-        shader.set_uniform(name, values)?;
+    let BoundProgram { mut shader, resources, warnings } =
+        bind_program(&gpu, &mut scene, &args.scene, &program, &args.sets, args.rates.tile)?;
+    for warning in &warnings {
+        eprintln!("warning: {warning}");
     }
-    let resources = Resources::new(&gpu, &program, size, textures, args.rates.tile)?;
+    shader.set_timestamp_period(&gpu.queue);
+    let channels = std::mem::take(&mut scene.channels);
     resources.note_fallbacks();
     // Created only now, so that a run that fails before rendering leaves nothing behind.
     std::fs::create_dir_all(&args.out_dir).map_err(|e| anyhow!("cannot create {}: {e}", args.out_dir.display()))?;
@@ -307,6 +306,7 @@ impl Still<'_> {
 
     /// The mode's outputs: `-o`'s path (with the mode when several run),
     /// else `OUT/STEM.MODE.png`; outputs after the first add their name.
+    /// With `--raw`, each output's texels too, as `OUT/STEM.MODE.OUTPUT.bin`.
     fn save_outputs(&self, mode: Mode, written: &mut Vec<PathBuf>) -> Result<()> {
         let args = self.args;
         let suffix = if args.modes.len() > 1 || args.output.is_none() { format!(".{mode}") } else { String::new() };
@@ -317,8 +317,14 @@ impl Still<'_> {
                 (None, 0) => args.out_dir.join(format!("{}{suffix}.png", self.stem)),
                 (None, _) => args.out_dir.join(format!("{}{suffix}.{name}.png", self.stem)),
             };
-            save_output(self.gpu, texture, &path)?;
+            let texels = self.gpu.read_texture(texture)?;
+            save_texels(texture, &texels, &path)?;
             written.push(path);
+            if args.raw {
+                let raw = args.out_dir.join(format!("{}.{mode}.{name}.bin", self.stem));
+                crate::output::write(&raw, &texels)?;
+                written.push(raw);
+            }
         }
         Ok(())
     }

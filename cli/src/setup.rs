@@ -88,6 +88,34 @@ impl Prepared {
     }
 }
 
+/// A program bound over a scene as every command binds it.
+pub struct BoundProgram {
+    pub shader: Shader,
+    pub resources: Resources,
+    /// The scene's uniforms the program declares with another type.
+    pub warnings: Vec<mrsl_lab::uniforms::Mismatch>,
+}
+
+/// Makes `program`'s shader over `scene` (called `scene_name` in errors):
+/// the scene's uniforms ([`BoundScene::prepare`]), then `sets` (the
+/// command line's `--set`), then the [`Resources`].
+pub fn bind_program(
+    gpu: &Gpu,
+    scene: &mut BoundScene,
+    scene_name: &str,
+    program: &mrsl::Program,
+    sets: &[(String, Vec<f64>)],
+    rate_tile: u32,
+) -> Result<BoundProgram> {
+    let mut shader = Shader::new(&gpu.device, program)?;
+    let prepared = scene.prepare(gpu, &mut shader).map_err(|e| anyhow!("{scene_name}: {e}"))?;
+    for (name, values) in sets {
+        shader.set_uniform(name, values)?;
+    }
+    let resources = Resources::new(gpu, program, scene.size, prepared.textures, rate_tile)?;
+    Ok(BoundProgram { shader, resources, warnings: prepared.warnings })
+}
+
 /// `--scene`: a built-in scene's name, or a `.toml` scene file (see
 /// docs/scenes.md). A scene file's `size` applies unless `--size` was given.
 /// What loading a mesh skipped or could not use is printed as warnings.
@@ -99,7 +127,9 @@ pub fn bind_scene(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> Result<Bo
     Ok(bound)
 }
 
-fn bind_scene_quietly(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> Result<BoundScene> {
+/// [`bind_scene`] without printing: what loading a mesh skipped is in the
+/// mesh scene's `warnings`.
+pub fn bind_scene_quietly(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> Result<BoundScene> {
     if let Some(builtin) = Scene::parse(scene) {
         let size = size.unwrap_or(DEFAULT_SIZE);
         let mesh = builtin.mesh_scene(gpu)?;
@@ -123,13 +153,13 @@ fn bind_scene_quietly(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> Resul
 
 /// What a program binds besides the G-buffer: its outputs, and for each of
 /// its textures the scene's texture of that name (the shadow map, a scene
-/// file's image), else a procedural checker; every sampler is linear and
-/// repeating.
+/// file's image), else a procedural checker; every sampler is
+/// [`SAMPLER`].
 pub struct Resources {
     pub size: (u32, u32),
     pub outputs: Vec<(String, wgpu::Texture)>,
-    checker_view: wgpu::TextureView,
-    views: Vec<(String, wgpu::TextureView)>,
+    checker: (wgpu::Texture, wgpu::TextureView),
+    textures: Vec<(String, wgpu::Texture, wgpu::TextureView)>,
     /// The program's textures that get the checker.
     checkered: Vec<String>,
     sampler: wgpu::Sampler,
@@ -152,34 +182,50 @@ impl Resources {
             .iter()
             .map(|o| (o.name.clone(), gpu.output_texture(&o.name, size, mrsl_runtime::wgpu_format(o.format))))
             .collect();
-        let views: Vec<(String, wgpu::TextureView)> =
-            textures.iter().map(|(name, t)| (name.clone(), t.create_view(&Default::default()))).collect();
+        let textures: Vec<(String, wgpu::Texture, wgpu::TextureView)> = textures
+            .into_iter()
+            .map(|(name, t)| {
+                let view = t.create_view(&Default::default());
+                (name, t, view)
+            })
+            .collect();
         let checkered = program
             .layout
             .textures
             .iter()
-            .filter(|t| !views.iter().any(|(name, _)| *name == t.name))
+            .filter(|t| !textures.iter().any(|(name, ..)| *name == t.name))
             .map(|t| t.name.clone())
             .collect();
+        let checker = checker_texture(gpu);
+        let checker_view = checker.create_view(&Default::default());
         Ok(Resources {
             size,
             outputs,
-            checker_view: checker_texture(gpu).create_view(&Default::default()),
-            views,
+            checker: (checker, checker_view),
+            textures,
             checkered,
-            sampler: linear_sampler(gpu),
+            sampler: gpu.device.create_sampler(&SAMPLER),
             shading_rate,
         })
+    }
+
+    /// The program's textures that get the procedural checker.
+    pub fn checkered(&self) -> &[String] {
+        &self.checkered
     }
 
     /// Says which textures get the procedural checker, and how to give them an image.
     pub fn note_fallbacks(&self) {
         for name in &self.checkered {
-            eprintln!(
-                "note: texture `{name}` gets a procedural 64x64 checker (a scene file binds an image to it: \
-                 `{name} = \"FILE.png\"` under [uniforms])"
-            );
+            eprintln!("note: {}", checker_note(name));
         }
+    }
+
+    /// The texture and view bound to the program's texture `name`: the
+    /// scene's of that name, else the checker.
+    pub fn texture(&self, name: &str) -> (&wgpu::Texture, &wgpu::TextureView) {
+        let (texture, view) = &self.checker;
+        self.textures.iter().find(|(n, ..)| n == name).map_or((texture, view), |(_, t, v)| (t, v))
     }
 
     /// The bindings of `program` over the G-buffer `channels`.
@@ -189,8 +235,7 @@ impl Resources {
             bindings.channels.insert(name.clone(), texture);
         }
         for t in &program.layout.textures {
-            let view = self.views.iter().find(|(name, _)| *name == t.name).map_or(&self.checker_view, |(_, v)| v);
-            bindings.textures.insert(t.name.clone(), view);
+            bindings.textures.insert(t.name.clone(), self.texture(&t.name).1);
         }
         for s in &program.layout.samplers {
             bindings.samplers.insert(s.name.clone(), &self.sampler);
@@ -203,17 +248,29 @@ impl Resources {
     }
 }
 
-/// A linear, repeating sampler (what programs' `sampler` uniforms get).
-pub fn linear_sampler(gpu: &Gpu) -> wgpu::Sampler {
-    gpu.device.create_sampler(&wgpu::SamplerDescriptor {
-        address_mode_u: wgpu::AddressMode::Repeat,
-        address_mode_v: wgpu::AddressMode::Repeat,
-        mag_filter: wgpu::FilterMode::Linear,
-        min_filter: wgpu::FilterMode::Linear,
-        mipmap_filter: wgpu::MipmapFilterMode::Linear,
-        ..Default::default()
-    })
+/// What a texture that gets the checker is told.
+pub fn checker_note(name: &str) -> String {
+    format!(
+        "texture `{name}` gets a procedural 64x64 checker (a scene file binds an image to it: \
+         `{name} = \"FILE.png\"` under [uniforms])"
+    )
 }
+
+/// The sampler every `sampler` uniform of a program gets: linear, repeating.
+pub const SAMPLER: wgpu::SamplerDescriptor<'static> = wgpu::SamplerDescriptor {
+    label: Some("mrsl linear sampler"),
+    address_mode_u: wgpu::AddressMode::Repeat,
+    address_mode_v: wgpu::AddressMode::Repeat,
+    address_mode_w: wgpu::AddressMode::Repeat,
+    mag_filter: wgpu::FilterMode::Linear,
+    min_filter: wgpu::FilterMode::Linear,
+    mipmap_filter: wgpu::MipmapFilterMode::Linear,
+    lod_min_clamp: 0.0,
+    lod_max_clamp: 32.0,
+    compare: None,
+    anisotropy_clamp: 1,
+    border_color: None,
+};
 
 fn checker_texture(gpu: &Gpu) -> wgpu::Texture {
     let n = 64u32;

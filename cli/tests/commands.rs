@@ -17,6 +17,15 @@ const TESTS: &[(&str, fn())] = &[
     ("render_all_skips_only_the_modes_the_device_cannot_run", render_all_skips_only_the_modes_the_device_cannot_run),
     ("heatmaps_mark_background_pixels_grey", heatmaps_mark_background_pixels_grey),
     ("gpu_bench_script_writes_the_suite_report", gpu_bench_script_writes_the_suite_report),
+    (
+        "gbuffer_exports_the_channels_and_what_the_program_binds",
+        gbuffer_exports_the_channels_and_what_the_program_binds,
+    ),
+    (
+        "gbuffer_exports_the_rig_and_the_shadow_map_of_a_mesh_scene",
+        gbuffer_exports_the_rig_and_the_shadow_map_of_a_mesh_scene,
+    ),
+    ("render_raw_writes_the_texels_the_png_was_made_from", render_raw_writes_the_texels_the_png_was_made_from),
 ];
 
 fn main() {
@@ -174,5 +183,133 @@ fn gpu_bench_script_writes_the_suite_report() {
     for heading in ["## 48x27", "### sponza (48x27)", "| geometric mean speedup |", "## Not measured"] {
         assert!(md.contains(heading), "{heading} in:\n{md}");
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Bytes per texel of the formats an export holds.
+fn texel_bytes(format: &str) -> usize {
+    match format {
+        "rgba32float" | "rgba32uint" | "rgba32sint" => 16,
+        "rg32float" | "rg32uint" | "rg32sint" => 8,
+        "r32float" | "r32uint" | "r32sint" | "rgba8unorm" | "rgba8unorm-srgb" | "rg16float" => 4,
+        other => panic!("unexpected format {other}"),
+    }
+}
+
+/// `mrslc gbuffer`: the demo scene's channels are the lab's G-buffer (the
+/// CPU one, padded to the texture formats), the textures the program
+/// binds are the checker with its size and format, `--set` is listed with
+/// its value, the sampler is described; a size past the limit is refused
+/// and writes nothing.
+fn gbuffer_exports_the_channels_and_what_the_program_binds() {
+    let dir = scratch("gbuffer");
+    let out = dir.join("export");
+    let program = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/textured_materials.mrsl");
+    let (w, h) = (40usize, 24usize);
+    let run = mrslc(&["gbuffer", program, "--size", "40x24", "-o", out.to_str().unwrap(), "--set", "ambient=0.5"]);
+    let said = stderr(&run);
+    assert!(run.status.success(), "{said}");
+    assert!(
+        said.trim_end().ends_with(&format!("wrote {}", out.join("texture.roughness_map.0.bin").display())),
+        "{said}"
+    );
+    let m = read_json(&out.join("gbuffer.json"));
+    assert_eq!(m["format"], "mrsl-gbuffer/1");
+    assert_eq!((m["scene"].as_str(), m["program"].as_str()), (Some("demo"), Some("textured_materials.mrsl")));
+    assert_eq!(m["size"], serde_json::json!([40, 24]));
+    let cpu = mrsl_lab::scene::Scene::Demo.render(w as u32, h as u32);
+    let channels = m["channels"].as_array().unwrap();
+    assert_eq!(channels.len(), cpu.channels.len());
+    for c in channels {
+        let (name, format) = (c["name"].as_str().unwrap(), c["format"].as_str().unwrap());
+        let bytes = std::fs::read(out.join(c["file"].as_str().unwrap())).unwrap();
+        assert_eq!(bytes.len(), w * h * texel_bytes(format), "{name}");
+        let expected: Vec<u8> = match cpu.channel(name).unwrap_or_else(|| panic!("{name} is a channel of the demo")) {
+            mrsl_lab::gbuffer::ChannelData::Uint(values) => bytemuck::cast_slice(values).to_vec(),
+            mrsl_lab::gbuffer::ChannelData::Float { components, data } => {
+                let stride = texel_bytes(format) / 4;
+                let padded =
+                    data.chunks(*components as usize).flat_map(|p| (0..stride).map(|k| *p.get(k).unwrap_or(&0.0)));
+                padded.flat_map(f32::to_le_bytes).collect()
+            }
+        };
+        assert!(bytes == expected, "{name}: the file is not the lab's G-buffer");
+    }
+    assert_eq!(m["uniforms"], serde_json::json!([{ "name": "ambient", "type": "float", "values": [0.5] }]));
+    let textures = m["textures"].as_array().unwrap();
+    let names: Vec<&str> = textures.iter().map(|t| t["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["albedo_map", "roughness_map"]);
+    for t in textures {
+        assert_eq!((t["format"].as_str(), &t["size"]), (Some("rgba8unorm-srgb"), &serde_json::json!([64, 64])));
+        let mip = &t["mips"][0];
+        assert_eq!(std::fs::read(out.join(mip["file"].as_str().unwrap())).unwrap().len(), 64 * 64 * 4);
+    }
+    let sampler = serde_json::json!([{ "name": "linear", "address_mode": "repeat", "mag_filter": "linear",
+                                       "min_filter": "linear", "mipmap_filter": "linear" }]);
+    assert_eq!(m["samplers"], sampler);
+    let warnings = m["warnings"].as_array().unwrap();
+    assert!(warnings.iter().any(|w| w.as_str().unwrap().contains("`albedo_map` gets a procedural 64x64 checker")));
+
+    let big = dir.join("big");
+    let run = mrslc(&["gbuffer", "--size", "4000x3000", "-o", big.to_str().unwrap()]);
+    let said = stderr(&run);
+    assert!(!run.status.success(), "{said}");
+    assert!(said.contains("an export is at most 8294400 pixels") && said.contains("4000x3000"), "{said}");
+    assert!(!big.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Over Sponza, the rig's uniforms (as the runtime holds them) and the
+/// shadow map, whose one level is listed with its size.
+fn gbuffer_exports_the_rig_and_the_shadow_map_of_a_mesh_scene() {
+    let dir = scratch("gbuffer-sponza");
+    let program = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/sponza_lights.mrsl");
+    let run = mrslc(&["gbuffer", program, "--scene", "sponza", "--size", "32x18", "-o", dir.to_str().unwrap()]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let m = read_json(&dir.join("gbuffer.json"));
+    let uniform = |name: &str| m["uniforms"].as_array().unwrap().iter().find(|u| u["name"] == name).cloned();
+    let count = uniform("light_count").expect("the rig sets light_count");
+    assert_eq!(count["type"], "int");
+    let lights = count["values"][0].as_f64().unwrap();
+    assert!(lights >= 1.0, "{count}");
+    let positions = uniform("light_pos").expect("the rig sets light_pos");
+    assert_eq!(positions["values"].as_array().unwrap().len() % 4, 0);
+    assert_eq!(uniform("sun_view_proj").unwrap()["values"].as_array().unwrap().len(), 16);
+    let shadow = &m["textures"][0];
+    assert_eq!((shadow["name"].as_str(), shadow["format"].as_str()), (Some("shadow_map"), Some("rg16float")));
+    let [sw, sh] = [0, 1].map(|k| shadow["size"][k].as_u64().unwrap() as usize);
+    assert_eq!(shadow["mips"].as_array().unwrap().len(), 1);
+    let bytes = std::fs::read(dir.join(shadow["mips"][0]["file"].as_str().unwrap())).unwrap();
+    assert_eq!(bytes.len(), sw * sh * 4);
+    assert!(bytes.iter().any(|&b| b != 0), "the shadow map holds distances");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `render --raw`: each output's texels, whose sRGB encoding is the PNG;
+/// with `--force-refine` the rate-image mode at a uniform 2x2 rate writes
+/// the reference's bytes exactly.
+fn render_raw_writes_the_texels_the_png_was_made_from() {
+    let dir = scratch("raw");
+    let out = dir.to_str().unwrap();
+    let (w, h) = (40usize, 24usize);
+    let args = ["render", "--size", "40x24", "--mode", "reference,rate-image", "--uniform-rate", "2x2"];
+    let run = mrslc(&[&args[..], &["--force-refine", "--raw", "--out", out]].concat());
+    let said = stderr(&run);
+    assert!(run.status.success(), "{said}");
+    let mut raws = vec![];
+    for mode in ["reference", "rate-image"] {
+        let raw = dir.join(format!("demo.{mode}.color.bin"));
+        assert!(said.contains(&format!("wrote {}", raw.display())), "{said}");
+        let bytes = std::fs::read(&raw).unwrap();
+        assert_eq!(bytes.len(), w * h * 16, "rgba32float");
+        let png = image::open(dir.join(format!("demo.{mode}.png"))).unwrap().to_rgb8();
+        let pixels: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
+        for (k, p) in pixels.iter().enumerate() {
+            let expected = [0, 1, 2].map(|c| mrsl_lab::color::linear_to_srgb8(p[c]));
+            assert_eq!(png.get_pixel((k % w) as u32, (k / w) as u32).0, expected, "{mode}, pixel {k}");
+        }
+        raws.push(bytes);
+    }
+    assert!(raws[0] == raws[1], "forced refinement is the reference, bit for bit");
     std::fs::remove_dir_all(&dir).unwrap();
 }
