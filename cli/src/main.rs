@@ -96,7 +96,7 @@ enum Command {
     /// the samplers) and one file of raw texels per channel and mip level,
     /// rows tightly packed, in the texture's format.
     Gbuffer(Gbuffer),
-    /// Serve the playground on a local HTTP server (docs/runtime.md, "The playground").
+    /// Serve the playground on a local HTTP server (its API: docs/serve.md).
     ///
     /// Prints `playground: http://HOST:PORT/` once it listens, and runs
     /// until stopped.

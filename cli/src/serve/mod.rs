@@ -4,8 +4,7 @@
 //! compiling a program ([`api`]), and exporting a scene's G-buffer for the
 //! page's WebGPU runtime ([`export`]). Every refusal is JSON,
 //! `{"error": "..."}`, with a fitting status ([`reply`]); a bad request
-//! never takes the server down. docs/runtime.md, "The playground",
-//! describes the endpoints.
+//! never takes the server down. docs/serve.md describes the endpoints.
 
 mod api;
 mod export;
