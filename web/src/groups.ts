@@ -1,0 +1,61 @@
+// Bind group layouts: group 0 (the control and uniform blocks, textures,
+// samplers) and group 1 (the G-buffer) from the layout, group 2 (a
+// kernel's stage group) from a pass of the plan, and group 3 (indirect
+// arguments) for the entry points that write them. The group and binding
+// numbers all come from the layout and the plan.
+
+import type { BindingType, Layout, PassBinding } from './contract.js';
+
+// Read when a layout is made, not at import: Node gets the WebGPU globals
+// only once its binding is loaded.
+const visibility = () => GPUShaderStage.COMPUTE;
+
+export function resourcesLayout(device: GPUDevice, l: Layout): GPUBindGroupLayout {
+  const entries: GPUBindGroupLayoutEntry[] = [{ binding: l.control.binding, visibility: visibility(), buffer: { type: 'uniform' } }];
+  if (l.uniforms) entries.push({ binding: l.uniforms.binding, visibility: visibility(), buffer: { type: 'uniform' } });
+  for (const t of l.textures) {
+    entries.push({ binding: t.binding, visibility: visibility(), texture: { sampleType: 'float', viewDimension: '2d' } });
+  }
+  for (const s of l.samplers) entries.push({ binding: s.binding, visibility: visibility(), sampler: { type: 'filtering' } });
+  return device.createBindGroupLayout({ label: 'mrsl resources', entries });
+}
+
+export function gbufferLayout(device: GPUDevice, l: Layout): GPUBindGroupLayout {
+  const entries: GPUBindGroupLayoutEntry[] = l.channels.map((c) => ({
+    binding: c.binding,
+    visibility: visibility(),
+    texture: { sampleType: c.sample_type, viewDimension: '2d' },
+  }));
+  return device.createBindGroupLayout({ label: 'mrsl g-buffer', entries });
+}
+
+function entry(binding: number, ty: BindingType): GPUBindGroupLayoutEntry {
+  const base = { binding, visibility: visibility() };
+  switch (ty.kind) {
+    case 'buffer':
+      return { ...base, buffer: { type: ty.read_only ? 'read-only-storage' : 'storage' } };
+    case 'storage_texture':
+      return { ...base, storageTexture: { access: 'write-only', format: ty.format, viewDimension: '2d' } };
+    case 'uint_texture':
+      return { ...base, texture: { sampleType: 'uint', viewDimension: '2d' } };
+    case 'record_texture':
+      return { ...base, texture: { sampleType: 'uint', viewDimension: '2d-array' } };
+    case 'record_storage_texture':
+      return { ...base, storageTexture: { access: 'write-only', format: 'rgba32uint', viewDimension: '2d-array' } };
+    case 'word_texture':
+      return { ...base, storageTexture: { access: 'read-write', format: 'r32uint', viewDimension: '2d-array' } };
+  }
+}
+
+/** The stage group of a kernel, from the bindings a pass of the plan lists. */
+export function stageLayout(device: GPUDevice, label: string, bindings: readonly PassBinding[]): GPUBindGroupLayout {
+  return device.createBindGroupLayout({ label, entries: bindings.map((b) => entry(b.binding, b.type)) });
+}
+
+/** Group 3: the indirect arguments an entry point writes, at `binding`. */
+export function argumentsLayout(device: GPUDevice, binding: number): GPUBindGroupLayout {
+  return device.createBindGroupLayout({
+    label: 'mrsl indirect arguments',
+    entries: [entry(binding, { kind: 'buffer', read_only: false })],
+  });
+}

@@ -1,0 +1,407 @@
+// A compiled mrsl program on a page's GPUDevice: pipelines, bind group
+// layouts, the control and uniform blocks, and the resources of its plan.
+// `Shader.encode` interprets the mode's plan: one loop over its steps, with
+// no dispatch rule of its own.
+
+import type { KernelRef, Mode, ModePlan, Pass, ResourceId } from './contract.js';
+import { MODES } from './contract.js';
+import { MrslError } from './errors.js';
+import { directWorkgroups, type DispatchContext, type Size } from './geometry.js';
+import * as groups from './groups.js';
+import { mostPasses, passes, planResources } from './plan.js';
+import { ResourcePool } from './pool.js';
+import type { CompiledProgram, Kernel } from './program.js';
+import { makeStats, type Stats, type Timings } from './stats.js';
+import { controlBytes, UniformValues } from './uniforms.js';
+import { checkBindings, checkSize } from './validate.js';
+
+/** What the page binds for one dispatch; every name is a declaration of the program. */
+export interface Bindings {
+  /** Width and height of the shaded image in pixels. */
+  size: Size;
+  /** G-buffer channel textures, by `in` name. */
+  channels: Record<string, GPUTexture>;
+  /** Sampled textures, by `uniform texture2d` name (a texture, or a view of one). */
+  textures?: Record<string, GPUTexture | GPUTextureView>;
+  /** Samplers, by `uniform sampler` name. */
+  samplers?: Record<string, GPUSampler>;
+  /** Output storage textures, by `fine out` name. */
+  outputs: Record<string, GPUTexture>;
+  /** The rate-image mode's shading-rate image: one r8uint/r16uint/r32uint texel per tile. */
+  shadingRate?: GPUTexture;
+}
+
+export interface DispatchOptions {
+  mode: Mode;
+  /** Treat every refine predicate as true: the output must then equal the reference. */
+  forceRefine?: boolean;
+  /** Hierarchical mode: the relative variance still interpolated (default 1e-3). */
+  similarity?: number;
+  /** Rate-image mode: pixels per side of a shading-rate tile, 8 (default) or 16. */
+  rateTile?: number;
+  /** Count per-pixel re-evaluations and write the refine mask (default on). */
+  statistics?: boolean;
+}
+
+/** The hierarchical mode's default similarity: a standard deviation of about 3% of the values. */
+export const DEFAULT_SIMILARITY = 1e-3;
+/** The rate-image mode's default tile size. */
+export const DEFAULT_RATE_TILE = 8;
+
+interface Timestamps {
+  set: GPUQuerySet;
+  resolve: GPUBuffer;
+  readback: GPUBuffer;
+}
+
+const kernelKey = (k: KernelRef) => `${k.kind}/${k.block}`;
+
+/** A program on a device. Make one with `Shader.create`. */
+export class Shader {
+  readonly #uniforms: UniformValues;
+  readonly #pool: ResourcePool;
+  readonly #control: GPUBuffer;
+  readonly #uniformBuffer: GPUBuffer | null;
+  #frame = 0;
+  #last: { options: Required<DispatchOptions>; size: Size; passes: number } | null = null;
+
+  private constructor(
+    readonly device: GPUDevice,
+    readonly program: CompiledProgram,
+    private readonly layouts: { resources: GPUBindGroupLayout; gbuffer: GPUBindGroupLayout; arguments: GPUBindGroupLayout; stages: Map<string, GPUBindGroupLayout> },
+    private readonly pipelines: Map<string, GPUComputePipeline>,
+    /** Kernel kinds the device refused, with its reason. */
+    private readonly unavailable: Map<string, string>,
+    private readonly timestamps: Timestamps | null,
+  ) {
+    const layout = program.layout;
+    this.#uniforms = new UniformValues(layout.uniforms);
+    this.#pool = new ResourcePool(device, layout.plan);
+    const uniform = (label: string, size: number) =>
+      device.createBuffer({ label, size, usage: GPUBufferUsage.UNIFORM | GPUBufferUsage.COPY_DST });
+    this.#control = uniform('mrsl control', layout.control.size);
+    this.#uniformBuffer = layout.uniforms ? uniform('mrsl uniforms', layout.uniforms.size) : null;
+  }
+
+  /**
+   * Creates the pipelines of every kernel the plan uses. A kernel the device
+   * refuses does not fail this: the modes that need it are refused by
+   * `supports` and `encode` with the device's reason.
+   */
+  static async create(device: GPUDevice, program: CompiledProgram): Promise<Shader> {
+    const layout = program.layout;
+    const plan = layout.plan;
+    const c = plan.constants;
+    const resources = groups.resourcesLayout(device, layout);
+    const gbuffer = groups.gbufferLayout(device, layout);
+    const argumentsLayout = groups.argumentsLayout(device, c.arguments_binding);
+    const stages = new Map<string, GPUBindGroupLayout>();
+    const pipelines = new Map<string, GPUComputePipeline>();
+    const unavailable = new Map<string, string>();
+    const allPasses = plan.modes.flatMap(passes);
+    // One kernel at a time, each under its own error scope, so that a
+    // kernel the device refuses is told apart from the others.
+    for (const kernel of program.kernels) {
+      const key = kernelKey(kernel);
+      const kernelPasses = allPasses.filter((p) => kernelKey(p.kernel) === key);
+      if (kernelPasses.length === 0) continue;
+      const made = await makeKernel(device, kernel, kernelPasses, { resources, gbuffer, arguments: argumentsLayout, argumentsGroup: c.arguments_group });
+      if ('refused' in made) unavailable.set(kernel.kind, made.refused);
+      else {
+        stages.set(key, made.stage);
+        for (const [entry, pipeline] of made.pipelines) pipelines.set(`${key}:${entry}`, pipeline);
+      }
+    }
+    const timestamps = device.features.has('timestamp-query') ? makeTimestamps(device, 2 * Math.max(mostPasses(plan), 1)) : null;
+    return new Shader(device, program, { resources, gbuffer, arguments: argumentsLayout, stages }, pipelines, unavailable, timestamps);
+  }
+
+  get layout() {
+    return this.program.layout;
+  }
+
+  /** Sets a uniform's components in order (matrices column by column, arrays element by element, bools as 0/1). */
+  setUniform(name: string, values: number | readonly number[] | boolean): void {
+    const list = typeof values === 'number' ? [values] : typeof values === 'boolean' ? [values ? 1 : 0] : values;
+    this.#uniforms.set(name, list);
+  }
+
+  /** A uniform's value: the one set, else its default, else `null`. */
+  uniform(name: string): number[] | null {
+    return this.#uniforms.get(name);
+  }
+
+  /** Whether `encode` can run `mode`; throws `unsupported-mode` saying why not. */
+  supports(mode: Mode): void {
+    if (!MODES.includes(mode)) {
+      throw new MrslError('unknown-mode', `unknown mode \`${mode}\` (expected ${MODES.join(', ')})`, mode);
+    }
+    const plan = this.program.layout.plan.modes.find((m) => m.mode === mode);
+    const unsupported = (reason: string) =>
+      new MrslError('unsupported-mode', `mode \`${mode}\` is not supported by this program: ${reason}`, mode);
+    if (!plan) throw unsupported("the program's plan does not list it");
+    for (const k of plan.kernels) {
+      const refused = this.unavailable.get(k.kind);
+      if (refused) throw unsupported(`the device cannot run its ${k.kind} kernel: ${refused}`);
+      if (!this.layouts.stages.has(kernelKey(k))) throw unsupported(`the program was compiled without its ${k.kind} kernel`);
+    }
+  }
+
+  /** The modes this program and device can run. */
+  modes(): Mode[] {
+    return MODES.filter((m) => {
+      try {
+        this.supports(m);
+        return true;
+      } catch {
+        return false;
+      }
+    });
+  }
+
+  /**
+   * Records the program's passes for one image into `encoder`. Everything is
+   * checked before anything is recorded; the statistics of the last dispatch
+   * can be read with `readStats` after the encoder's commands were submitted.
+   */
+  encode(encoder: GPUCommandEncoder, bindings: Bindings, options: DispatchOptions): void {
+    const o: Required<DispatchOptions> = {
+      mode: options.mode,
+      forceRefine: options.forceRefine ?? false,
+      similarity: options.similarity ?? DEFAULT_SIMILARITY,
+      rateTile: options.rateTile ?? DEFAULT_RATE_TILE,
+      statistics: options.statistics ?? true,
+    };
+    if (!Number.isFinite(o.similarity) || o.similarity < 0) {
+      throw new MrslError('bad-option', `similarity is ${o.similarity}, but it must be a finite number >= 0`);
+    }
+    this.supports(o.mode);
+    const layout = this.program.layout;
+    const plan = layout.plan.modes.find((m) => m.mode === o.mode) as ModePlan;
+    checkSize(layout.plan, plan, bindings.size, this.device.limits);
+    checkBindings(layout, plan, bindings, o.rateTile);
+    const uniformBytes = this.#uniformBuffer ? this.#uniforms.bytes() : null;
+    this.#frame = (this.#frame + 1) % 2 ** 32 || 1;
+    const control = controlBytes(layout.control.fields, layout.control.size, {
+      size: [bindings.size[0], bindings.size[1]],
+      force_refine: [o.forceRefine ? 1 : 0],
+      frame: [this.#frame],
+      similarity: [o.similarity],
+      rate_tile: [o.rateTile],
+      statistics: [o.statistics ? 1 : 0],
+    });
+    const queue = this.device.queue;
+    queue.writeBuffer(this.#control, 0, control);
+    if (this.#uniformBuffer && uniformBytes) queue.writeBuffer(this.#uniformBuffer, 0, uniformBytes);
+    for (const desc of planResources(layout.plan, plan)) this.#pool.ensure(desc, bindings.size);
+    const shared = [this.#resourcesGroup(bindings), this.#gbufferGroup(bindings)] as const;
+    const context: DispatchContext = { size: bindings.size, forced: o.forceRefine, rateTile: o.rateTile };
+    const stageGroups = new Map<string, GPUBindGroup>();
+    let index = 0;
+    for (const step of plan.steps) {
+      if (step.step === 'clear') encoder.clearBuffer(this.#pool.buffer(step.resource));
+      else if (step.step === 'readback') this.#pool.copyOut(encoder, step.resource, step.bytes);
+      else {
+        const key = kernelKey(step.kernel);
+        let stage = stageGroups.get(key);
+        if (!stage) stageGroups.set(key, (stage = this.#stageGroup(step, bindings)));
+        this.#recordPass(encoder, step, index++, [shared[0], shared[1], stage], context);
+      }
+    }
+    if (this.timestamps && index > 0) {
+      const t = this.timestamps;
+      encoder.resolveQuerySet(t.set, 0, 2 * index, t.resolve, 0);
+      encoder.copyBufferToBuffer(t.resolve, 0, t.readback, 0, 16 * index);
+    }
+    this.#last = { options: o, size: bindings.size, passes: index };
+  }
+
+  #recordPass(encoder: GPUCommandEncoder, pass: Pass, index: number, bound: GPUBindGroup[], context: DispatchContext): void {
+    const timestampWrites = this.timestamps
+      ? { querySet: this.timestamps.set, beginningOfPassWriteIndex: 2 * index, endOfPassWriteIndex: 2 * index + 1 }
+      : undefined;
+    const compute = encoder.beginComputePass(timestampWrites ? { label: pass.label, timestampWrites } : { label: pass.label });
+    bound.forEach((group, i) => compute.setBindGroup(i, group));
+    const c = this.program.layout.plan.constants;
+    for (const dispatch of pass.dispatches) {
+      compute.setPipeline(this.pipelines.get(`${kernelKey(pass.kernel)}:${dispatch.entry}`) as GPUComputePipeline);
+      if (dispatch.arguments) {
+        const group = this.device.createBindGroup({
+          label: 'mrsl indirect arguments',
+          layout: this.layouts.arguments,
+          entries: [{ binding: c.arguments_binding, resource: { buffer: this.#pool.buffer(dispatch.arguments) } }],
+        });
+        compute.setBindGroup(c.arguments_group, group);
+      }
+      const w = dispatch.workgroups;
+      if (w.kind === 'indirect') compute.dispatchWorkgroupsIndirect(this.#pool.buffer(w.buffer), w.offset);
+      else {
+        const [x, y] = directWorkgroups(c, w, context) as [number, number];
+        compute.dispatchWorkgroups(x, y, 1);
+      }
+    }
+    compute.end();
+  }
+
+  #resourcesGroup(bindings: Bindings): GPUBindGroup {
+    const l = this.program.layout;
+    const entries: GPUBindGroupEntry[] = [{ binding: l.control.binding, resource: { buffer: this.#control } }];
+    if (l.uniforms && this.#uniformBuffer) entries.push({ binding: l.uniforms.binding, resource: { buffer: this.#uniformBuffer } });
+    for (const t of l.textures) {
+      const bound = bindings.textures?.[t.name] as GPUTexture | GPUTextureView;
+      entries.push({ binding: t.binding, resource: 'createView' in bound ? bound.createView() : bound });
+    }
+    for (const s of l.samplers) entries.push({ binding: s.binding, resource: bindings.samplers?.[s.name] as GPUSampler });
+    return this.device.createBindGroup({ label: 'mrsl resources', layout: this.layouts.resources, entries });
+  }
+
+  #gbufferGroup(bindings: Bindings): GPUBindGroup {
+    const entries = this.program.layout.channels.map((c) => ({
+      binding: c.binding,
+      resource: (bindings.channels[c.name] as GPUTexture).createView(),
+    }));
+    return this.device.createBindGroup({ label: 'mrsl g-buffer', layout: this.layouts.gbuffer, entries });
+  }
+
+  /** Group 2 of `pass`: each binding the resource the plan names. */
+  #stageGroup(pass: Pass, bindings: Bindings): GPUBindGroup {
+    const outputs = this.program.layout.outputs;
+    const resource = (id: ResourceId): GPUBindingResource => {
+      if (id.id === 'output') return (bindings.outputs[outputs[id.index]!.name] as GPUTexture).createView();
+      if (id.id === 'shading_rate') return (bindings.shadingRate as GPUTexture).createView();
+      return this.#pool.binding(id);
+    };
+    return this.device.createBindGroup({
+      label: pass.kernel.kind,
+      layout: this.layouts.stages.get(kernelKey(pass.kernel)) as GPUBindGroupLayout,
+      entries: pass.bindings.map((b) => ({ binding: b.binding, resource: resource(b.resource) })),
+    });
+  }
+
+  /**
+   * The per-pixel refine mask (rg32uint) of the last dispatch of a mode with
+   * coarse effects: x bit k set when coarse effect k (`layout.stats.counters[k]`)
+   * was evaluated per pixel, y bit k when it came from the dynamic mode's 2x2 level.
+   */
+  refineMask(): GPUTexture | null {
+    return this.#pool.texture({ id: 'refine_mask' });
+  }
+
+  /** Reads the statistics of the last submitted dispatch (waits for the GPU). */
+  async readStats(): Promise<Stats> {
+    const last = this.#last;
+    if (!last) throw new MrslError('readback', 'reading results back failed: nothing was dispatched yet');
+    if (!last.options.statistics) {
+      throw new MrslError('statistics-off', 'the last dispatch ran with statistics off, so it counted nothing');
+    }
+    const layout = this.program.layout;
+    const plan = layout.plan.modes.find((m) => m.mode === last.options.mode) as ModePlan;
+    const read = async (id: ResourceId) => {
+      const buffer = this.#pool.readback(id);
+      if (!buffer) throw new MrslError('readback', `reading results back failed: ${id.id} was not read back`);
+      return readWords(buffer);
+    };
+    const counters = await read({ id: 'statistics' });
+    const listed = plan.counts.samples.kind === 'listed' ? ((await read(plan.counts.samples.resource))[plan.counts.samples.word] ?? 0) : 0;
+    const lists = plan.counts.work_lists;
+    let workLists: number[] = [];
+    if (lists) {
+      const words = await read(lists.resource);
+      workLists = lists.levels.map((level) => words[lists.words_per_level * level] ?? 0);
+    }
+    const timings = this.timestamps ? timingsOf(plan, await readTicks(this.timestamps.readback, last.passes)) : null;
+    const counted = { counters, listedSamples: listed, workLists };
+    return makeStats(layout, plan.counts, last.options.mode, last.options.forceRefine, last.size, counted, timings);
+  }
+
+  /** Frees the shader's buffers and textures. */
+  destroy(): void {
+    this.#pool.destroy();
+    this.#control.destroy();
+    this.#uniformBuffer?.destroy();
+    if (this.timestamps) [this.timestamps.resolve, this.timestamps.readback].forEach((b) => b.destroy());
+    this.timestamps?.set.destroy();
+  }
+}
+
+interface SharedLayouts {
+  resources: GPUBindGroupLayout;
+  gbuffer: GPUBindGroupLayout;
+  arguments: GPUBindGroupLayout;
+  argumentsGroup: number;
+}
+
+/**
+ * A kernel's stage group and the pipeline of each entry point its passes
+ * dispatch (those that write indirect arguments also see the arguments
+ * group), or the device's reason for refusing them.
+ */
+async function makeKernel(
+  device: GPUDevice,
+  kernel: Kernel,
+  kernelPasses: Pass[],
+  shared: SharedLayouts,
+): Promise<{ stage: GPUBindGroupLayout; pipelines: Map<string, GPUComputePipeline> } | { refused: string }> {
+  device.pushErrorScope('validation');
+  const stage = groups.stageLayout(device, kernel.kind, kernelPasses[0]!.bindings);
+  const module = device.createShaderModule({ label: kernel.kind, code: kernel.wgsl });
+  const groupLayouts: (GPUBindGroupLayout | null)[] = [shared.resources, shared.gbuffer, stage];
+  const plain = device.createPipelineLayout({ label: kernel.kind, bindGroupLayouts: groupLayouts });
+  const withArgumentsGroups = [...groupLayouts];
+  withArgumentsGroups[shared.argumentsGroup] = shared.arguments;
+  const withArguments = device.createPipelineLayout({ label: kernel.kind, bindGroupLayouts: withArgumentsGroups });
+  const writesArguments = new Map<string, boolean>();
+  for (const d of kernelPasses.flatMap((p) => p.dispatches)) {
+    writesArguments.set(d.entry, (writesArguments.get(d.entry) ?? false) || d.arguments !== null);
+  }
+  const pipelines = new Map<string, GPUComputePipeline>();
+  let refused: string | null = null;
+  for (const [entry, writes] of writesArguments) {
+    try {
+      const layout = writes ? withArguments : plain;
+      pipelines.set(entry, await device.createComputePipelineAsync({ label: entry, layout, compute: { module, entryPoint: entry } }));
+    } catch (error) {
+      refused ??= error instanceof Error ? error.message : String(error);
+    }
+  }
+  const scoped = await device.popErrorScope();
+  refused ??= scoped?.message ?? null;
+  return refused === null ? { stage, pipelines } : { refused };
+}
+
+function makeTimestamps(device: GPUDevice, count: number): Timestamps {
+  return {
+    set: device.createQuerySet({ label: 'mrsl timestamps', type: 'timestamp', count }),
+    resolve: device.createBuffer({ label: 'mrsl timestamps resolve', size: 8 * count, usage: GPUBufferUsage.QUERY_RESOLVE | GPUBufferUsage.COPY_SRC }),
+    readback: device.createBuffer({ label: 'mrsl timestamps readback', size: 8 * count, usage: GPUBufferUsage.MAP_READ | GPUBufferUsage.COPY_DST }),
+  };
+}
+
+async function readWords(buffer: GPUBuffer): Promise<Uint32Array> {
+  await buffer.mapAsync(GPUMapMode.READ);
+  const words = new Uint32Array(buffer.getMappedRange().slice(0));
+  buffer.unmap();
+  return words;
+}
+
+async function readTicks(buffer: GPUBuffer, passes: number): Promise<BigUint64Array> {
+  await buffer.mapAsync(GPUMapMode.READ, 0, 16 * passes);
+  const ticks = new BigUint64Array(buffer.getMappedRange(0, 16 * passes).slice(0));
+  buffer.unmap();
+  return ticks;
+}
+
+/** The passes' GPU times (WebGPU timestamps are nanoseconds), summed by stage. */
+function timingsOf(plan: ModePlan, ticks: BigUint64Array): Timings {
+  const ms = (a: bigint, b: bigint) => (b > a ? Number(b - a) / 1e6 : 0);
+  const t: Timings = { coarseMs: 0, coarse2Ms: 0, fineMs: 0, totalMs: 0 };
+  const list = passes(plan);
+  list.forEach((pass, i) => {
+    const time = ms(ticks[2 * i]!, ticks[2 * i + 1]!);
+    if (pass.stage === 'coarse') t.coarseMs += time;
+    else if (pass.stage === 'coarse2x2') t.coarse2Ms += time;
+    else t.fineMs += time;
+  });
+  if (list.length > 0) t.totalMs = ms(ticks[0]!, ticks[2 * list.length - 1]!);
+  return t;
+}

@@ -1,0 +1,182 @@
+// What a page binds, checked against the program's layout and the mode's
+// plan before anything is recorded: every mismatch is a typed `MrslError`
+// naming the binding at fault (the Rust runtime's checks, in WebGPU terms).
+
+import type { Channel, Layout, ModePlan, Output, Plan } from './contract.js';
+import { MrslError } from './errors.js';
+import { formatInfo } from './formats.js';
+import { extentCount, extentGrid, rateImageSize, type Size } from './geometry.js';
+import { planResources } from './plan.js';
+import type { Bindings } from './shader.js';
+
+/** Shading-rate tile sizes the rate-image mode supports. */
+export const RATE_TILE_SIZES: readonly number[] = [8, 16];
+
+function badSize([w, h]: Size, reason: string): MrslError {
+  return new MrslError('bad-size', `target size ${w}x${h} is not supported: ${reason}`);
+}
+
+/**
+ * The image size: not empty, within the largest side (the plan's and the
+ * device's), and within the limits of what the mode makes and dispatches.
+ */
+export function checkSize(plan: Plan, mode: ModePlan, size: Size, limits: GPUSupportedLimits): void {
+  const g = plan.constants;
+  const [w, h] = size;
+  if (!(Number.isInteger(w) && Number.isInteger(h)) || w <= 0 || h <= 0) throw badSize(size, 'it is empty');
+  if (w > g.max_side || h > g.max_side) throw badSize(size, `the largest supported side is ${g.max_side}`);
+  if (w > limits.maxTextureDimension2D || h > limits.maxTextureDimension2D) {
+    throw badSize(size, `the device's largest texture side (maxTextureDimension2D) is ${limits.maxTextureDimension2D}`);
+  }
+  for (const desc of planResources(plan, mode)) {
+    const shape = desc.shape;
+    if (shape.type === 'buffer') {
+      const bytes = extentCount(g, shape.elements, size) * shape.words * 4;
+      if (bytes > g.max_storage_binding_bytes) {
+        const mib = (n: number) => Math.floor(n / 2 ** 20);
+        throw badSize(size, `${desc.what} would need ${mib(bytes)} MiB, more than a ${mib(g.max_storage_binding_bytes)} MiB storage binding`);
+      }
+    } else if (shape.type === 'texture_array') {
+      const [tw, th] = extentGrid(shape.texels, size) ?? [1, 1];
+      if (Math.max(tw, th) > g.max_texture_side || shape.layers > g.max_texture_layers) {
+        const side = g.max_texture_side;
+        throw badSize(size, `${desc.what} would need ${tw}x${th} texels and ${shape.layers} layers, more than ${side}x${side} texels and ${g.max_texture_layers} layers`);
+      }
+    }
+  }
+  for (const pass of mode.steps) {
+    if (pass.step !== 'pass') continue;
+    for (const d of pass.dispatches) {
+      if (d.workgroups.kind === 'indirect' && d.workgroups.at_most) {
+        const groups = Math.ceil(extentCount(g, d.workgroups.at_most, size) / d.workgroups.per_workgroup);
+        if (groups > g.max_workgroups_per_dimension) {
+          throw badSize(size, `\`${d.entry}\` would need more than ${g.max_workgroups_per_dimension} workgroups`);
+        }
+      }
+    }
+  }
+}
+
+/** Why `t` is not the single-sample 2D texture of one layer (and one mip level for storage) a binding takes. */
+function shapeProblem(t: GPUTexture, storage: boolean): string | null {
+  if (t.dimension !== '2d') return `a ${t.dimension} texture`;
+  if (t.depthOrArrayLayers !== 1) return `a 2D texture of ${t.depthOrArrayLayers} layers`;
+  if (t.sampleCount !== 1) return `a multisampled texture (${t.sampleCount} samples): resolve it into a single-sample one`;
+  if (storage && t.mipLevelCount !== 1) {
+    return `a texture of ${t.mipLevelCount} mip levels, and a storage texture binding takes one`;
+  }
+  return null;
+}
+
+function checkTextureSize(what: string, name: string, t: GPUTexture, [w, h]: Size): void {
+  if (t.width !== w || t.height !== h) {
+    throw new MrslError('size-mismatch', `${what} \`${name}\` is ${t.width}x${t.height}, but the target is ${w}x${h}`, name);
+  }
+}
+
+const COMPONENTS: Record<string, number> = { '2': 2, '3': 3, '4': 4 };
+
+/** A channel's texture: a colour format read as the channel's sample type with enough components. */
+function checkChannel(ch: Channel, t: GPUTexture): void {
+  const info = formatInfo(t.format);
+  const wants = ch.sample_type === 'unfilterable-float' ? 'float' : ch.sample_type;
+  if (info?.readAs === 'depth') {
+    throw new MrslError(
+      'channel-format',
+      `G-buffer channel \`${ch.name}\` has the depth/stencil format ${t.format}, which is not accepted as a channel (the kernels read channels as colour textures): write what the program reads as \`${ch.type}\` into a ${ch.format} texture, or reconstruct it from depth and bind that`,
+      ch.name,
+    );
+  }
+  const need = Math.min(COMPONENTS[ch.type.at(-1) ?? ''] ?? 1, 4);
+  const fits = info !== null && info.readAs === wants && info.components >= need && (need !== 3 || info.components === 4);
+  if (!fits) {
+    const rule = need === 1 ? 'any' : need === 2 ? 'at least 2' : 'exactly 4';
+    throw new MrslError(
+      'channel-format',
+      `G-buffer channel \`${ch.name}\` has format ${t.format}, but the program reads it as \`${ch.type}\`: bind ${ch.format} (the layout's format) or another format read as ${wants} with ${rule} components`,
+      ch.name,
+    );
+  }
+  if (!(t.usage & GPUTextureUsage.TEXTURE_BINDING)) {
+    throw new MrslError(
+      'channel-usage',
+      `G-buffer channel \`${ch.name}\` was not created with GPUTextureUsage.TEXTURE_BINDING, which the kernels need to read it: add it to the texture's usage`,
+      ch.name,
+    );
+  }
+  const shape = shapeProblem(t, false);
+  if (shape) {
+    throw new MrslError('texture-shape', `G-buffer channel \`${ch.name}\` is ${shape}, but the kernels bind a single-sample 2D texture of one layer`, ch.name);
+  }
+}
+
+function checkOutput(o: Output, t: GPUTexture): void {
+  if (t.format !== o.format) {
+    throw new MrslError('output-format', `output \`${o.name}\` must be a ${o.format} storage texture, found ${t.format}`, o.name);
+  }
+  if (!(t.usage & GPUTextureUsage.STORAGE_BINDING)) {
+    throw new MrslError(
+      'output-usage',
+      `output \`${o.name}\` was not created with GPUTextureUsage.STORAGE_BINDING, which the kernels need to write it: add it to the texture's usage`,
+      o.name,
+    );
+  }
+  const shape = shapeProblem(t, true);
+  if (shape) {
+    throw new MrslError('texture-shape', `output \`${o.name}\` is ${shape}, but the kernels bind a single-sample 2D texture of one layer and one mip level`, o.name);
+  }
+}
+
+function checkShadingRate(bindings: Bindings, tile: number): void {
+  const what = 'the shading-rate image';
+  if (!RATE_TILE_SIZES.includes(tile)) {
+    throw new MrslError('bad-tile-size', `rate tile size ${tile} is not supported (expected 8 or 16)`);
+  }
+  const t = bindings.shadingRate;
+  if (!t) {
+    throw new MrslError('missing-shading-rate', 'the rate-image mode needs a shading-rate image (`Bindings.shadingRate`), and none is bound');
+  }
+  if (!['r8uint', 'r16uint', 'r32uint'].includes(t.format)) {
+    throw new MrslError('rate-format', `${what} has format ${t.format}, expected r8uint (as in D3D12 and Vulkan), r16uint or r32uint`);
+  }
+  if (!(t.usage & GPUTextureUsage.TEXTURE_BINDING)) {
+    throw new MrslError('rate-usage', `${what} was not created with GPUTextureUsage.TEXTURE_BINDING`);
+  }
+  const [ew, eh] = rateImageSize(bindings.size, tile);
+  if (t.width !== ew || t.height !== eh) {
+    const [w, h] = bindings.size;
+    throw new MrslError('rate-image-size', `${what} is ${t.width}x${t.height}, but a ${w}x${h} image with ${tile}x${tile} tiles needs ${ew}x${eh} texels`);
+  }
+}
+
+/** Every channel, texture, sampler and output the layout declares, and the shading-rate image where the mode binds one. */
+export function checkBindings(layout: Layout, mode: ModePlan, bindings: Bindings, rateTile: number): void {
+  const bindsRate = mode.steps.some((s) => s.step === 'pass' && s.bindings.some((b) => b.resource.id === 'shading_rate'));
+  if (bindsRate) checkShadingRate(bindings, rateTile);
+  for (const ch of layout.channels) {
+    const t = bindings.channels[ch.name];
+    if (!t) throw new MrslError('missing-channel', `G-buffer channel \`${ch.name}\` is not bound`, ch.name);
+    checkChannel(ch, t);
+    checkTextureSize('G-buffer channel', ch.name, t, bindings.size);
+  }
+  for (const t of layout.textures) {
+    const bound = bindings.textures?.[t.name];
+    if (!bound) throw new MrslError('missing-texture', `texture \`${t.name}\` is not bound`, t.name);
+    if ('usage' in bound && !(bound.usage & GPUTextureUsage.TEXTURE_BINDING)) {
+      throw new MrslError(
+        'texture-usage',
+        `texture \`${t.name}\` was not created with GPUTextureUsage.TEXTURE_BINDING, which the kernels need to sample it: add it to the texture's usage`,
+        t.name,
+      );
+    }
+  }
+  for (const s of layout.samplers) {
+    if (!bindings.samplers?.[s.name]) throw new MrslError('missing-sampler', `sampler \`${s.name}\` is not bound`, s.name);
+  }
+  for (const o of layout.outputs) {
+    const t = bindings.outputs[o.name];
+    if (!t) throw new MrslError('missing-output', `output \`${o.name}\` is not bound`, o.name);
+    checkOutput(o, t);
+    checkTextureSize('output', o.name, t, bindings.size);
+  }
+}
