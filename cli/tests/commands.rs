@@ -26,6 +26,10 @@ const TESTS: &[(&str, fn())] = &[
         gbuffer_exports_the_rig_and_the_shadow_map_of_a_mesh_scene,
     ),
     ("render_raw_writes_the_texels_the_png_was_made_from", render_raw_writes_the_texels_the_png_was_made_from),
+    (
+        "gbuffer_exports_a_scene_files_images_with_every_mip_level",
+        gbuffer_exports_a_scene_files_images_with_every_mip_level,
+    ),
 ];
 
 fn main() {
@@ -311,5 +315,53 @@ fn render_raw_writes_the_texels_the_png_was_made_from() {
         raws.push(bytes);
     }
     assert!(raws[0] == raws[1], "forced refinement is the reference, bit for bit");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A scene file's images, with every level of their mip chains (8x4 down
+/// to 1x1), in the format each is bound as; the scene file's size applies
+/// without `--size`, and the mesh scene's `camera_pos` is listed.
+fn gbuffer_exports_a_scene_files_images_with_every_mip_level() {
+    let dir = scratch("gbuffer-images");
+    let quad = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+    std::fs::write(dir.join("quad.obj"), quad).unwrap();
+    image::RgbImage::from_pixel(8, 4, image::Rgb([200, 120, 40])).save(dir.join("albedo.png")).unwrap();
+    image::RgbImage::from_pixel(8, 4, image::Rgb([90, 90, 90])).save(dir.join("rough.png")).unwrap();
+    let scene = dir.join("quad.toml");
+    let text = "mesh = \"quad.obj\"\nsize = [24, 16]\n[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nfov = 45\n\
+                [uniforms]\nalbedo_map = \"albedo.png\"\nroughness_map = { image = \"rough.png\", srgb = false }\n";
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.join("export");
+    let program = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/textured_materials.mrsl");
+    let run = mrslc(&["gbuffer", program, "--scene", scene.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let m = read_json(&out.join("gbuffer.json"));
+    assert_eq!(m["size"], serde_json::json!([24, 16]), "the scene file's size");
+    let camera = m["uniforms"].as_array().unwrap().iter().find(|u| u["name"] == "camera_pos").cloned();
+    assert_eq!(camera.expect("the mesh scene sets camera_pos")["values"], serde_json::json!([0.0, 0.0, 3.0]));
+    for (name, format, texel) in
+        [("albedo_map", "rgba8unorm-srgb", [200, 120, 40, 255]), ("roughness_map", "rgba8unorm", [90, 90, 90, 255])]
+    {
+        let t = m["textures"].as_array().unwrap().iter().find(|t| t["name"] == name).unwrap().clone();
+        assert_eq!((t["format"].as_str(), &t["size"]), (Some(format), &serde_json::json!([8, 4])), "{name}");
+        let mips = t["mips"].as_array().unwrap();
+        let sizes: Vec<&serde_json::Value> = mips.iter().map(|m| &m["size"]).collect();
+        assert_eq!(
+            sizes,
+            [
+                &serde_json::json!([8, 4]),
+                &serde_json::json!([4, 2]),
+                &serde_json::json!([2, 1]),
+                &serde_json::json!([1, 1])
+            ]
+        );
+        for (level, mip) in mips.iter().enumerate() {
+            assert_eq!(mip["file"], format!("texture.{name}.{level}.bin"));
+            let bytes = std::fs::read(out.join(mip["file"].as_str().unwrap())).unwrap();
+            let [w, h] = [0, 1].map(|k| mip["size"][k].as_u64().unwrap() as usize);
+            assert_eq!(bytes.len(), w * h * 4, "{name} level {level}");
+            assert!(bytes.chunks(4).all(|t| t == texel), "{name} level {level}: {bytes:?}");
+        }
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
