@@ -12,3 +12,4 @@ export type { Stats, EffectStats, Timings } from './stats.js';
 export { loadGBuffer, applyUniforms, GBUFFER_FORMAT, type GBufferManifest, type LoadedGBuffer } from './gbuffer.js';
 export { rateImageSize, sampleGrid, type Size } from './geometry.js';
 export { formatInfo } from './formats.js';
+export { readTexture, uniformRateImage } from './readback.js';

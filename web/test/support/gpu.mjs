@@ -43,21 +43,3 @@ async function open() {
   console.log(`web tests: Dawn on ${description}`);
   return { device, adapter, description };
 }
-
-/** Reads a 2D texture's texels back, rows tightly packed. */
-export async function readTexture(device, texture, bytesPerTexel) {
-  const { width, height } = texture;
-  const row = width * bytesPerTexel;
-  const paddedRow = Math.ceil(row / 256) * 256;
-  const buffer = device.createBuffer({ size: paddedRow * height, usage: GPUBufferUsage.COPY_DST | GPUBufferUsage.MAP_READ });
-  const encoder = device.createCommandEncoder();
-  encoder.copyTextureToBuffer({ texture }, { buffer, bytesPerRow: paddedRow }, [width, height]);
-  device.queue.submit([encoder.finish()]);
-  await buffer.mapAsync(GPUMapMode.READ);
-  const mapped = new Uint8Array(buffer.getMappedRange());
-  const out = new Uint8Array(row * height);
-  for (let y = 0; y < height; y++) out.set(mapped.subarray(y * paddedRow, y * paddedRow + row), y * row);
-  buffer.unmap();
-  buffer.destroy();
-  return out;
-}

@@ -1,5 +1,6 @@
-// The mrslc binary the tests run (built with cargo from this repository,
-// debug profile, as `cargo test` builds it), and a helper to run it.
+// The mrslc binary the tests run: $MRSLC when set (cargo's test of this
+// suite, cli/tests/web.rs, passes the one it built), else built with cargo
+// from this repository in the debug profile, as `cargo test` builds it.
 import { execFileSync } from 'node:child_process';
 import { dirname, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -10,6 +11,7 @@ let binary;
 
 /** Builds mrslc (a no-op when it is up to date) and returns its path. */
 export function mrslcPath() {
+  binary ??= process.env.MRSLC;
   if (binary) return binary;
   const out = execFileSync('cargo', ['build', '-q', '-p', 'mrslc', '--message-format=json'], {
     cwd: REPO,

@@ -1,0 +1,124 @@
+// What the playground shows of a render: the image (sRGB-encoded from the
+// float output), the heatmap of where coarse effects were evaluated per
+// pixel, the per-effect statistics and the per-mode timings.
+
+import type { Layout, Mode, Stats } from '../../src/index.js';
+import type { Diagnostic } from './api.js';
+
+/** The sRGB curve and the rounding to a byte (the lab's `linear_to_srgb8`: clamp, encode, round half up). */
+export function linearToSrgb8(v: number): number {
+  if (!Number.isFinite(v)) return 0;
+  const c = Math.min(Math.max(v, 0), 1);
+  const s = c <= 0.0031308 ? 12.92 * c : 1.055 * Math.pow(c, 1 / 2.4) - 0.055;
+  return Math.floor(s * 255 + 0.5);
+}
+
+/** Draws an rgba32float output, tightly packed, into the canvas. */
+export function drawImage(canvas: HTMLCanvasElement, size: readonly [number, number], texels: Uint8Array): void {
+  const floats = new Float32Array(texels.buffer, texels.byteOffset, texels.byteLength / 4);
+  const image = new ImageData(size[0], size[1]);
+  for (let i = 0; i < size[0] * size[1]; i++) {
+    for (let c = 0; c < 3; c++) image.data[4 * i + c] = linearToSrgb8(floats[4 * i + c]!);
+    image.data[4 * i + 3] = 255;
+  }
+  put(canvas, image);
+}
+
+/**
+ * Draws the refine mask (rg32uint): the image dimmed where every coarse
+ * effect was resampled, red by the share of coarse effects evaluated per
+ * pixel, yellow where one came from the dynamic mode's 2x2 level.
+ */
+export function drawHeatmap(canvas: HTMLCanvasElement, size: readonly [number, number], mask: Uint8Array, image: Uint8Array, coarseEffects: number): void {
+  const words = new Uint32Array(mask.buffer, mask.byteOffset, mask.byteLength / 4);
+  const floats = new Float32Array(image.buffer, image.byteOffset, image.byteLength / 4);
+  const out = new ImageData(size[0], size[1]);
+  for (let i = 0; i < size[0] * size[1]; i++) {
+    const evaluated = popcount(words[2 * i]!) / Math.max(coarseEffects, 1);
+    const fromLevel2 = words[2 * i + 1]! !== 0;
+    const grey = 0.3 * linearToSrgb8(floats[4 * i]!) + 0.4 * linearToSrgb8(floats[4 * i + 1]!) + 0.1 * linearToSrgb8(floats[4 * i + 2]!);
+    const base = 0.35 * grey;
+    out.data[4 * i] = Math.round(base + evaluated * (255 - base));
+    out.data[4 * i + 1] = Math.round(fromLevel2 ? 200 : base * (1 - evaluated));
+    out.data[4 * i + 2] = Math.round(base * (1 - evaluated));
+    out.data[4 * i + 3] = 255;
+  }
+  put(canvas, out);
+}
+
+function put(canvas: HTMLCanvasElement, image: ImageData): void {
+  canvas.width = image.width;
+  canvas.height = image.height;
+  (canvas.getContext('2d') as CanvasRenderingContext2D).putImageData(image, 0, 0);
+}
+
+function popcount(n: number): number {
+  let count = 0;
+  for (let v = n >>> 0; v; v &= v - 1) count++;
+  return count;
+}
+
+const percent = (f: number) => `${(100 * f).toFixed(1)}%`;
+
+function rows(table: HTMLTableElement, head: string[], body: string[][]): void {
+  table.replaceChildren();
+  const tr = (cells: string[], tag: 'th' | 'td') => {
+    const row = table.insertRow();
+    for (const text of cells) {
+      const cell = document.createElement(tag);
+      cell.textContent = text;
+      row.append(cell);
+    }
+  };
+  tr(head, 'th');
+  body.forEach((cells) => tr(cells, 'td'));
+}
+
+/** The per-effect statistics: how many pixels evaluated each effect, how many resampled it. */
+export function showStats(table: HTMLTableElement, stats: Stats): void {
+  const body = stats.effects.map((e) => [e.name, e.rate, String(e.coarseEvaluations), String(e.pixelEvaluations), String(e.resampled), percent(e.shadedFraction)]);
+  body.push(['all effects', '', String(stats.coarseSamples), '', '', percent(stats.shadedFraction)]);
+  rows(table, ['effect', 'rate', 'coarse', 'per-pixel', 'resampled', 'shaded'], body);
+}
+
+export interface ModeTiming {
+  mode: Mode;
+  ms: number;
+  /** `gpu` from timestamp queries, `wall` from submission to completion. */
+  clock: 'gpu' | 'wall';
+  shadedFraction: number;
+}
+
+/** Each mode's time, and its speed against the reference's. */
+export function showTimings(table: HTMLTableElement, timings: ModeTiming[]): void {
+  const reference = timings.find((t) => t.mode === 'reference')?.ms;
+  const body = timings.map((t) => [t.mode, `${t.ms.toFixed(2)} ms (${t.clock})`, reference ? `${(reference / t.ms).toFixed(2)}x` : '', percent(t.shadedFraction)]);
+  rows(table, ['mode', 'time', 'vs reference', 'shaded'], body);
+}
+
+/** Compiler diagnostics as the compiler renders them. */
+export function showDiagnostics(panel: HTMLElement, diagnostics: Diagnostic[], problem: string | null): void {
+  panel.replaceChildren();
+  for (const d of diagnostics) {
+    const pre = document.createElement('pre');
+    pre.className = d.severity;
+    pre.textContent = d.rendered;
+    panel.append(pre);
+  }
+  if (problem) {
+    const pre = document.createElement('pre');
+    pre.textContent = problem;
+    panel.append(pre);
+  }
+}
+
+/** The kernels' WGSL, one at a time, and the layout. */
+export function showProgram(select: HTMLSelectElement, wgsl: HTMLElement, layoutPre: HTMLElement, kernels: { file: string; wgsl: string }[], layout: Layout): void {
+  const chosen = select.value;
+  select.replaceChildren(...kernels.map((k) => new Option(k.file, k.file)));
+  if (kernels.some((k) => k.file === chosen)) select.value = chosen;
+  const show = () => (wgsl.textContent = kernels.find((k) => k.file === select.value)?.wgsl ?? '');
+  select.onchange = show;
+  show();
+  layoutPre.textContent = JSON.stringify(layout, null, 2);
+}
