@@ -66,6 +66,8 @@ pub struct PlanConstants {
     /// ([`crate::GROUP_ARGS`], [`crate::BINDING_ARGS`]).
     pub arguments_group: u32,
     pub arguments_binding: u32,
+    /// The refine-mask texel of a background pixel ([`crate::BACKGROUND_MARK`]).
+    pub background_mark: [u32; 2],
 }
 
 /// A [`Lattice`] as data.
@@ -95,6 +97,7 @@ impl Default for PlanConstants {
             max_workgroups_per_dimension: MAX_WORKGROUPS_PER_DIMENSION,
             arguments_group: crate::GROUP_ARGS,
             arguments_binding: crate::BINDING_ARGS,
+            background_mark: crate::BACKGROUND_MARK,
         }
     }
 }

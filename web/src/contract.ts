@@ -134,6 +134,8 @@ export interface PlanConstants {
   max_workgroups_per_dimension: number;
   arguments_group: number;
   arguments_binding: number;
+  /** The refine-mask texel of a background pixel (where the background rule skipped the coarse effects). */
+  background_mark: [number, number];
 }
 
 export interface KernelRef {

@@ -54,6 +54,8 @@ function setState(state: State, message: string): void {
 }
 
 let device: GPUDevice | null = null;
+/** Whether timestamps measure the shader work: a GPU's do, a CPU adapter's (SwiftShader, a fallback adapter) do not. */
+let gpuClock = false;
 let shader: Shader | null = null;
 let gbuffer: { key: string; loaded: LoadedGBuffer } | null = null;
 /** Bumped by every edit: a compile or render that finds it changed stops. */
@@ -62,6 +64,8 @@ let generation = 0;
 async function openDevice(): Promise<GPUDevice | null> {
   const adapter = await navigator.gpu?.requestAdapter();
   if (!adapter) return null;
+  const info = adapter.info as GPUAdapterInfo & { isFallbackAdapter?: boolean };
+  gpuClock = adapter.features.has('timestamp-query') && !info.isFallbackAdapter && !/swiftshader|llvmpipe|cpu/i.test(`${info.architecture} ${info.description} ${info.device}`);
   const requiredFeatures: GPUFeatureName[] = adapter.features.has('timestamp-query') ? ['timestamp-query'] : [];
   const opened = await adapter.requestDevice({ requiredFeatures });
   opened.lost.then((info) => setState('error', `the WebGPU device was lost: ${info.message}`));
@@ -127,6 +131,7 @@ async function update(view: EditorView): Promise<void> {
     return setState('error', `${errors} error${errors === 1 ? '' : 's'}: the image is the last program's`);
   }
   const program = { layout: parseLayout(compiled.layout), kernels: compiled.kernels };
+  ui.timings.replaceChildren(); // the last program's
   showProgram(ui.kernel, ui.wgsl, ui.layout, compiled.kernels, program.layout);
   if (!device) return setState('no-webgpu', 'compiled; this browser has no WebGPU, so nothing is rendered');
   try {
@@ -189,8 +194,7 @@ async function render(mode: Mode, forced: boolean): Promise<Rendered> {
   const mask = maskTexture && mode !== 'reference' ? await readTexture(d, maskTexture) : null;
   Object.values(outputs).forEach((t) => t.destroy());
   shadingRate.destroy();
-  const gpuMs = stats.timings?.totalMs;
-  const timing: ModeTiming = gpuMs ? { mode, ms: gpuMs, clock: 'gpu', shadedFraction: stats.shadedFraction } : { mode, ms: wallMs, clock: 'wall', shadedFraction: stats.shadedFraction };
+  const timing: ModeTiming = { mode, wallMs, gpuMs: stats.timings?.totalMs ?? null, shadedFraction: stats.shadedFraction };
   return { stats, timing, image, mask };
 }
 
@@ -201,14 +205,16 @@ async function renderSelected(mine = generation): Promise<void> {
   const r = await render(mode, ui.forced.checked);
   if (mine !== generation) return;
   const coarse = shader.layout.stats.counters.length;
-  if (ui.view.value === 'heatmap' && r.mask) drawHeatmap(ui.canvas, gbuffer.loaded.size, r.mask, r.image, coarse);
+  const mark = shader.layout.plan.constants.background_mark;
+  if (ui.view.value === 'heatmap' && r.mask) drawHeatmap(ui.canvas, gbuffer.loaded.size, r.mask, r.image, coarse, mark);
   else drawImage(ui.canvas, gbuffer.loaded.size, r.image);
-  const heat = ui.view.value === 'heatmap' ? (r.mask ? 'heatmap: red where coarse effects were evaluated per pixel, yellow from the 2x2 level; ' : 'no heatmap in this mode; ') : '';
+  const heat = ui.view.value === 'heatmap' ? (r.mask ? 'heatmap: red by the share of coarse effects evaluated per pixel, green from the 2x2 level, grey the background; ' : 'no heatmap in this mode; ') : '';
   const rate = mode === 'rate-image' ? `; every ${RATE.tile}x${RATE.tile} tile at ${RATE.rate.join('x')}` : '';
-  ui.note.textContent = `${heat}${mode}${ui.forced.checked ? ' (forced)' : ''} over ${gbuffer.loaded.manifest.scene} at ${ui.size.value}${rate}; ${r.timing.ms.toFixed(2)} ms (${r.timing.clock} time)`;
+  const ms = (t: ModeTiming) => (gpuClock && t.gpuMs !== null ? `${t.gpuMs.toFixed(2)} ms GPU time` : `${t.wallMs.toFixed(2)} ms wall time`);
+  ui.note.textContent = `${heat}${mode}${ui.forced.checked ? ' (forced)' : ''} over ${gbuffer.loaded.manifest.scene} at ${ui.size.value}${rate}; ${ms(r.timing)}`;
   showStats(ui.stats, r.stats);
   document.body.dataset.renders = String(Number(document.body.dataset.renders ?? 0) + 1);
-  setState('rendered', `${mode}: ${(100 * r.stats.shadedFraction).toFixed(1)}% shaded, ${r.timing.ms.toFixed(2)} ms`);
+  setState('rendered', `${mode}: ${(100 * r.stats.shadedFraction).toFixed(1)}% shaded, ${ms(r.timing)}`);
 }
 
 async function timeEveryMode(): Promise<void> {
@@ -219,7 +225,7 @@ async function timeEveryMode(): Promise<void> {
     setState('rendering', `timing ${mode}…`);
     timings.push((await render(mode, false)).timing);
     if (mine !== generation) return;
-    showTimings(ui.timings, timings);
+    showTimings(ui.timings, timings, gpuClock);
   }
   setState('rendered', `timed ${timings.length} modes`);
 }

@@ -24,16 +24,32 @@ export function drawImage(canvas: HTMLCanvasElement, size: readonly [number, num
   put(canvas, image);
 }
 
+/** What `mrslc render`'s heatmaps paint the background (cli/src/legend.rs). */
+const BACKGROUND_GREY = 150;
+
 /**
  * Draws the refine mask (rg32uint): the image dimmed where every coarse
  * effect was resampled, red by the share of coarse effects evaluated per
- * pixel, yellow where one came from the dynamic mode's 2x2 level.
+ * pixel, green where one came from the dynamic mode's 2x2 level, grey on
+ * the background (where the background rule skipped the coarse effects).
  */
-export function drawHeatmap(canvas: HTMLCanvasElement, size: readonly [number, number], mask: Uint8Array, image: Uint8Array, coarseEffects: number): void {
+export function drawHeatmap(
+  canvas: HTMLCanvasElement,
+  size: readonly [number, number],
+  mask: Uint8Array,
+  image: Uint8Array,
+  coarseEffects: number,
+  backgroundMark: readonly [number, number],
+): void {
   const words = new Uint32Array(mask.buffer, mask.byteOffset, mask.byteLength / 4);
   const floats = new Float32Array(image.buffer, image.byteOffset, image.byteLength / 4);
   const out = new ImageData(size[0], size[1]);
   for (let i = 0; i < size[0] * size[1]; i++) {
+    out.data[4 * i + 3] = 255;
+    if (words[2 * i] === backgroundMark[0] && words[2 * i + 1] === backgroundMark[1]) {
+      out.data.fill(BACKGROUND_GREY, 4 * i, 4 * i + 3);
+      continue;
+    }
     const evaluated = popcount(words[2 * i]!) / Math.max(coarseEffects, 1);
     const fromLevel2 = words[2 * i + 1]! !== 0;
     const grey = 0.3 * linearToSrgb8(floats[4 * i]!) + 0.4 * linearToSrgb8(floats[4 * i + 1]!) + 0.1 * linearToSrgb8(floats[4 * i + 2]!);
@@ -41,7 +57,6 @@ export function drawHeatmap(canvas: HTMLCanvasElement, size: readonly [number, n
     out.data[4 * i] = Math.round(base + evaluated * (255 - base));
     out.data[4 * i + 1] = Math.round(fromLevel2 ? 200 : base * (1 - evaluated));
     out.data[4 * i + 2] = Math.round(base * (1 - evaluated));
-    out.data[4 * i + 3] = 255;
   }
   put(canvas, out);
 }
@@ -83,17 +98,29 @@ export function showStats(table: HTMLTableElement, stats: Stats): void {
 
 export interface ModeTiming {
   mode: Mode;
-  ms: number;
-  /** `gpu` from timestamp queries, `wall` from submission to completion. */
-  clock: 'gpu' | 'wall';
+  /** From submission to completion of the frame's commands. */
+  wallMs: number;
+  /** The passes' span from timestamp queries, where the device has them. */
+  gpuMs: number | null;
   shadedFraction: number;
 }
 
-/** Each mode's time, and its speed against the reference's. */
-export function showTimings(table: HTMLTableElement, timings: ModeTiming[]): void {
-  const reference = timings.find((t) => t.mode === 'reference')?.ms;
-  const body = timings.map((t) => [t.mode, `${t.ms.toFixed(2)} ms (${t.clock})`, reference ? `${(reference / t.ms).toFixed(2)}x` : '', percent(t.shadedFraction)]);
-  rows(table, ['mode', 'time', 'vs reference', 'shaded'], body);
+/**
+ * Each mode's times, and its speed against the reference's: by GPU time
+ * where `gpuClock` (timestamps measure the shader work on a GPU, not on a
+ * CPU adapter such as SwiftShader), else by wall time.
+ */
+export function showTimings(table: HTMLTableElement, timings: ModeTiming[], gpuClock: boolean): void {
+  const time = (t: ModeTiming) => (gpuClock && t.gpuMs !== null ? t.gpuMs : t.wallMs);
+  const reference = timings.find((t) => t.mode === 'reference');
+  const body = timings.map((t) => [
+    t.mode,
+    t.gpuMs === null ? '' : `${t.gpuMs.toFixed(2)} ms`,
+    `${t.wallMs.toFixed(2)} ms`,
+    reference ? `${(time(reference) / time(t)).toFixed(2)}x` : '',
+    percent(t.shadedFraction),
+  ]);
+  rows(table, ['mode', 'GPU time', 'wall time', `vs reference (${gpuClock ? 'GPU' : 'wall'})`, 'shaded'], body);
 }
 
 /** Compiler diagnostics as the compiler renders them. */
