@@ -286,6 +286,42 @@ pub struct Channel {
     /// was drawn), if the channel says (absent from the JSON otherwise).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub background: Option<Background>,
+    /// How the kernels decode the channel from what the engine stores, if
+    /// it is not stored as its type (absent from the JSON otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub decode: Option<Decode>,
+}
+
+/// How a channel is computed from an engine's encoding of it (`@depth`,
+/// `@encoded`; docs/language.md). Every kernel decodes it the same way, in
+/// the channel's one loader, so forced refinement still equals the reference.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Decode {
+    /// A `float3` position rebuilt from a depth texture (WebGPU's clip
+    /// space: depth 0 to 1, y up) and the `float4x4` uniform
+    /// `inverse_view_projection` names: the world position of the pixel's
+    /// centre at its depth.
+    Depth { inverse_view_projection: String },
+    /// Stored as unorm (0 to 1), read as `2 v - 1` (normals in `Rgb10a2Unorm`
+    /// or `Rgba8Unorm`).
+    Unorm,
+    /// A unit `float3` stored as two octahedral components in -1 to 1
+    /// (`Rg16Float`, `Rg16Snorm`, `Rg8Snorm`, ...).
+    Octahedral,
+    /// The same, the components stored as unorm (0 to 1; `Rg16Unorm`, `Rg8Unorm`).
+    OctahedralUnorm,
+}
+
+impl Decode {
+    /// The components the engine's texture must hold for a channel of type `ty`.
+    pub fn stored_components(&self, ty: &ValueType) -> u32 {
+        match self {
+            Decode::Depth { .. } => 1,
+            Decode::Octahedral | Decode::OctahedralUnorm => 2,
+            Decode::Unorm => ty.components(),
+        }
+    }
 }
 
 /// How a discontinuity-key channel is compared between samples.

@@ -157,11 +157,14 @@ pub enum TextureFormat {
     R32Sint,
     Rg32Sint,
     Rgba32Sint,
+    /// A depth texture: the format of a channel decoded from depth
+    /// (`@depth(..)`, [`crate::Decode::Depth`]); never an output.
+    Depth32Float,
 }
 
 impl TextureFormat {
     /// Every format, for tables and parsing.
-    pub const ALL: [TextureFormat; 11] = [
+    pub const ALL: [TextureFormat; 12] = [
         TextureFormat::R32Float,
         TextureFormat::Rg32Float,
         TextureFormat::Rgba32Float,
@@ -173,6 +176,7 @@ impl TextureFormat {
         TextureFormat::R32Sint,
         TextureFormat::Rg32Sint,
         TextureFormat::Rgba32Sint,
+        TextureFormat::Depth32Float,
     ];
 
     /// The WebGPU name (`rgba32float`), which is also the WGSL texel format.
@@ -189,13 +193,16 @@ impl TextureFormat {
             TextureFormat::R32Sint => "r32sint",
             TextureFormat::Rg32Sint => "rg32sint",
             TextureFormat::Rgba32Sint => "rgba32sint",
+            TextureFormat::Depth32Float => "depth32float",
         }
     }
 
     /// Number of channels.
     pub fn components(self) -> u32 {
         match self {
-            TextureFormat::R32Float | TextureFormat::R32Uint | TextureFormat::R32Sint => 1,
+            TextureFormat::R32Float | TextureFormat::R32Uint | TextureFormat::R32Sint | TextureFormat::Depth32Float => {
+                1
+            }
             TextureFormat::Rg32Float | TextureFormat::Rg32Uint | TextureFormat::Rg32Sint => 2,
             _ => 4,
         }
@@ -253,6 +260,8 @@ pub enum SampleType {
     UnfilterableFloat,
     Uint,
     Sint,
+    /// A depth texture (`texture_depth_2d`), for a channel decoded from depth.
+    Depth,
 }
 
 impl SampleType {

@@ -10,10 +10,10 @@ use crate::interface::Interface;
 use crate::syntax::ast::Rate;
 use crate::types::{Scalar, Type, round_up};
 use mrsl_abi::{
-    BINDING_CONTROL, BINDING_UNIFORMS, CONTROL_FIELDS, Channel, Control, ControlBlock, EffectLayout, Field, GROUP_ARGS,
-    GROUP_GBUFFER, GROUP_RESOURCES, GROUP_STAGE, HierarchicalLayout, InterfaceLayout, LAYOUT_FORMAT, Layout,
-    NeighbourLayout, NeighbourValue, Output, Plan, Resample, ResourceBinding, ResourceKind, SampleType, SlotLayout,
-    StatsLayout, TextureFormat, UniformBlock, ValueType,
+    BINDING_CONTROL, BINDING_UNIFORMS, CONTROL_FIELDS, Channel, Control, ControlBlock, Decode, EffectLayout, Field,
+    GROUP_ARGS, GROUP_GBUFFER, GROUP_RESOURCES, GROUP_STAGE, HierarchicalLayout, InterfaceLayout, LAYOUT_FORMAT,
+    Layout, NeighbourLayout, NeighbourValue, Output, Plan, Resample, ResourceBinding, ResourceKind, SampleType,
+    SlotLayout, StatsLayout, TextureFormat, UniformBlock, ValueType,
 };
 use std::collections::{BTreeSet, HashMap};
 
@@ -37,6 +37,18 @@ pub fn channel_format(ty: &Type) -> (TextureFormat, SampleType) {
         (Scalar::Int, _) => TextureFormat::Rgba32Sint,
     };
     (format, SampleType::of(format.scalar()))
+}
+
+/// Texture format and sample type of a channel the engine stores encoded:
+/// what the tools create for it (the runtime accepts the others the
+/// encoding fits, docs/runtime.md).
+fn decoded_channel_format(decode: &Decode, ty: &Type) -> (TextureFormat, SampleType) {
+    match decode {
+        Decode::Depth { .. } => (TextureFormat::Depth32Float, SampleType::Depth),
+        Decode::Octahedral | Decode::OctahedralUnorm => (TextureFormat::Rg32Float, SampleType::UnfilterableFloat),
+        Decode::Unorm if ty.components() >= 3 => (TextureFormat::Rgba8Unorm, SampleType::UnfilterableFloat),
+        Decode::Unorm => channel_format(ty),
+    }
 }
 
 pub fn build(
@@ -117,7 +129,10 @@ pub fn build(
         .iter()
         .enumerate()
         .map(|(i, input)| {
-            let (format, sample_type) = channel_format(&input.ty);
+            let (format, sample_type) = match &input.decode {
+                Some(decode) => decoded_channel_format(decode, &input.ty),
+                None => channel_format(&input.ty),
+            };
             Channel {
                 name: input.name.clone(),
                 ty: value_type(&input.ty),
@@ -127,6 +142,7 @@ pub fn build(
                 sample_type,
                 key: input.key.clone(),
                 background: input.background,
+                decode: input.decode.clone(),
             }
         })
         .collect();

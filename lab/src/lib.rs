@@ -41,6 +41,7 @@
 pub mod camera;
 pub mod camera_path;
 pub mod color;
+pub mod engine_formats;
 pub mod fixtures;
 pub mod gbuffer;
 pub mod gpu;

@@ -159,6 +159,12 @@ impl Scene {
         }
     }
 
+    /// The demo scene's camera (the CPU ray caster's pinhole, [`Camera`]'s
+    /// pixel convention): at (0, 1.5, 5), looking at (0, 0.5, 0), 50 degrees.
+    pub fn demo_camera() -> Camera {
+        Camera::look_at([0.0, 1.5, 5.0], [0.0, 0.5, 0.0], 50.0)
+    }
+
     /// Sponza's default camera: in the atrium, at head height near its -x
     /// end, looking along the nave (+x) and slightly up towards the galleries.
     pub fn sponza_camera() -> Camera {
@@ -420,12 +426,12 @@ impl Builder {
 /// Ray-casts spheres on a ground plane from the demo program's default camera
 /// (at (0, 1.5, 5), looking at (0, 0.5, 0), 50 degree vertical field of view).
 fn demo(width: u32, height: u32) -> GBuffer {
-    let eye = Vec3::new(0.0, 1.5, 5.0);
-    let target = Vec3::new(0.0, 0.5, 0.0);
+    let camera = Scene::demo_camera();
+    let (eye, target) = (Vec3::from(camera.eye), Vec3::from(camera.target));
     let forward = normalize(target - eye);
     let right = normalize(Vec3::new(-forward.z, 0.0, forward.x));
     let up = right.cross(forward);
-    let tan_half = (50.0f32.to_radians() / 2.0).tan();
+    let tan_half = (camera.fov_y_degrees.to_radians() / 2.0).tan();
     let aspect = width as f32 / height as f32;
     // (center, radius, material)
     let spheres = [

@@ -18,9 +18,14 @@ pub enum Error {
         found: wgpu::TextureFormat,
     },
     #[error(
-        "G-buffer channel `{channel}` has the depth/stencil format {found:?}, which is not accepted as a channel (the kernels read channels as colour textures): in an engine pass, write what the program reads as `{ty}` into a {expected:?} texture (depth itself fits an R32Float channel, `in float depth`), or reconstruct it from depth (a position, for example) and bind that"
+        "G-buffer channel `{channel}` has the depth/stencil format {found:?}, which is not accepted as a channel (the kernels read channels as colour textures): in an engine pass, write what the program reads as `{ty}` into a {expected:?} texture, or declare the channel `@depth(inverse_view_projection) in float3` to have the kernels rebuild a position from this depth texture"
     )]
     ChannelDepthFormat { channel: String, ty: String, expected: wgpu::TextureFormat, found: wgpu::TextureFormat },
+    /// A channel the program rebuilds from depth (`@depth(..)`) bound with a colour texture.
+    #[error(
+        "G-buffer channel `{channel}` is rebuilt from depth (`@depth`), so it binds the engine's depth texture (Depth32Float, Depth24Plus, Depth16Unorm or a depth-stencil format), but a {found:?} texture was bound"
+    )]
+    ChannelNotDepth { channel: String, found: wgpu::TextureFormat },
     #[error(
         "G-buffer channel `{channel}` was not created with TextureUsages::{missing}, which the kernels need to read it: add it to the texture's usage"
     )]

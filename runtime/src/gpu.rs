@@ -19,6 +19,7 @@ pub fn wgpu_format(format: TextureFormat) -> wgpu::TextureFormat {
         TextureFormat::R32Sint => F::R32Sint,
         TextureFormat::Rg32Sint => F::Rg32Sint,
         TextureFormat::Rgba32Sint => F::Rgba32Sint,
+        TextureFormat::Depth32Float => F::Depth32Float,
     }
 }
 

@@ -59,6 +59,7 @@ pub(crate) fn gbuffer_layout(device: &wgpu::Device, l: &Layout) -> wgpu::BindGro
                     SampleType::Uint => wgpu::TextureSampleType::Uint,
                     SampleType::Sint => wgpu::TextureSampleType::Sint,
                     SampleType::UnfilterableFloat => wgpu::TextureSampleType::Float { filterable: false },
+                    SampleType::Depth => wgpu::TextureSampleType::Depth,
                 },
                 view_dimension: wgpu::TextureViewDimension::D2,
                 multisampled: false,
@@ -175,7 +176,16 @@ pub(crate) fn gbuffer_group(
     let views: Vec<(u32, wgpu::TextureView)> = layout
         .channels
         .iter()
-        .map(|c| (c.binding, bindings.channels[&c.name].create_view(&Default::default())))
+        .map(|c| {
+            // A depth-and-stencil texture is bound through its depth aspect.
+            let aspect = if c.sample_type == SampleType::Depth {
+                wgpu::TextureAspect::DepthOnly
+            } else {
+                wgpu::TextureAspect::All
+            };
+            let view = wgpu::TextureViewDescriptor { aspect, ..Default::default() };
+            (c.binding, bindings.channels[&c.name].create_view(&view))
+        })
         .collect();
     let entries: Vec<wgpu::BindGroupEntry> = views
         .iter()

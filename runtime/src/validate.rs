@@ -7,7 +7,7 @@ use crate::gpu::{layout_format, wgpu_format};
 use crate::shader::Bindings;
 use mrsl_abi::geometry::MAX_SIDE;
 use mrsl_abi::plan::{MAX_WORKGROUPS_PER_DIMENSION, ModePlan, TooLarge, Workgroups};
-use mrsl_abi::{Channel, Layout, Output, Plan, ResourceId, SampleType, TextureFormat};
+use mrsl_abi::{Channel, Decode, Layout, Output, Plan, ResourceId, SampleType, TextureFormat};
 
 /// The image size: not empty, within [`MAX_SIDE`], and within the limits of
 /// every resource the mode makes and every indirect dispatch it records.
@@ -66,15 +66,31 @@ pub(crate) fn bindings(layout: &Layout, mode: &ModePlan, bindings: &Bindings, ra
     Ok(())
 }
 
-/// A G-buffer channel's texture: not a depth format, a format of the
-/// channel's sample type with enough components, `TEXTURE_BINDING`, a
+/// A G-buffer channel's texture: a depth format exactly when the channel is
+/// rebuilt from depth, else a format of the channel's sample type with
+/// enough components (of what its encoding stores), `TEXTURE_BINDING`, a
 /// single-sample 2D texture of one layer.
 fn channel(ch: &Channel, t: &wgpu::Texture) -> Result<(), Error> {
     let (found, expected) = (t.format(), wgpu_format(ch.format));
-    if found.is_depth_stencil_format() {
-        return Err(Error::ChannelDepthFormat { channel: ch.name.clone(), ty: ch.ty.to_string(), expected, found });
+    let from_depth = matches!(ch.decode, Some(Decode::Depth { .. }));
+    if found.is_depth_stencil_format() != from_depth {
+        let (channel, ty) = (ch.name.clone(), ch.ty.to_string());
+        return Err(if from_depth {
+            Error::ChannelNotDepth { channel, found }
+        } else {
+            Error::ChannelDepthFormat { channel, ty, expected, found }
+        });
     }
-    let need = ch.ty.components().min(4);
+    if from_depth {
+        if !found.has_depth_aspect() {
+            return Err(Error::ChannelNotDepth { channel: ch.name.clone(), found });
+        }
+        return usage_and_shape(ch, t);
+    }
+    let need = match &ch.decode {
+        Some(decode) => decode.stored_components(&ch.ty),
+        None => ch.ty.components().min(4),
+    };
     let components = u32::from(found.components());
     let fits = matches!(
         (ch.sample_type, found.sample_type(None, None)),
@@ -87,6 +103,11 @@ fn channel(ch: &Channel, t: &wgpu::Texture) -> Result<(), Error> {
         let (channel, ty, accepted) = (ch.name.clone(), ch.ty.to_string(), accepted_formats(ch));
         return Err(Error::ChannelFormat { channel, ty, expected, accepted, found });
     }
+    usage_and_shape(ch, t)
+}
+
+/// A channel's texture has `TEXTURE_BINDING` and is a single-sample 2D texture of one layer.
+fn usage_and_shape(ch: &Channel, t: &wgpu::Texture) -> Result<(), Error> {
     if !t.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING) {
         return Err(Error::ChannelUsage { channel: ch.name.clone(), missing: "TEXTURE_BINDING" });
     }
@@ -104,13 +125,16 @@ pub(crate) fn accepted_formats(ch: &Channel) -> String {
         SampleType::UnfilterableFloat => "colour format read as float (float, unorm or snorm)",
         SampleType::Uint => "uint colour format",
         SampleType::Sint => "sint colour format",
+        SampleType::Depth => return "a depth format (Depth32Float, Depth24Plus, Depth16Unorm, ...)".into(),
     };
     let examples = |float: &str, uint: &str, sint: &str| match ch.sample_type {
-        SampleType::UnfilterableFloat => float.to_string(),
         SampleType::Uint => uint.to_string(),
         SampleType::Sint => sint.to_string(),
+        _ => float.to_string(),
     };
-    match ch.ty.components().min(4) {
+    // An encoded channel's texture holds what the engine stores (two octahedral components, say).
+    let stored = ch.decode.as_ref().map_or(ch.ty.components(), |d| d.stored_components(&ch.ty));
+    match stored.min(4) {
         1 => format!(
             "any other {kind} ({})",
             examples(
@@ -231,7 +255,17 @@ mod tests {
 
     fn channel(ty: &str, sample_type: SampleType, format: TextureFormat) -> Channel {
         let ty: ValueType = ty.parse().unwrap();
-        Channel { name: "c".into(), ty, group: 1, binding: 0, format, sample_type, key: None, background: None }
+        Channel {
+            name: "c".into(),
+            ty,
+            group: 1,
+            binding: 0,
+            format,
+            sample_type,
+            key: None,
+            background: None,
+            decode: None,
+        }
     }
 
     /// The rule in words: "any" for one component, "at least 2", "exactly 4"

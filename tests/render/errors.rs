@@ -143,7 +143,7 @@ pub fn engine_textures_are_checked_before_recording(gpu: &Gpu) {
     bindings.channels.insert("normal".into(), &depth);
     let (text, e) = error(&bindings, &mut shader);
     assert!(matches!(e, Error::ChannelDepthFormat { ref channel, .. } if channel == "normal"), "{e:?}");
-    assert!(text.contains("not accepted as a channel") && text.contains("reconstruct it from depth"), "{text}");
+    assert!(text.contains("not accepted as a channel") && text.contains("@depth(inverse_view_projection)"), "{text}");
     // A texture array of two layers.
     let layered = gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some("layered"),

@@ -11,6 +11,7 @@ mod harness;
 
 mod background;
 mod binding;
+mod engine_formats;
 mod errors;
 mod frames;
 mod modes;
@@ -39,6 +40,14 @@ const GPU_TESTS: &[GpuTest] = &[
     ),
     ("binding::textured_materials_are_lit_over_a_mesh_scene", binding::textured_materials_are_lit_over_a_mesh_scene),
     ("binding::mismatches_without_defaults_are_typed_errors", binding::mismatches_without_defaults_are_typed_errors),
+    (
+        "engine_formats::depth_and_octahedral_normals_render_as_the_float_gbuffer",
+        engine_formats::depth_and_octahedral_normals_render_as_the_float_gbuffer,
+    ),
+    (
+        "engine_formats::decoded_channels_take_their_engine_formats",
+        engine_formats::decoded_channels_take_their_engine_formats,
+    ),
     ("errors::binding_mismatches_are_typed_errors", errors::binding_mismatches_are_typed_errors),
     ("errors::engine_textures_are_checked_before_recording", errors::engine_textures_are_checked_before_recording),
     (

@@ -72,7 +72,14 @@ export interface ResourceBinding {
   kind: string;
 }
 
-export type SampleType = 'uint' | 'sint' | 'unfilterable-float';
+export type SampleType = 'uint' | 'sint' | 'unfilterable-float' | 'depth';
+
+/** How a channel is decoded from what the engine stores (`@depth`, `@encoded`). */
+export type Decode =
+  | { kind: 'depth'; inverse_view_projection: string }
+  | { kind: 'unorm' }
+  | { kind: 'octahedral' }
+  | { kind: 'octahedral_unorm' };
 
 export interface Channel {
   name: string;
@@ -81,6 +88,7 @@ export interface Channel {
   binding: number;
   format: TextureFormatName;
   sample_type: SampleType;
+  decode?: Decode | null;
 }
 
 export interface Output {

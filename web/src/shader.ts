@@ -256,9 +256,10 @@ export class Shader {
   }
 
   #gbufferGroup(bindings: Bindings): GPUBindGroup {
+    // A depth-and-stencil texture is bound through its depth aspect.
     const entries = this.program.layout.channels.map((c) => ({
       binding: c.binding,
-      resource: (bindings.channels[c.name] as GPUTexture).createView(),
+      resource: (bindings.channels[c.name] as GPUTexture).createView(c.sample_type === 'depth' ? { aspect: 'depth-only' } : {}),
     }));
     return this.device.createBindGroup({ label: 'mrsl g-buffer', layout: this.layouts.gbuffer, entries });
   }

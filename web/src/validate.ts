@@ -76,18 +76,46 @@ function checkTextureSize(what: string, name: string, t: GPUTexture, [w, h]: Siz
 
 const COMPONENTS: Record<string, number> = { '2': 2, '3': 3, '4': 4 };
 
-/** A channel's texture: a colour format read as the channel's sample type with enough components. */
+/** The components the engine's texture holds for a channel (two octahedral ones for a `float3`, say). */
+function storedComponents(ch: Channel): number {
+  const components = COMPONENTS[ch.type.at(-1) ?? ''] ?? 1;
+  switch (ch.decode?.kind) {
+    case 'depth':
+      return 1;
+    case 'octahedral':
+    case 'octahedral_unorm':
+      return 2;
+    default:
+      return components;
+  }
+}
+
+/**
+ * A channel's texture: a depth format exactly when the channel is rebuilt
+ * from depth, else a colour format read as the channel's sample type with
+ * enough components (of what its encoding stores).
+ */
 function checkChannel(ch: Channel, t: GPUTexture): void {
   const info = formatInfo(t.format);
   const wants = ch.sample_type === 'unfilterable-float' ? 'float' : ch.sample_type;
+  if (ch.decode?.kind === 'depth') {
+    if (info?.readAs !== 'depth' || t.format === 'stencil8') {
+      throw new MrslError(
+        'channel-format',
+        `G-buffer channel \`${ch.name}\` is rebuilt from depth (\`@depth\`), so it binds the engine's depth texture (depth32float, depth24plus, depth16unorm or a depth-stencil format), but a ${t.format} texture was bound`,
+        ch.name,
+      );
+    }
+    return checkUsageAndShape(ch, t);
+  }
   if (info?.readAs === 'depth') {
     throw new MrslError(
       'channel-format',
-      `G-buffer channel \`${ch.name}\` has the depth/stencil format ${t.format}, which is not accepted as a channel (the kernels read channels as colour textures): write what the program reads as \`${ch.type}\` into a ${ch.format} texture, or reconstruct it from depth and bind that`,
+      `G-buffer channel \`${ch.name}\` has the depth/stencil format ${t.format}, which is not accepted as a channel (the kernels read channels as colour textures): write what the program reads as \`${ch.type}\` into a ${ch.format} texture, or declare the channel \`@depth(inverse_view_projection) in float3\` to have the kernels rebuild a position from this depth texture`,
       ch.name,
     );
   }
-  const need = Math.min(COMPONENTS[ch.type.at(-1) ?? ''] ?? 1, 4);
+  const need = Math.min(storedComponents(ch), 4);
   const fits = info !== null && info.readAs === wants && info.components >= need && (need !== 3 || info.components === 4);
   if (!fits) {
     const rule = need === 1 ? 'any' : need === 2 ? 'at least 2' : 'exactly 4';
@@ -97,6 +125,11 @@ function checkChannel(ch: Channel, t: GPUTexture): void {
       ch.name,
     );
   }
+  checkUsageAndShape(ch, t);
+}
+
+/** A channel's texture has TEXTURE_BINDING and is a single-sample 2D texture of one layer. */
+function checkUsageAndShape(ch: Channel, t: GPUTexture): void {
   if (!(t.usage & GPUTextureUsage.TEXTURE_BINDING)) {
     throw new MrslError(
       'channel-usage',

@@ -50,7 +50,13 @@ impl Checker<'_> {
             match item {
                 Item::Input(d) => {
                     let ty = self.resolve_type(&d.ty);
-                    self.out.inputs.push(InputInfo { name: d.name.name.clone(), ty, key: None, background: None });
+                    self.out.inputs.push(InputInfo {
+                        name: d.name.name.clone(),
+                        ty,
+                        key: None,
+                        background: None,
+                        decode: None,
+                    });
                 }
                 Item::Uniform(d) => {
                     let ty = self.resolve_type(&d.ty);
@@ -181,7 +187,12 @@ impl Checker<'_> {
                     let rule = self.background_rule(attr, &ty);
                     self.out.inputs[id.index()].background = rule;
                 }
-                other => self.unknown_attribute(attr, other, &["key", "surface_key", "background", "foreground"]),
+                "depth" | "encoded" => self.channel_decode(id, attr, &ty),
+                other => self.unknown_attribute(
+                    attr,
+                    other,
+                    &["key", "surface_key", "background", "foreground", "depth", "encoded"],
+                ),
             }
         }
     }

@@ -22,6 +22,7 @@ use std::collections::{HashMap, HashSet};
 mod builtins;
 mod constants;
 mod declarations;
+mod decode;
 mod expressions;
 mod fold;
 mod formats;
@@ -82,6 +83,8 @@ pub struct InputInfo {
     pub key: Option<KeyCompare>,
     /// `@background(v)` or `@foreground(v)`: which values mark background pixels.
     pub background: Option<Background>,
+    /// `@depth(..)` or `@encoded(..)`: how the engine stores it.
+    pub decode: Option<mrsl_abi::Decode>,
 }
 
 /// What a uniform binds to: a value in the uniform block, or a resource.

@@ -14,7 +14,7 @@ use crate::check::{Background, EffectId, InputId, KeyCompare, Symbol};
 use crate::syntax::ast::*;
 use crate::syntax::{visit_expr, visit_stmt_exprs};
 use crate::types::Scalar;
-use mrsl_abi::{CONTROL_FIELDS, KernelKind};
+use mrsl_abi::{CONTROL_FIELDS, Decode, KernelKind, SampleType};
 use std::collections::{BTreeSet, HashMap, HashSet};
 
 /// The most parameters a WGSL function may declare (the specification's
@@ -204,17 +204,12 @@ impl<'b> Writer<'_, '_, 'b> {
         }
         self.template(0, channels, &[]);
         for ch in &l.channels {
-            let sample = ch.format.scalar().wgsl();
-            self.line(
-                0,
-                format!(
-                    "@group({}) @binding({}) var {}: texture_2d<{sample}>; // {}",
-                    ch.group,
-                    ch.binding,
-                    Name::GBuffer.of(&ch.name),
-                    ch.format
-                ),
-            );
+            let texture = match ch.sample_type {
+                SampleType::Depth => "texture_depth_2d".to_string(),
+                _ => format!("texture_2d<{}>", ch.format.scalar().wgsl()),
+            };
+            let (group, binding, name) = (ch.group, ch.binding, Name::GBuffer.of(&ch.name));
+            self.line(0, format!("@group({group}) @binding({binding}) var {name}: {texture}; // {}", ch.format));
         }
         self.template(0, stage, &[]);
         match self.kind {
@@ -267,20 +262,50 @@ impl<'b> Writer<'_, '_, 'b> {
         self.template(0, include_str!("templates/positions.wgsl"), &[("GRID", &grid), ("PIXEL", &pixel)]);
     }
 
-    /// `mrsl_load_<input>(pos)`: a G-buffer channel at a position's pixel.
+    /// `mrsl_load_<input>(pos)`: a G-buffer channel at a position's pixel,
+    /// decoded where the engine stores it encoded (`@depth`, `@encoded`):
+    /// every kernel reads a channel through its loader, so all decode alike.
     pub(super) fn input_loaders(&mut self) {
-        for input in &self.checked().inputs {
+        let inputs = &self.checked().inputs;
+        if inputs.iter().any(|i| matches!(i.decode, Some(Decode::Octahedral | Decode::OctahedralUnorm))) {
+            self.template(0, include_str!("templates/octahedral.wgsl"), &[]);
+        }
+        for input in inputs {
             let swizzle = match input.ty.components() {
                 1 => ".x",
                 2 => ".xy",
                 3 => ".xyz",
                 _ => "",
             };
-            self.template(
-                0,
-                include_str!("templates/load.wgsl"),
-                &[("NAME", &input.name), ("TYPE", &input.ty.wgsl()), ("SWIZZLE", &swizzle)],
-            );
+            let name = &input.name;
+            match &input.decode {
+                None => self.template(
+                    0,
+                    include_str!("templates/load.wgsl"),
+                    &[("NAME", name), ("TYPE", &input.ty.wgsl()), ("SWIZZLE", &swizzle)],
+                ),
+                Some(Decode::Unorm) => {
+                    let swizzle = format!("{swizzle} * 2.0 - 1.0");
+                    self.template(
+                        0,
+                        include_str!("templates/load.wgsl"),
+                        &[("NAME", name), ("TYPE", &input.ty.wgsl()), ("SWIZZLE", &swizzle)],
+                    )
+                }
+                Some(Decode::Depth { inverse_view_projection }) => self.template(
+                    0,
+                    include_str!("templates/load_depth.wgsl"),
+                    &[("NAME", name), ("MATRIX", &wgsl_ident(inverse_view_projection))],
+                ),
+                Some(octahedral) => {
+                    let unorm = if *octahedral == Decode::OctahedralUnorm { " * 2.0 - 1.0" } else { "" };
+                    self.template(
+                        0,
+                        include_str!("templates/load_octahedral.wgsl"),
+                        &[("NAME", name), ("UNORM", &unorm)],
+                    )
+                }
+            }
         }
     }
 

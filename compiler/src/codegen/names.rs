@@ -310,6 +310,8 @@ pub(super) const FIXED: &[&str] = &[
     BLOCK_SIZE,
     BLOCK_STRUCT,
     CORNERS_STRUCT,
+    // octahedral.wgsl: an octahedral channel's decoding
+    "mrsl_octahedral",
     // resources.wgsl, uniforms.wgsl, stats.wgsl, positions.wgsl: bindings and position helpers
     "MrslControl",
     "MrslUniforms",

@@ -1,0 +1,114 @@
+//! G-buffers as engines store them, made from a lab G-buffer and the camera
+//! it was drawn with: a depth texture (for `@depth` position channels) and
+//! octahedral normals (for `@encoded(octahedral)`), so that a program over
+//! them can be compared with the same program over the float channels.
+
+use crate::camera::{Camera, CameraError};
+use crate::gpu::Gpu;
+use glam::{Mat4, Vec4};
+
+/// The near plane the depth is projected with.
+pub const NEAR: f32 = 0.05;
+
+/// The view-projection `camera` draws a `size` image with (reversed depth,
+/// infinite far plane: [`Camera::view_projection`]), and its inverse, as
+/// the column-major values a `uniform float4x4` takes.
+pub fn view_projection(camera: &Camera, size: (u32, u32)) -> Result<(Mat4, [f32; 16]), CameraError> {
+    let vp = camera.view_projection(size.0 as f32 / size.1 as f32, NEAR)?;
+    Ok((vp, vp.inverse().to_cols_array()))
+}
+
+/// Each pixel's depth as `vp` projects its position (`positions`:
+/// `components` floats a pixel, x, y, z first, as a lab channel holds them).
+pub fn depths(positions: &[f32], components: usize, vp: Mat4) -> Vec<f32> {
+    positions
+        .chunks_exact(components)
+        .map(|p| {
+            let clip = vp * Vec4::new(p[0], p[1], p[2], 1.0);
+            clip.z / clip.w
+        })
+        .collect()
+}
+
+/// The octahedral encoding of a unit vector, both components in -1 to 1
+/// (the inverse of the kernels' `@encoded(octahedral)` decoding).
+pub fn octahedral(n: [f32; 3]) -> [f32; 2] {
+    let sum = n[0].abs() + n[1].abs() + n[2].abs();
+    let (x, y) = (n[0] / sum, n[1] / sum);
+    if n[2] >= 0.0 {
+        [x, y]
+    } else {
+        let sign = |v: f32| if v >= 0.0 { 1.0 } else { -1.0 };
+        [(1.0 - y.abs()) * sign(x), (1.0 - x.abs()) * sign(y)]
+    }
+}
+
+/// A `Depth32Float` texture (TEXTURE_BINDING) holding `depths`. WebGPU
+/// copies no data into a depth32float texture, so a render pass writes it:
+/// a full-screen triangle whose fragments read their depth from an
+/// `R32Float` texture and write it as `frag_depth`.
+pub fn depth_texture(gpu: &Gpu, size: (u32, u32), depths: &[f32]) -> wgpu::Texture {
+    let device = &gpu.device;
+    let source =
+        gpu.texture_with_data("depth values", size, wgpu::TextureFormat::R32Float, bytemuck::cast_slice(depths));
+    let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT;
+    let depth = gpu.texture_2d("depth", size, wgpu::TextureFormat::Depth32Float, usage);
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("depth upload"),
+        source: wgpu::ShaderSource::Wgsl(include_str!("depth_upload.wgsl").into()),
+    });
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("depth upload"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs"),
+            compilation_options: Default::default(),
+            targets: &[],
+        }),
+        primitive: Default::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: wgpu::TextureFormat::Depth32Float,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        multiview_mask: None,
+        cache: None,
+    });
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("depth upload"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: wgpu::BindingResource::TextureView(&source.create_view(&Default::default())),
+        }],
+    });
+    let view = depth.create_view(&Default::default());
+    let mut encoder = device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("depth upload"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, Some(&group), &[]);
+        pass.draw(0..3, 0..1);
+    }
+    gpu.queue.submit([encoder.finish()]);
+    depth
+}

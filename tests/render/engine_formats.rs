@@ -1,0 +1,135 @@
+//! Channels as engines store them: the demo program with its position
+//! rebuilt from a depth texture (`@depth`) and its normals read from two
+//! octahedral components (`@encoded(octahedral)`) renders the image of the
+//! float G-buffer within the rounding of the reconstruction; forced
+//! refinement still equals the reference bit for bit in every mode; and a
+//! texture of the wrong kind for a decoded channel is a typed error.
+
+use crate::harness::*;
+use mrsl_lab::engine_formats;
+use mrsl_lab::gpu::Gpu;
+use mrsl_lab::scene::{ChannelData, Scene};
+use mrsl_runtime::{Bindings, DispatchOptions, Error, Mode, Shader};
+
+const DEMO: &str = include_str!("../../examples/demo.mrsl");
+const SIZE: (u32, u32) = (96, 54);
+
+/// examples/demo.mrsl over a depth texture and octahedral normals.
+fn engine_program() -> String {
+    let position = "@surface_key(normal, 0.05) in float3 position;";
+    let normal = "@key(0.4) in float3 normal;";
+    assert!(DEMO.contains(position) && DEMO.contains(normal), "examples/demo.mrsl declares its channels so");
+    DEMO.replace(position, "@surface_key(normal, 0.05) @depth(inverse_view_proj) in float3 position;")
+        .replace(normal, "@key(0.4) @encoded(octahedral) in float3 normal;")
+        + "\nuniform float4x4 inverse_view_proj;\n"
+}
+
+fn floats<'a>(data: Option<&'a ChannelData>, name: &str) -> (usize, &'a [f32]) {
+    match data {
+        Some(ChannelData::Float { components, data }) => (*components as usize, data),
+        _ => panic!("the demo scene has a float `{name}` channel"),
+    }
+}
+
+/// The demo G-buffer twice: as the lab stores it, and as an engine does
+/// (depth in a Depth32Float texture, normals as octahedral Rg32Float).
+fn gbuffers(gpu: &Gpu) -> (Vec<(String, wgpu::Texture)>, Vec<(String, wgpu::Texture)>, [f32; 16]) {
+    let gbuffer = Scene::Demo.render(SIZE.0, SIZE.1);
+    let float = gbuffer.upload(gpu);
+    let (vp, inverse) = engine_formats::view_projection(&Scene::demo_camera(), SIZE).unwrap();
+    let (n, positions) = floats(gbuffer.channel("position"), "position");
+    let depth = engine_formats::depth_texture(gpu, SIZE, &engine_formats::depths(positions, n, vp));
+    let (n, normals) = floats(gbuffer.channel("normal"), "normal");
+    let encoded: Vec<f32> =
+        normals.chunks_exact(n).flat_map(|v| engine_formats::octahedral([v[0], v[1], v[2]])).collect();
+    let normal = gpu.texture_with_data("normal", SIZE, wgpu::TextureFormat::Rg32Float, bytemuck::cast_slice(&encoded));
+    let mut engine = gbuffer.upload(gpu);
+    engine.retain(|(name, _)| name != "position" && name != "normal");
+    engine.push(("position".into(), depth));
+    engine.push(("normal".into(), normal));
+    (float, engine, inverse)
+}
+
+fn render(
+    gpu: &Gpu,
+    shader: &mut Shader,
+    channels: &[(String, wgpu::Texture)],
+    mode: Mode,
+    forced: bool,
+) -> Vec<[f32; 4]> {
+    let options = DispatchOptions { force_refine: forced, ..DispatchOptions::new(mode) };
+    render_color(gpu, shader, channels, &[], &[], SIZE, options).pixels
+}
+
+/// Every mode over the engine's G-buffer against the same mode over the
+/// float one. The depth is a 32-bit float of `near / view depth`, and the
+/// position rebuilt from it through the inverse view-projection differs
+/// from the ray-cast one by float rounding (relative 1e-6 near, more for
+/// the sky at 50 units); the octahedral normals by a few ulps. A key or a
+/// refine predicate near its threshold may therefore flip at a pixel or
+/// two; the bound, 60 dB PSNR in every mode, allows that and nothing like
+/// a wrong decoding (which loses the image: below 20 dB).
+pub fn depth_and_octahedral_normals_render_as_the_float_gbuffer(gpu: &Gpu) {
+    let (float_channels, engine_channels, inverse) = gbuffers(gpu);
+    let mut float = Shader::new(&gpu.device, &compile(DEMO)).unwrap();
+    let mut engine = Shader::new(&gpu.device, &compile(&engine_program())).unwrap();
+    engine.set_uniform_f32("inverse_view_proj", &inverse).unwrap();
+    let reference = render(gpu, &mut engine, &engine_channels, Mode::Reference, false);
+    for mode in Mode::ALL {
+        let expected = render(gpu, &mut float, &float_channels, mode, false);
+        let found = render(gpu, &mut engine, &engine_channels, mode, false);
+        let psnr = psnr_of(&found, &expected);
+        println!("  {mode}: depth + octahedral normals against the float G-buffer: {psnr:.1} dB");
+        assert!(psnr >= 60.0, "{mode}: {psnr:.1} dB against the float G-buffer");
+        if mode != Mode::Reference {
+            let forced = render(gpu, &mut engine, &engine_channels, mode, true);
+            assert_eq!(worst_ulps(&forced, &reference), 0, "{mode}: forced refinement differs from the reference");
+        }
+    }
+}
+
+/// A decoded channel takes only the texture its decoding reads.
+pub fn decoded_channels_take_their_engine_formats(gpu: &Gpu) {
+    let (float_channels, engine_channels, _) = gbuffers(gpu);
+    let engine = compile(&engine_program());
+    let float = compile(DEMO);
+    let encode = |program: &mrsl::Program, swap: &[(&str, &wgpu::Texture)]| -> Error {
+        let mut shader = Shader::new(&gpu.device, program).unwrap();
+        shader.set_uniform_f32("inverse_view_proj", &[0.0; 16]).ok();
+        let base = if std::ptr::eq(program, &engine) { &engine_channels } else { &float_channels };
+        let color = gpu.output_texture("color", SIZE, wgpu::TextureFormat::Rgba32Float);
+        let mut bindings = Bindings { size: SIZE, ..Default::default() };
+        for (name, texture) in base {
+            bindings.channels.insert(name.clone(), texture);
+        }
+        for (name, texture) in swap {
+            bindings.channels.insert(name.to_string(), texture);
+        }
+        bindings.outputs.insert("color".into(), &color);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        shader
+            .encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, DispatchOptions::new(Mode::Reference))
+            .unwrap_err()
+    };
+    let texture = |set: &[(String, wgpu::Texture)], name: &str| set.iter().find(|(n, _)| n == name).unwrap().1.clone();
+    match encode(&engine, &[("position", &texture(&float_channels, "position"))]) {
+        Error::ChannelNotDepth { channel, found } => {
+            assert_eq!((channel.as_str(), found), ("position", wgpu::TextureFormat::Rgba32Float))
+        }
+        other => panic!("a colour texture for a depth channel: {other:?}"),
+    }
+    match encode(&float, &[("position", &texture(&engine_channels, "position"))]) {
+        e @ Error::ChannelDepthFormat { .. } => assert!(e.to_string().contains("@depth"), "{e}"),
+        other => panic!("a depth texture for a float channel: {other:?}"),
+    }
+    let one = gpu.texture_with_data(
+        "normal",
+        SIZE,
+        wgpu::TextureFormat::R32Float,
+        &vec![0u8; (SIZE.0 * SIZE.1 * 4) as usize],
+    );
+    match encode(&engine, &[("normal", &one)]) {
+        e @ Error::ChannelFormat { .. } => assert!(e.to_string().contains("at least 2 components"), "{e}"),
+        other => panic!("one component for an octahedral channel: {other:?}"),
+    }
+}
