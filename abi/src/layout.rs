@@ -311,6 +311,41 @@ pub enum Decode {
     Octahedral,
     /// The same, the components stored as unorm (0 to 1; `Rg16Unorm`, `Rg8Unorm`).
     OctahedralUnorm,
+    /// One field of Bevy's deferred G-buffer (`Rgba32Uint`, as Bevy 0.19's
+    /// `pbr_deferred_functions.wgsl` packs it); every such channel binds
+    /// the same texture.
+    BevyDeferred { field: BevyField },
+}
+
+/// The fields of Bevy's deferred G-buffer texel: x the base colour (stored
+/// with a 1/2.2 gamma) and perceptual roughness as unorm4x8, y the emissive
+/// colour as rgb9e5, z reflectance, metallic and occlusion as unorm4x8, w a
+/// 24-bit octahedral normal (two 12-bit unorm halves) and 8 flag bits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BevyField {
+    BaseColor,
+    PerceptualRoughness,
+    Emissive,
+    Reflectance,
+    Metallic,
+    Occlusion,
+    Normal,
+    Flags,
+}
+
+impl BevyField {
+    /// Every field, as `@packed(bevy_deferred, ..)` names it, with its type.
+    pub const ALL: [(BevyField, &'static str, &'static str); 8] = [
+        (BevyField::BaseColor, "base_color", "float3"),
+        (BevyField::PerceptualRoughness, "perceptual_roughness", "float"),
+        (BevyField::Emissive, "emissive", "float3"),
+        (BevyField::Reflectance, "reflectance", "float"),
+        (BevyField::Metallic, "metallic", "float"),
+        (BevyField::Occlusion, "occlusion", "float"),
+        (BevyField::Normal, "normal", "float3"),
+        (BevyField::Flags, "flags", "uint"),
+    ];
 }
 
 impl Decode {
@@ -320,6 +355,7 @@ impl Decode {
             Decode::Depth { .. } => 1,
             Decode::Octahedral | Decode::OctahedralUnorm => 2,
             Decode::Unorm => ty.components(),
+            Decode::BevyDeferred { .. } => 4,
         }
     }
 }

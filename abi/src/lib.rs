@@ -38,7 +38,7 @@ mod types;
 pub use control::{CONTROL_FIELDS, Control, ControlField};
 pub use kernel::{KernelKind, entry};
 pub use layout::{
-    BACKGROUND_MARK, Background, Channel, ControlBlock, Decode, EffectLayout, Field, HierarchicalLayout,
+    BACKGROUND_MARK, Background, BevyField, Channel, ControlBlock, Decode, EffectLayout, Field, HierarchicalLayout,
     InterfaceLayout, KeyCompare, LAYOUT_FORMAT, Layout, NeighbourLayout, NeighbourValue, Output, Rate, RefineMaskTexel,
     Resample, ResourceBinding, ResourceKind, SlotLayout, StatsLayout, UniformBlock,
 };

@@ -48,6 +48,7 @@ fn decoded_channel_format(decode: &Decode, ty: &Type) -> (TextureFormat, SampleT
         Decode::Octahedral | Decode::OctahedralUnorm => (TextureFormat::Rg32Float, SampleType::UnfilterableFloat),
         Decode::Unorm if ty.components() >= 3 => (TextureFormat::Rgba8Unorm, SampleType::UnfilterableFloat),
         Decode::Unorm => channel_format(ty),
+        Decode::BevyDeferred { .. } => (TextureFormat::Rgba32Uint, SampleType::Uint),
     }
 }
 

@@ -1,6 +1,7 @@
 //! G-buffers as engines store them, made from a lab G-buffer and the camera
-//! it was drawn with: a depth texture (for `@depth` position channels) and
-//! octahedral normals (for `@encoded(octahedral)`), so that a program over
+//! it was drawn with: a depth texture (for `@depth` position channels),
+//! octahedral normals (for `@encoded(octahedral)`) and Bevy's deferred
+//! G-buffer texel (for `@packed(bevy_deferred, ..)`), so that a program over
 //! them can be compared with the same program over the float channels.
 
 use crate::camera::{Camera, CameraError};
@@ -111,4 +112,27 @@ pub fn depth_texture(gpu: &Gpu, size: (u32, u32), depths: &[f32]) -> wgpu::Textu
     }
     gpu.queue.submit([encoder.finish()]);
     depth
+}
+
+/// What a pixel of Bevy's deferred G-buffer holds (the lab's G-buffer has
+/// no emissive, reflectance or flags of its own: they get Bevy's defaults).
+pub struct BevySurface {
+    pub base_color: [f32; 3],
+    pub perceptual_roughness: f32,
+    pub normal: [f32; 3],
+}
+
+/// Bevy 0.19's deferred G-buffer texel (`Rgba32Uint`) of a surface, packed
+/// as its `deferred_gbuffer_from_pbr_input` packs it: x the base colour with
+/// a 1/2.2 gamma and the roughness as unorm4x8, y no emissive (rgb9e5 of
+/// zero is 0), z reflectance 0.5, metallic 0 and occlusion 1 as unorm4x8,
+/// w the octahedral normal in two 12-bit halves and no flags.
+pub fn bevy_deferred(s: &BevySurface) -> [u32; 4] {
+    let unorm4x8 = |v: [f32; 4]| {
+        v.iter().enumerate().fold(0u32, |word, (k, c)| word | (((c.clamp(0.0, 1.0) * 255.0).round() as u32) << (8 * k)))
+    };
+    let gamma = |c: f32| c.max(0.0).powf(1.0 / 2.2);
+    let color = [gamma(s.base_color[0]), gamma(s.base_color[1]), gamma(s.base_color[2]), s.perceptual_roughness];
+    let [x, y] = octahedral(s.normal).map(|e| ((e * 0.5 + 0.5).clamp(0.0, 1.0) * 4095.0) as u32);
+    [unorm4x8(color), 0, unorm4x8([0.5, 0.0, 1.0, 0.0]), (x & 0xfff) | ((y & 0xfff) << 12)]
 }

@@ -45,6 +45,10 @@ const GPU_TESTS: &[GpuTest] = &[
         engine_formats::depth_and_octahedral_normals_render_as_the_float_gbuffer,
     ),
     (
+        "engine_formats::bevy_deferred_gbuffer_renders_as_the_float_gbuffer",
+        engine_formats::bevy_deferred_gbuffer_renders_as_the_float_gbuffer,
+    ),
+    (
         "engine_formats::decoded_channels_take_their_engine_formats",
         engine_formats::decoded_channels_take_their_engine_formats,
     ),

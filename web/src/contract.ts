@@ -79,7 +79,8 @@ export type Decode =
   | { kind: 'depth'; inverse_view_projection: string }
   | { kind: 'unorm' }
   | { kind: 'octahedral' }
-  | { kind: 'octahedral_unorm' };
+  | { kind: 'octahedral_unorm' }
+  | { kind: 'bevy_deferred'; field: string };
 
 export interface Channel {
   name: string;

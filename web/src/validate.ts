@@ -85,6 +85,8 @@ function storedComponents(ch: Channel): number {
     case 'octahedral':
     case 'octahedral_unorm':
       return 2;
+    case 'bevy_deferred':
+      return 4;
     default:
       return components;
   }

@@ -187,11 +187,11 @@ impl Checker<'_> {
                     let rule = self.background_rule(attr, &ty);
                     self.out.inputs[id.index()].background = rule;
                 }
-                "depth" | "encoded" => self.channel_decode(id, attr, &ty),
+                "depth" | "encoded" | "packed" => self.channel_decode(id, attr, &ty),
                 other => self.unknown_attribute(
                     attr,
                     other,
-                    &["key", "surface_key", "background", "foreground", "depth", "encoded"],
+                    &["key", "surface_key", "background", "foreground", "depth", "encoded", "packed"],
                 ),
             }
         }

@@ -2,12 +2,13 @@
 //! `@depth(U)` (a `float3` position rebuilt from a depth texture and the
 //! `float4x4` uniform `U`, the inverse view-projection) and
 //! `@encoded(unorm | octahedral | octahedral_unorm)` (normals packed as
-//! engines pack them). The kernels decode in the channel's loader.
+//! engines pack them) and `@packed(bevy_deferred, FIELD)` (one field of
+//! Bevy's deferred G-buffer). The kernels decode in the channel's loader.
 
 use super::{Checker, InputId, UniformKind, err};
 use crate::syntax::ast::*;
 use crate::types::{Scalar, Type};
-use mrsl_abi::Decode;
+use mrsl_abi::{BevyField, Decode};
 
 /// The encodings `@encoded` takes, with what each means in messages.
 const ENCODINGS: [(&str, &str); 3] = [
@@ -21,13 +22,14 @@ impl Checker<'_> {
     pub(super) fn channel_decode(&mut self, id: InputId, attr: &Attribute, ty: &Type) {
         let decode = match attr.name.name.as_str() {
             "depth" => self.depth_decode(attr, ty),
+            "packed" => self.packed(attr, ty),
             _ => self.encoded(attr, ty),
         };
         let Some(decode) = decode else { return };
         if self.out.inputs[id.index()].decode.is_some() {
             self.error(
                 err("E0111", "a channel is decoded one way", attr.span, "a second decoding")
-                    .with_note("`@depth` and `@encoded` are each a whole decoding of the channel"),
+                    .with_note("`@depth`, `@encoded` and `@packed` are each a whole decoding of the channel"),
             );
             return;
         }
@@ -63,6 +65,51 @@ impl Checker<'_> {
                 None
             }
         }
+    }
+
+    /// `@packed(bevy_deferred, FIELD)`: the channel is FIELD of Bevy's
+    /// deferred G-buffer, and has FIELD's type.
+    fn packed(&mut self, attr: &Attribute, ty: &Type) -> Option<Decode> {
+        let fields = || {
+            let list: Vec<String> = BevyField::ALL.iter().map(|(_, name, ty)| format!("`{name}` ({ty})")).collect();
+            format!("the fields of `bevy_deferred`: {}", list.join(", "))
+        };
+        let name = |e: &Expr| match &e.kind {
+            ExprKind::Name(name) => Some(name.clone()),
+            _ => None,
+        };
+        let [preset, field] = attr.args.as_slice() else {
+            self.error(
+                err("E0111", "`@packed` takes a packing and a field", attr.span, "expected two arguments")
+                    .with_note("e.g. `@packed(bevy_deferred, normal) in float3 normal;`"),
+            );
+            return None;
+        };
+        if name(preset).as_deref() != Some("bevy_deferred") {
+            self.error(
+                err("E0111", "unknown packing", preset.span, "not a packing")
+                    .with_note("the packings: `bevy_deferred` (Bevy's deferred G-buffer, an `Rgba32Uint` texture)"),
+            );
+            return None;
+        }
+        let Some(&(field, _, wanted)) = BevyField::ALL.iter().find(|(_, n, _)| name(field).as_deref() == Some(*n))
+        else {
+            self.error(err("E0111", "unknown field of `bevy_deferred`", field.span, "not a field").with_note(fields()));
+            return None;
+        };
+        if ty.to_string() != wanted && !ty.is_error() {
+            self.error(
+                err(
+                    "E0111",
+                    format!("this field of `bevy_deferred` is a `{wanted}`"),
+                    attr.span,
+                    format!("declare the channel `{wanted}`"),
+                )
+                .with_note(fields()),
+            );
+            return None;
+        }
+        Some(Decode::BevyDeferred { field })
     }
 
     /// `@encoded(unorm)` on a float channel, `@encoded(octahedral)` and

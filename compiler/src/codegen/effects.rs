@@ -14,7 +14,7 @@ use crate::check::{Background, EffectId, InputId, KeyCompare, Symbol};
 use crate::syntax::ast::*;
 use crate::syntax::{visit_expr, visit_stmt_exprs};
 use crate::types::Scalar;
-use mrsl_abi::{CONTROL_FIELDS, Decode, KernelKind, SampleType};
+use mrsl_abi::{BevyField, CONTROL_FIELDS, Decode, KernelKind, SampleType};
 use std::collections::{BTreeSet, HashMap, HashSet};
 
 /// The most parameters a WGSL function may declare (the specification's
@@ -267,8 +267,15 @@ impl<'b> Writer<'_, '_, 'b> {
     /// every kernel reads a channel through its loader, so all decode alike.
     pub(super) fn input_loaders(&mut self) {
         let inputs = &self.checked().inputs;
-        if inputs.iter().any(|i| matches!(i.decode, Some(Decode::Octahedral | Decode::OctahedralUnorm))) {
+        let bevy = |f: BevyField| Some(Decode::BevyDeferred { field: f });
+        let octahedral = |d: &Option<Decode>| {
+            matches!(d, Some(Decode::Octahedral | Decode::OctahedralUnorm)) || *d == bevy(BevyField::Normal)
+        };
+        if inputs.iter().any(|i| octahedral(&i.decode)) {
             self.template(0, include_str!("templates/octahedral.wgsl"), &[]);
+        }
+        if inputs.iter().any(|i| i.decode == bevy(BevyField::Emissive)) {
+            self.template(0, include_str!("templates/rgb9e5.wgsl"), &[]);
         }
         for input in inputs {
             let swizzle = match input.ty.components() {
@@ -297,6 +304,13 @@ impl<'b> Writer<'_, '_, 'b> {
                     include_str!("templates/load_depth.wgsl"),
                     &[("NAME", name), ("MATRIX", &wgsl_ident(inverse_view_projection))],
                 ),
+                Some(Decode::BevyDeferred { field }) => {
+                    let what = BevyField::ALL.iter().find(|(f, ..)| f == field).map_or("", |(_, n, _)| n);
+                    let value = bevy_field(*field);
+                    let values: [(&str, &dyn std::fmt::Display); 4] =
+                        [("NAME", name), ("FIELD", &what), ("TYPE", &input.ty.wgsl()), ("VALUE", &value)];
+                    self.template(0, include_str!("templates/load_packed.wgsl"), &values)
+                }
                 Some(octahedral) => {
                     let unorm = if *octahedral == Decode::OctahedralUnorm { " * 2.0 - 1.0" } else { "" };
                     self.template(
@@ -812,5 +826,21 @@ fn visit_kept_exprs<'a>(s: &'a Stmt, skipped: &HashSet<NodeId>, f: &mut dyn FnMu
         }
         StmtKind::Block(b) => b.stmts.iter().for_each(|s| visit_kept_exprs(s, skipped, f)),
         _ => visit_stmt_exprs(s, f),
+    }
+}
+
+/// The WGSL of a field of Bevy's deferred G-buffer texel `g` (a `vec4<u32>`),
+/// as Bevy 0.19's `pbr_input_from_deferred_gbuffer` decodes it.
+fn bevy_field(field: BevyField) -> String {
+    let octahedral = "mrsl_octahedral(vec2<f32>(f32(g.w & 0xfffu), f32((g.w >> 12u) & 0xfffu)) / 4095.0 * 2.0 - 1.0)";
+    match field {
+        BevyField::BaseColor => "pow(unpack4x8unorm(g.x).rgb, vec3<f32>(2.2))".into(),
+        BevyField::PerceptualRoughness => "unpack4x8unorm(g.x).a".into(),
+        BevyField::Emissive => "mrsl_rgb9e5(g.y)".into(),
+        BevyField::Reflectance => "unpack4x8unorm(g.z).x".into(),
+        BevyField::Metallic => "unpack4x8unorm(g.z).y".into(),
+        BevyField::Occlusion => "unpack4x8unorm(g.z).z".into(),
+        BevyField::Normal => octahedral.into(),
+        BevyField::Flags => "(g.w >> 24u) & 0xffu".into(),
     }
 }

@@ -310,8 +310,9 @@ pub(super) const FIXED: &[&str] = &[
     BLOCK_SIZE,
     BLOCK_STRUCT,
     CORNERS_STRUCT,
-    // octahedral.wgsl: an octahedral channel's decoding
+    // octahedral.wgsl, rgb9e5.wgsl: decodings of packed channels
     "mrsl_octahedral",
+    "mrsl_rgb9e5",
     // resources.wgsl, uniforms.wgsl, stats.wgsl, positions.wgsl: bindings and position helpers
     "MrslControl",
     "MrslUniforms",
