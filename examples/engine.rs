@@ -1,29 +1,38 @@
 //! An engine using mrsl the way a real renderer would: it owns the wgpu
-//! device, fills its own G-buffer textures, loads kernels that `mrslc
-//! compile` wrote ahead of time, and lets the mrsl runtime record its passes
-//! into the engine's command encoder. The compiler is not linked:
+//! device, fills its own G-buffer textures as engines store them, loads
+//! kernels that `mrslc compile` wrote ahead of time, and lets the mrsl
+//! runtime record its passes into the engine's command encoder. The
+//! compiler is not linked:
 //!
 //! ```sh
-//! cargo run --release -p mrslc -- compile examples/demo.mrsl -o kernels
+//! cargo run --release -p mrslc -- compile examples/engine/deferred.mrsl -o kernels
 //! cargo run --release -p mrsl-runtime --example engine -- kernels [--out DIR]
 //! ```
 //!
 //! writes `engine.dynamic.png` and `engine.reference.png` into `out/` (or
 //! `--out DIR`). Built with the runtime's `compile` feature (`--features
-//! compile`) and no kernel directory, it compiles the built-in demo program
+//! compile`) and no kernel directory, it compiles examples/engine/deferred.mrsl
 //! at load time instead.
 //!
-//! The G-buffer here is filled from the CPU (a sphere over a ground plane,
-//! analytically); an engine would rasterise it in its own geometry pass. It
-//! has `position`, `normal` (rgba32float), `uv` (rg32float) and `material`
-//! (r32uint); a program reading another channel gets a typed error naming it.
+//! The G-buffer is a sphere over a ground plane, ray-cast on the CPU (an
+//! engine rasterises it in its geometry pass), stored as engines store it:
+//! a `Depth32Float` depth texture (no position: the kernels rebuild it
+//! through the inverse view-projection, `@depth`), normals in
+//! `Rgb10a2Unorm` (`@encoded(unorm)`), albedo in `Rgba8Unorm` and an
+//! `R8Uint` material id. A program reading a channel the engine does not
+//! have gets a typed error naming it.
 
+use glam::{Mat4, Vec3, Vec4};
 use mrsl_runtime::{Bindings, CompiledProgram, DispatchOptions, Mode, Shader};
 use std::collections::HashMap;
 
 const WIDTH: u32 = 480;
 const HEIGHT: u32 = 270;
 const EYE: [f32; 3] = [0.0, 1.2, 4.0];
+const TARGET: [f32; 3] = [0.0, 0.5, 0.0];
+const FOV_Y_DEGREES: f32 = 45.0;
+/// The near plane of the reversed, infinite-far depth.
+const NEAR: f32 = 0.05;
 
 fn main() -> std::process::ExitCode {
     let runtime_dir = quiet_headless_vulkan();
@@ -122,11 +131,13 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     };
     let g = gbuffer();
     let sampled = wgpu::TextureUsages::TEXTURE_BINDING;
+    let normals: Vec<u32> = g.normal.iter().map(|n| rgb10a2unorm(*n)).collect();
+    let albedo: Vec<u8> = g.albedo.iter().flat_map(|a| a.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8)).collect();
     let channels = HashMap::from([
-        ("position", texture("position", wgpu::TextureFormat::Rgba32Float, bytemuck::cast_slice(&g.position), sampled)),
-        ("normal", texture("normal", wgpu::TextureFormat::Rgba32Float, bytemuck::cast_slice(&g.normal), sampled)),
-        ("uv", texture("uv", wgpu::TextureFormat::Rg32Float, bytemuck::cast_slice(&g.uv), sampled)),
-        ("material", texture("material", wgpu::TextureFormat::R32Uint, bytemuck::cast_slice(&g.material), sampled)),
+        ("position", depth_texture(&device, &queue, &g.depth)),
+        ("normal", texture("normal", wgpu::TextureFormat::Rgb10a2Unorm, bytemuck::cast_slice(&normals), sampled)),
+        ("albedo", texture("albedo", wgpu::TextureFormat::Rgba8Unorm, &albedo, sampled)),
+        ("material", texture("material", wgpu::TextureFormat::R8Uint, &g.material, sampled)),
     ]);
     // Output targets in the formats the layout names.
     let storage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
@@ -139,8 +150,15 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
 
     // 3. The program on the engine's device.
     let mut shader = Shader::new(&device, &program)?;
-    if program.layout.uniforms.as_ref().is_some_and(|u| u.fields.iter().any(|f| f.name == "camera_pos")) {
-        shader.set_uniform("camera_pos", &EYE.map(f64::from))?;
+    let declares =
+        |name: &str| program.layout.uniforms.as_ref().is_some_and(|u| u.fields.iter().any(|f| f.name == name));
+    if declares("camera_pos") {
+        shader.set_uniform_f32("camera_pos", &EYE)?;
+    }
+    // The position channel is rebuilt from depth with the inverse of the
+    // view-projection the depth was written with (`@depth(inverse_view_proj)`).
+    if declares("inverse_view_proj") {
+        shader.set_uniform_f32("inverse_view_proj", &view_projection().inverse().to_cols_array())?;
     }
     let mut bindings = Bindings { size: (WIDTH, HEIGHT), ..Default::default() };
     for (name, t) in &channels {
@@ -173,74 +191,196 @@ fn load_program(dir: Option<&std::path::Path>) -> Result<CompiledProgram, Box<dy
     }
     #[cfg(feature = "compile")]
     {
-        println!("no kernel directory given: compiling the built-in demo program");
+        println!("no kernel directory given: compiling examples/engine/deferred.mrsl");
         // The kernels of the two modes this engine runs.
         Ok(mrsl_runtime::compile_modes(
-            include_str!("demo.mrsl"),
-            "examples/demo.mrsl",
+            include_str!("engine/deferred.mrsl"),
+            "examples/engine/deferred.mrsl",
             &[Mode::Dynamic, Mode::Reference],
         )?)
     }
     #[cfg(not(feature = "compile"))]
     Err("usage: engine KERNEL_DIR [--out DIR]\n\
          KERNEL_DIR holds the files `mrslc compile` writes, e.g.:\n  \
-         cargo run --release -p mrslc -- compile examples/demo.mrsl -o kernels\n  \
+         cargo run --release -p mrslc -- compile examples/engine/deferred.mrsl -o kernels\n  \
          cargo run --release -p mrsl-runtime --example engine -- kernels\n\
-         (or build the example with `--features compile` to compile the demo at load time)"
+         (or build the example with `--features compile` to compile it at load time)"
         .into())
 }
 
-/// The engine's G-buffer, per pixel.
+/// The engine's G-buffer, per pixel: what its geometry pass writes.
 struct GBuffer {
-    position: Vec<[f32; 4]>,
-    normal: Vec<[f32; 4]>,
-    uv: Vec<[f32; 2]>,
-    material: Vec<u32>,
+    depth: Vec<f32>,
+    normal: Vec<[f32; 3]>,
+    albedo: Vec<[f32; 4]>,
+    material: Vec<u8>,
 }
 
-/// A sphere on a ground plane seen from `EYE`: world-space position, normal,
-/// uv (planar on the ground, spherical on the sphere) and material per pixel
-/// (0 = ground, 1 = sphere, 255 = sky).
+/// The camera's view-projection: reversed depth with an infinite far plane
+/// (clip = (x f / aspect, y f, NEAR, -z_view), so depth = NEAR / view depth),
+/// as engines use for precision.
+fn view_projection() -> Mat4 {
+    let (eye, target) = (Vec3::from(EYE), Vec3::from(TARGET));
+    let forward = (target - eye).normalize();
+    let right = forward.cross(Vec3::Y).normalize();
+    let up = right.cross(forward);
+    let f = 1.0 / (FOV_Y_DEGREES.to_radians() / 2.0).tan();
+    let aspect = WIDTH as f32 / HEIGHT as f32;
+    let row = |axis: Vec3, scale: f32| (axis * scale).extend(-axis.dot(eye) * scale);
+    Mat4::from_cols(row(right, f / aspect), row(up, f), Vec4::new(0.0, 0.0, 0.0, NEAR), row(forward, 1.0)).transpose()
+}
+
+/// A sphere (centre (0, 0.7, 0), radius 0.7) on a ground plane seen from
+/// `EYE`, ray-cast through each pixel's centre: depth, normal, albedo and
+/// material (0 = ground, 1 = sphere, 255 = sky, at a depth of 100 units).
 fn gbuffer() -> GBuffer {
-    let eye = EYE;
-    let mut g = GBuffer { position: vec![], normal: vec![], uv: vec![], material: vec![] };
+    let (eye, target) = (Vec3::from(EYE), Vec3::from(TARGET));
+    let forward = (target - eye).normalize();
+    let right = forward.cross(Vec3::Y).normalize();
+    let up = right.cross(forward);
+    let tan_half = (FOV_Y_DEGREES.to_radians() / 2.0).tan();
+    let aspect = WIDTH as f32 / HEIGHT as f32;
+    let vp = view_projection();
+    let mut g = GBuffer { depth: vec![], normal: vec![], albedo: vec![], material: vec![] };
     for y in 0..HEIGHT {
         for x in 0..WIDTH {
-            let u = (x as f32 + 0.5) / WIDTH as f32 * 2.0 - 1.0;
-            let v = 1.0 - (y as f32 + 0.5) / HEIGHT as f32 * 2.0;
-            let d = normalize([u * 0.8 * WIDTH as f32 / HEIGHT as f32, v * 0.8 - 0.25, -1.6]);
-            // Sphere at (0, 0.7, 0), radius 0.7.
-            let oc = [eye[0], eye[1] - 0.7, eye[2]];
-            let b = oc[0] * d[0] + oc[1] * d[1] + oc[2] * d[2];
-            let c = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2] - 0.49;
+            let sx = (2.0 * (x as f32 + 0.5) / WIDTH as f32 - 1.0) * tan_half * aspect;
+            let sy = (1.0 - 2.0 * (y as f32 + 0.5) / HEIGHT as f32) * tan_half;
+            let d = (forward + sx * right + sy * up).normalize();
+            let oc = eye - Vec3::new(0.0, 0.7, 0.0);
+            let (b, c) = (oc.dot(d), oc.dot(oc) - 0.49);
             let (t, n, m) = if b * b - c >= 0.0 && -b - (b * b - c).sqrt() > 0.0 {
                 let t = -b - (b * b - c).sqrt();
-                let p = [eye[0] + t * d[0], eye[1] + t * d[1], eye[2] + t * d[2]];
-                (t, normalize([p[0], p[1] - 0.7, p[2]]), 1)
-            } else if d[1] < 0.0 {
-                (-eye[1] / d[1], [0.0, 1.0, 0.0], 0)
+                (t, (oc + t * d).normalize(), 1)
+            } else if d.y < 0.0 {
+                (-eye.y / d.y, Vec3::Y, 0)
             } else {
-                (100.0, [-d[0], -d[1], -d[2]], 255)
+                (100.0, -d, 255)
             };
-            let p = [eye[0] + t * d[0], eye[1] + t * d[1], eye[2] + t * d[2]];
-            let uv = match m {
-                1 => [0.5 + n[2].atan2(n[0]) / std::f32::consts::TAU, 0.5 - n[1].asin() / std::f32::consts::PI],
-                0 => [p[0] * 0.25, p[2] * 0.25],
-                _ => [0.0, 0.0],
+            let p = eye + t * d;
+            let checker = ((p.x * 2.0).floor() + (p.z * 2.0).floor()).rem_euclid(2.0) == 0.0;
+            let albedo = match m {
+                1 => [0.8, 0.25, 0.12, 1.0],
+                0 if checker => [0.75, 0.72, 0.66, 1.0],
+                0 => [0.25, 0.24, 0.22, 1.0],
+                _ => [0.0, 0.0, 0.0, 1.0],
             };
-            g.position.push([p[0], p[1], p[2], 1.0]);
-            g.normal.push([n[0], n[1], n[2], 0.0]);
-            g.uv.push(uv);
+            let clip = vp * p.extend(1.0);
+            g.depth.push(clip.z / clip.w);
+            g.normal.push(n.to_array());
+            g.albedo.push(albedo);
             g.material.push(m);
         }
     }
     g
 }
 
-fn normalize(v: [f32; 3]) -> [f32; 3] {
-    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    [v[0] / l, v[1] / l, v[2] / l]
+/// A unit normal as an `Rgb10a2Unorm` texel: each component `n * 0.5 + 0.5`
+/// in 10 bits (red lowest), alpha 0.
+fn rgb10a2unorm(n: [f32; 3]) -> u32 {
+    let bits = |c: f32| ((c * 0.5 + 0.5).clamp(0.0, 1.0) * 1023.0).round() as u32;
+    bits(n[0]) | (bits(n[1]) << 10) | (bits(n[2]) << 20)
 }
+
+/// The depth texture of the geometry pass. WebGPU copies no data into a
+/// `Depth32Float` texture, so a pass writes it, as a geometry pass would:
+/// a full-screen triangle whose fragments take their depth from an
+/// `R32Float` texture of the CPU depths.
+fn depth_texture(device: &wgpu::Device, queue: &wgpu::Queue, depths: &[f32]) -> wgpu::Texture {
+    let size = wgpu::Extent3d { width: WIDTH, height: HEIGHT, depth_or_array_layers: 1 };
+    let make = |label, format, usage| {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
+    };
+    let values = make(
+        "depth values",
+        wgpu::TextureFormat::R32Float,
+        wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+    );
+    let layout = wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(WIDTH * 4), rows_per_image: None };
+    queue.write_texture(values.as_image_copy(), bytemuck::cast_slice(depths), layout, size);
+    let depth = make(
+        "depth",
+        wgpu::TextureFormat::Depth32Float,
+        wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
+    );
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("geometry pass"),
+        source: wgpu::ShaderSource::Wgsl(DEPTH_PASS.into()),
+    });
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("geometry pass"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs"),
+            compilation_options: Default::default(),
+            targets: &[],
+        }),
+        primitive: Default::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: wgpu::TextureFormat::Depth32Float,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        multiview_mask: None,
+        cache: None,
+    });
+    let view = values.create_view(&Default::default());
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("geometry pass"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) }],
+    });
+    let target = depth.create_view(&Default::default());
+    let mut encoder = device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("geometry pass"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &target,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, Some(&group), &[]);
+        pass.draw(0..3, 0..1);
+    }
+    queue.submit([encoder.finish()]);
+    depth
+}
+
+/// The depth pass: one full-screen triangle, each fragment's depth from the values texture.
+const DEPTH_PASS: &str = "
+@group(0) @binding(0) var values: texture_2d<f32>;
+@vertex fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+}
+@fragment fn fs(@builtin(position) p: vec4<f32>) -> @builtin(frag_depth) f32 {
+    return textureLoad(values, vec2<i32>(p.xy), 0).x;
+}
+";
 
 fn copy_out(device: &wgpu::Device, encoder: &mut wgpu::CommandEncoder, texture: &wgpu::Texture) -> wgpu::Buffer {
     let padded = (WIDTH * 16).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;

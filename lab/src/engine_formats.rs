@@ -44,6 +44,14 @@ pub fn octahedral(n: [f32; 3]) -> [f32; 2] {
     }
 }
 
+/// A unit normal as an `Rgb10a2Unorm` texel (Bevy's prepass normals): each
+/// component `n * 0.5 + 0.5` in 10 bits, red lowest, alpha 0; what
+/// `@encoded(unorm)` reads back.
+pub fn rgb10a2unorm(n: [f32; 3]) -> u32 {
+    let bits = |c: f32| ((c * 0.5 + 0.5).clamp(0.0, 1.0) * 1023.0).round() as u32;
+    bits(n[0]) | (bits(n[1]) << 10) | (bits(n[2]) << 20)
+}
+
 /// A `Depth32Float` texture (TEXTURE_BINDING) holding `depths`. WebGPU
 /// copies no data into a depth32float texture, so a render pass writes it:
 /// a full-screen triangle whose fragments read their depth from an

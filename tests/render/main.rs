@@ -49,6 +49,10 @@ const GPU_TESTS: &[GpuTest] = &[
         engine_formats::bevy_deferred_gbuffer_renders_as_the_float_gbuffer,
     ),
     (
+        "engine_formats::the_engine_example_program_renders_over_engine_formats",
+        engine_formats::the_engine_example_program_renders_over_engine_formats,
+    ),
+    (
         "engine_formats::decoded_channels_take_their_engine_formats",
         engine_formats::decoded_channels_take_their_engine_formats,
     ),
