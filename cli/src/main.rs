@@ -66,7 +66,7 @@ enum Command {
         #[arg(long, value_enum)]
         emit: Option<Emit>,
         /// Modes to compile for, comma-separated (reference, coarse2x2, coarse4x4, dynamic,
-        /// hierarchical, checkerboard, rate-image), or all.
+        /// hierarchical, checkerboard, rate-image, multi-rate), or all.
         #[arg(long, alias = "modes", value_parser = args::parse_modes, default_value = "all")]
         mode: args::ModeList,
         /// With --emit coarse or fine: the block size of the kernel printed.

@@ -11,7 +11,7 @@ use std::collections::{BTreeSet, HashSet};
 /// What the later stages need of the graph whose nodes are effects and
 /// outputs and whose edges are uses (from the used effect to its user); the
 /// graph itself is only needed while [`build`] checks it.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct EffectGraph {
     /// Topological order, dependencies first; only effects that reach an output.
     pub order: Vec<EffectId>,

@@ -5,8 +5,15 @@ use mrsl_lab::gpu::Gpu;
 use mrsl_lab::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
 use mrsl_runtime::{DispatchOptions, Error, Mode};
 
-const COARSE_MODES: [Mode; 6] =
-    [Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic, Mode::Hierarchical, Mode::Checkerboard, Mode::RateImage];
+const COARSE_MODES: [Mode; 7] = [
+    Mode::Coarse2x2,
+    Mode::Coarse4x4,
+    Mode::Dynamic,
+    Mode::Hierarchical,
+    Mode::Checkerboard,
+    Mode::RateImage,
+    Mode::MultiRate,
+];
 
 fn examples() -> Vec<(String, String)> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");

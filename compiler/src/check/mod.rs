@@ -165,7 +165,7 @@ pub struct ConstValue {
 }
 
 /// The checked program: the AST plus everything the checks learned about it.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct Checked<'a> {
     pub program: &'a Program,
     pub inputs: Vec<InputInfo>,

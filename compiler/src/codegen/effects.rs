@@ -218,7 +218,13 @@ impl<'b> Writer<'_, '_, 'b> {
         }
         self.template(0, stage, &[]);
         match self.kind {
-            KernelKind::Coarse | KernelKind::Fine | KernelKind::DynamicFine => self.interface_bindings(),
+            // (The multi-rate kernels are written as the block kernels of their family.)
+            KernelKind::Coarse
+            | KernelKind::Fine
+            | KernelKind::DynamicFine
+            | KernelKind::MultiCoarse
+            | KernelKind::MultiResolve
+            | KernelKind::MultiFine => self.interface_bindings(),
             KernelKind::DynamicCoarse => self.dynamic_coarse_bindings(),
             KernelKind::Hierarchical => self.hierarchical_bindings(),
             KernelKind::Checkerboard => self.checkerboard_bindings(),
@@ -227,11 +233,11 @@ impl<'b> Writer<'_, '_, 'b> {
         }
         if self.counts_stats() {
             self.stats_bindings();
-        } else if matches!(self.kind, KernelKind::Coarse | KernelKind::RateCoarse) && self.has_background() {
+        } else if self.counts_background_samples() {
             // The coarse kernels count the background samples.
             self.stats_buffer();
         }
-        if !self.kind.is_coarse() {
+        if self.file.writes_outputs() {
             for o in &l.outputs {
                 self.line(
                     0,
@@ -366,7 +372,7 @@ impl<'b> Writer<'_, '_, 'b> {
 
     /// The signature of `mrsl_eval_<effect>`, or of `mrsl_val_<effect>`
     /// (`value_only`), which has no refine flag.
-    fn eval_signature(&self, e: EffectId, value_only: bool) -> String {
+    pub(super) fn eval_signature(&self, e: EffectId, value_only: bool) -> String {
         let c = self.checked();
         let info = &c.effects[e.index()];
         let mut params = vec![format!("{POS}: vec2<i32>")];
@@ -523,7 +529,8 @@ impl<'b> Writer<'_, '_, 'b> {
 
     fn live_sites(&self) -> Vec<usize> {
         let mut computed = vec![false; self.checked().effects.len()];
-        for e in self.kernel_effects() {
+        // A loaded effect's derivatives were taken where the resolve pass evaluated it.
+        for e in self.kernel_effects().into_iter().filter(|&e| !self.is_loaded(e)) {
             computed[e.index()] = true;
         }
         (0..self.i.deriv.sites.len()).filter(|&k| computed[self.i.deriv.sites[k].effect.index()]).collect()

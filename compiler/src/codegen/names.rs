@@ -238,6 +238,10 @@ pub(super) const LANE_PIXEL: &str = "mrsl_k";
 /// The records of the coarse samples (one level, or the dynamic mode's inner level).
 pub(super) const INTERFACE: &str = "mrsl_interface";
 pub(super) const INTERFACE2: &str = "mrsl_interface2";
+/// The multi-rate mode's `coarse(4)` values per pixel (layout `levels.values`).
+pub(super) const LEVEL_VALUES: &str = "mrsl_level_values";
+/// `mrsl_pixel(pos)`: the pixel of a position.
+pub(super) const PIXEL: &str = "mrsl_pixel";
 /// The records of the dynamic mode's outer level, as its inner coarse kernel reads them.
 pub(super) const PARENT: &str = "mrsl_parent";
 /// The neighbour values of the block coarse kernel (layout `neighbours`).
@@ -297,6 +301,8 @@ pub(super) const FIXED: &[&str] = &[
     LANE_PIXEL,
     INTERFACE,
     INTERFACE2,
+    LEVEL_VALUES,
+    PIXEL,
     PARENT,
     NEIGHBOURS,
     COMPACT_LISTS,
@@ -314,7 +320,6 @@ pub(super) const FIXED: &[&str] = &[
     "MrslControl",
     "MrslUniforms",
     "mrsl_refine_mask",
-    "mrsl_pixel",
     "mrsl_pair_x",
     "mrsl_pair_y",
     // derivative.wgsl, derivative_both.wgsl: the operand here, at the pair's other position
