@@ -501,6 +501,9 @@ pub enum SampleCount {
     Grid { block: u32, counter: Option<usize> },
     /// Word `word` of `resource`'s read-back (the rate-image mode's listed samples).
     Listed { resource: ResourceId, word: usize },
+    /// Each coarse effect's own sample grid, of the block size
+    /// [`crate::LevelsLayout::block`] gives it (the multi-rate mode).
+    Levels,
 }
 
 /// What a live coarse effect's evaluations are in a mode.

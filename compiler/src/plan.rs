@@ -95,7 +95,6 @@ fn block_steps(layout: &Layout, mode: Mode, steps: &mut Vec<Step>) -> Counts {
 /// values resolved and stored per pixel, the 2x2 samples of the other
 /// coarse effects, then the pixels.
 fn multi_rate_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
-    let levels = layout.levels.as_ref().expect("the multi-rate mode has levels");
     let (outer, inner) = (DYNAMIC_OUTER_BLOCK, DYNAMIC_INNER_BLOCK);
     let has_outer = has_outer_effects(layout);
     let kernel = |kind, block| KernelRef::new(kind, Some(block));
@@ -122,7 +121,7 @@ fn multi_rate_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
         vec![tiles(entry::FINE)],
     ));
     Counts {
-        samples: SampleCount::Grid { block: inner, counter: None },
+        samples: SampleCount::Levels,
         evaluations: Evaluations::SamplesAndCounted,
         work_lists: None,
         background: None,

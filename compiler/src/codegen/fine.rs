@@ -470,7 +470,10 @@ impl<'b> Writer<'_, '_, 'b> {
                     let k = w.coarse_index[&e] as usize;
                     w.count_refined(k, &format!("{IS_REFINED}({LAST_BLOCK}, {k}u)"));
                 }
-                w.count_background(LAST_BLOCK);
+                // The multi-rate mode counts its background pixels once, in its last pass.
+                if w.file != KernelKind::MultiResolve {
+                    w.count_background(LAST_BLOCK);
+                }
                 w.line(2, "}");
             },
             |w, e, indent| w.effect_chain(&[e], indent, Evaluation::Kernel),
