@@ -369,7 +369,8 @@ pub struct LevelsLayout {
     /// The 4x4 level's records (`coarse(4)` effects: the 4x4 to 1x1 boundary).
     pub outer: InterfaceLayout,
     /// The `coarse(4)` values per pixel (the 4x4 to 2x2 boundary and the
-    /// values read per pixel): a storage buffer of `words` words per pixel.
+    /// values read per pixel): an `r32uint` texture array over the pixels
+    /// with `words` layers, a layer per word.
     pub values: NeighbourLayout,
     /// The 2x2 level's records (`coarse(2)` and plain `coarse` effects: the 2x2 to 1x1 boundary).
     pub inner: InterfaceLayout,

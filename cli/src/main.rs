@@ -139,7 +139,8 @@ struct Bench {
     /// Image size, WIDTHxHEIGHT (default 1920x1080; repeatable with --suite).
     #[arg(long = "size", value_parser = args::parse_size)]
     sizes: Vec<(u32, u32)>,
-    /// Modes, comma-separated (reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard), or all.
+    /// Modes, comma-separated (reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard, rate-image,
+    /// multi-rate), or all.
     #[arg(long, alias = "mode", value_parser = args::parse_modes, default_value = "all")]
     modes: args::ModeList,
     /// The block and dynamic modes' knob: a float uniform of the program.
@@ -185,7 +186,8 @@ struct Render {
     /// Scene: demo, gradient, steps, sinusoid, sponza, dungeon, or a .toml scene file (docs/scenes.md).
     #[arg(long, default_value = "demo")]
     scene: String,
-    /// Modes, comma-separated (reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard), or all.
+    /// Modes, comma-separated (reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard, rate-image,
+    /// multi-rate), or all.
     #[arg(long, alias = "modes", value_parser = args::parse_modes, default_value = "coarse4x4")]
     mode: args::ModeList,
     /// Image size, WIDTHxHEIGHT (default: the scene file's, else 960x540).

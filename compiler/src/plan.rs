@@ -264,18 +264,18 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
         KernelKind::MultiCoarse => {
             let mut coarse = vec![at(interface, R::LevelRecords { block }, T::RecordStorageTexture)];
             if block == DYNAMIC_INNER_BLOCK {
-                coarse.extend(level_values(layout, true));
+                coarse.extend(level_values(layout));
             }
             coarse
         }
         KernelKind::MultiResolve => {
             let mut resolve = vec![at(interface, R::LevelRecords { block }, T::RecordTexture)];
-            resolve.extend(level_values(layout, false));
+            resolve.extend(level_values(layout));
             resolve
         }
         KernelKind::MultiFine => {
             let mut fine = vec![at(interface, R::LevelRecords { block }, T::RecordTexture)];
-            fine.extend(level_values(layout, true));
+            fine.extend(level_values(layout));
             fine
         }
     };
@@ -318,9 +318,9 @@ fn has_outer_effects(layout: &Layout) -> bool {
 }
 
 /// The multi-rate mode's stored values, where the program stores any.
-fn level_values(layout: &Layout, read_only: bool) -> Option<PassBinding> {
+fn level_values(layout: &Layout) -> Option<PassBinding> {
     let values = &layout.levels.as_ref()?.values;
-    let ty = BindingType::Buffer { read_only };
+    let ty = BindingType::WordTexture;
     (values.words > 0).then_some(PassBinding { binding: values.binding, resource: ResourceId::LevelValues, ty })
 }
 
@@ -374,8 +374,9 @@ fn resource(layout: &Layout, id: ResourceId) -> ResourceDesc {
             ("a multi-rate level's records", Shape::TextureArray { texels, layers: level.layers(), format })
         }
         R::LevelValues => {
-            let words_per_pixel = layout.levels.as_ref().map_or(1, |l| l.values.words.max(1));
-            ("the multi-rate mode's stored values", words(Extent::Pixels, words_per_pixel))
+            let layers = layout.levels.as_ref().map_or(1, |l| l.values.words.max(1));
+            let (texels, format) = (Extent::Pixels, TextureFormat::R32Uint);
+            ("the multi-rate mode's stored values", Shape::TextureArray { texels, layers, format })
         }
         R::ShadingRate | R::Output { .. } => unreachable!("engine-bound resources have no descriptor"),
     };

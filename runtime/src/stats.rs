@@ -86,8 +86,25 @@ impl Stats {
             }
             // The rate-image mode shades the samples its tiles listed (read back from its counter).
             SampleCount::Listed { .. } => listed_samples,
-            // Per effect, below.
-            SampleCount::Levels => 0,
+            // The grids of the levels that have live coarse effects (per effect, below).
+            SampleCount::Levels => {
+                let mut blocks: Vec<u32> = layout
+                    .effects
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, e)| e.live && e.rate == Rate::Coarse)
+                    .filter_map(|(k, _)| layout.levels.as_ref().map(|l| l.block[k]))
+                    .collect();
+                blocks.sort_unstable();
+                blocks.dedup();
+                blocks
+                    .into_iter()
+                    .map(|b| {
+                        let (nx, ny) = sample_grid(size, b);
+                        nx as u64 * ny as u64
+                    })
+                    .sum()
+            }
         };
         // The multi-rate mode: each coarse effect's samples are those of its own grid.
         let samples_of = |block: u32| {

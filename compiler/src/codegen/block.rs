@@ -11,10 +11,10 @@
 use super::effects::{Evaluation, Key};
 use super::fine::{CORNER_SAMPLES, Corners, LANES, Level, Resolver};
 use super::names::{
-    BACKGROUND, BLOCK_STRUCT, CONTROL, CORNERS_STRUCT, GID, INTERFACE, LEVEL_VALUES, NEIGHBOURS, Name, PIXEL, POS,
-    RECORD, SAMPLES, STATS, STRIDE,
+    BACKGROUND, BLOCK_STRUCT, CORNERS_STRUCT, GID, INTERFACE, LEVEL_VALUES, NEIGHBOURS, Name, PIXEL, POS, RECORD,
+    SAMPLES, STATS, STRIDE,
 };
-use super::words::{pack_words, test_bit, unpack_with, unpack_words};
+use super::words::{pack_words, test_bit, unpack_with};
 use super::writer::{cut, fill};
 use super::{ViewLevel, Writer};
 use crate::check::{EffectId, InputId};
@@ -80,25 +80,20 @@ impl Writer<'_, '_, '_> {
 
     /// The multi-rate mode's stored `coarse(4)` values (layout
     /// `levels.values`): written by the resolve pass, read by the 2x2
-    /// level and the pixels; nothing in the other kernels.
+    /// level and the pixels; nothing in the other kernels. A texture with a
+    /// layer per word rather than a storage buffer, for the reason
+    /// `InterfaceLayout` gives: llvmpipe loads a buffer word lane by lane.
     fn level_values_binding(&mut self) {
         let (ViewLevel::Outer { words, .. } | ViewLevel::Inner { words, .. }) = self.i.level else { return };
         if words == 0 || self.file == KernelKind::MultiCoarse && matches!(self.i.level, ViewLevel::Outer { .. }) {
             return;
         }
         let binding = self.i.layout.levels.as_ref().expect("the multi-rate mode has levels").values.binding;
-        let access = if matches!(self.i.level, ViewLevel::Outer { .. }) { "read_write" } else { "read" };
-        self.line(
-            0,
-            format!("// The coarse({}) values per pixel, {words} words each.", mrsl_abi::geometry::DYNAMIC_OUTER_BLOCK),
-        );
-        self.line(
-            0,
-            format!(
-                "@group({}) @binding({binding}) var<storage, {access}> {LEVEL_VALUES}: array<u32>;",
-                self.i.layout.interface.group
-            ),
-        );
+        let outer = mrsl_abi::geometry::DYNAMIC_OUTER_BLOCK;
+        self.line(0, format!("// The coarse({outer}) values per pixel, a layer per word ({words})."));
+        let group = self.i.layout.interface.group;
+        let ty = "texture_storage_2d_array<r32uint, read_write>";
+        self.line(0, format!("@group({group}) @binding({binding}) var {LEVEL_VALUES}: {ty};"));
         self.line(0, "");
     }
 
@@ -117,9 +112,10 @@ impl Writer<'_, '_, '_> {
         };
         self.line(0, format!("// `{}` as the resolve pass stored it at the position's pixel.", info.name));
         self.line(0, format!("{signature} {{"));
+        debug_assert!(offset + info.ty.components() <= words);
         self.line(1, format!("let p = {PIXEL}({POS});"));
-        self.line(1, format!("let base = (u32(p.y) * u32({CONTROL}.size.x) + u32(p.x)) * {words}u + {offset}u;"));
-        self.line(1, format!("return {};", unpack_words(&info.ty, LEVEL_VALUES)));
+        let value = unpack_with(&info.ty, |k| format!("textureLoad({LEVEL_VALUES}, p, {}).x", offset + k));
+        self.line(1, format!("return {value};"));
         self.line(0, "}");
         self.line(0, "");
     }

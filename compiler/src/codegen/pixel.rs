@@ -254,13 +254,14 @@ impl Writer<'_, '_, '_> {
             let value = to_vec4(&format!("{prefix}{}", self.effect_name(*e)), &info.ty);
             self.line(indent, format!("textureStore({}, {pos}, {value});", Name::Out.of(&info.name)));
         }
-        if let ViewLevel::Outer { values, words } = self.i.level {
+        if let ViewLevel::Outer { values, .. } = self.i.level {
             // The multi-rate resolve pass: the values finer levels read, stored at the pixel.
-            let at = format!("(u32({pos}.y) * u32({GRID}().x) + u32({pos}.x)) * {words}u");
             for &(e, offset) in values {
                 let info = &c.effects[e.index()];
                 for (j, word) in pack_words(&format!("{prefix}{}", self.effect_name(e)), &info.ty).iter().enumerate() {
-                    self.line(indent, format!("{LEVEL_VALUES}[{at} + {}u] = {word};", offset + j as u32));
+                    let layer = offset + j as u32;
+                    let store = format!("textureStore({LEVEL_VALUES}, {pos}, {layer}, vec4<u32>({word}, 0u, 0u, 0u));");
+                    self.line(indent, store);
                 }
             }
         }
