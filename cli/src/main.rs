@@ -49,10 +49,11 @@ enum Command {
     },
     /// Compile a program to WGSL kernels and a layout description.
     ///
-    /// Writes the kernels of the modes asked for (all by default: 11
+    /// Writes the kernels of the modes asked for (all by default: 15
     /// kernels), named <name>.KIND.bB.wgsl for the kinds that exist per
     /// block size (coarse and fine at 2 and 4, dynamic_coarse at 2,
-    /// dynamic_fine at 4) and <name>.KIND.wgsl for the others (reference,
+    /// dynamic_fine at 4, multi_coarse at 4 and 2, multi_resolve at 4,
+    /// multi_fine at 2) and <name>.KIND.wgsl for the others (reference,
     /// hierarchical, checkerboard, rate_coarse, rate_fine), and
     /// <name>.layout.json, which holds every binding and the plan of each
     /// mode, into the output directory.
