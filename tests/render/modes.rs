@@ -589,3 +589,26 @@ pub fn three_rates_shade_each_effect_at_its_own_rate(gpu: &Gpu) {
     let sky2 = effect(&out2, "sky");
     assert!(sky.shaded_fraction < sky2.shaded_fraction, "{sky:?} against coarse2x2's {sky2:?}; {shown}");
 }
+
+/// A program whose coarse effects are all plain `coarse` renders in the
+/// multi-rate mode exactly as in `coarse2x2` (docs/language.md, section
+/// 8.4): its 4x4 passes dispatch nothing, and its 2x2 and fine kernels are
+/// `coarse2x2`'s over the same program. Every such example, bit for bit.
+pub fn plain_programs_render_in_multi_rate_as_in_coarse2x2(gpu: &Gpu) {
+    let gbuffer = Scene::Demo.render(75, 43);
+    let mut plain = 0;
+    for (name, source) in examples() {
+        if source.contains("coarse(") {
+            continue;
+        }
+        plain += 1;
+        let program = compile(&source);
+        let block = run(gpu, &program, &gbuffer, Mode::Coarse2x2, false).unwrap();
+        let multi = run(gpu, &program, &gbuffer, Mode::MultiRate, false).unwrap();
+        assert_eq!(worst_ulps(&multi.pixels, &block.pixels), 0, "{name}: multi-rate differs from coarse2x2");
+        for (m, b) in multi.stats.effects.iter().zip(&block.stats.effects) {
+            assert_eq!(m, b, "{name}: the statistics of `{}`", m.name);
+        }
+    }
+    assert!(plain >= 8, "{plain} plain examples");
+}
