@@ -40,6 +40,11 @@ pub mod entry {
     /// Rate-image mode, per pixel: resample at the tile's rate or evaluate, then fine effects and outputs.
     pub const RATE_FINE: &str = "rate_fine";
 
+    /// Multi-rate mode: the `coarse(4)` effects resolved at every pixel
+    /// from the 4x4 samples (resampled or evaluated) and stored for the
+    /// 2x2 samples and the pixels to read.
+    pub const MULTI_RESOLVE: &str = "multi_resolve_main";
+
     /// Prefixes of generated entry points; user identifiers with them are renamed.
     pub const RESERVED_PREFIXES: [&str; 3] = ["hier_", "cb_", "rate_"];
 }
@@ -90,11 +95,21 @@ pub enum KernelKind {
     /// Rate-image mode, per pixel: coarse values resampled at the tile's rate
     /// (or evaluated), then fine effects and outputs.
     RateFine,
+    /// Multi-rate mode, per block size: the block coarse kernel over the
+    /// effects of one level (4x4: the `coarse(4)` ones; 2x2: the others,
+    /// reading the `coarse(4)` values [`KernelKind::MultiResolve`] stored).
+    MultiCoarse,
+    /// Multi-rate mode: the `coarse(4)` effects at every pixel, resampled
+    /// from the 4x4 samples or evaluated, stored per pixel.
+    MultiResolve,
+    /// Multi-rate mode, per pixel: the 2x2 level's effects resampled or
+    /// evaluated, the `coarse(4)` ones read as stored, then fine effects and outputs.
+    MultiFine,
 }
 
 impl KernelKind {
     /// Every kind, in the order the compiler writes them.
-    pub const ALL: [KernelKind; 9] = [
+    pub const ALL: [KernelKind; 12] = [
         KernelKind::Coarse,
         KernelKind::Fine,
         KernelKind::Reference,
@@ -104,6 +119,9 @@ impl KernelKind {
         KernelKind::Checkerboard,
         KernelKind::RateCoarse,
         KernelKind::RateFine,
+        KernelKind::MultiCoarse,
+        KernelKind::MultiResolve,
+        KernelKind::MultiFine,
     ];
 
     /// The name used in file names and messages (`dynamic_coarse`).
@@ -118,6 +136,9 @@ impl KernelKind {
             KernelKind::Checkerboard => "checkerboard",
             KernelKind::RateCoarse => "rate_coarse",
             KernelKind::RateFine => "rate_fine",
+            KernelKind::MultiCoarse => "multi_coarse",
+            KernelKind::MultiResolve => "multi_resolve",
+            KernelKind::MultiFine => "multi_fine",
         }
     }
 
@@ -138,6 +159,9 @@ impl KernelKind {
             KernelKind::Checkerboard => &[entry::CB_SHADE, entry::CB_FINAL],
             KernelKind::RateCoarse => &[entry::RATE_LIST, entry::RATE_ARGS, entry::RATE_COARSE],
             KernelKind::RateFine => &[entry::RATE_FINE],
+            KernelKind::MultiCoarse => &[entry::COARSE],
+            KernelKind::MultiResolve => &[entry::MULTI_RESOLVE],
+            KernelKind::MultiFine => &[entry::FINE],
         }
     }
 
@@ -149,24 +173,47 @@ impl KernelKind {
 
     /// Whether the kernel runs per coarse sample (else per pixel).
     pub fn is_coarse(self) -> bool {
-        matches!(self, KernelKind::Coarse | KernelKind::DynamicCoarse | KernelKind::RateCoarse)
+        matches!(
+            self,
+            KernelKind::Coarse | KernelKind::DynamicCoarse | KernelKind::RateCoarse | KernelKind::MultiCoarse
+        )
+    }
+
+    /// Whether the kernel writes the program's outputs.
+    pub fn writes_outputs(self) -> bool {
+        !self.is_coarse() && self != KernelKind::MultiResolve
     }
 
     /// Whether the kernel resolves coarse values per pixel from an interface buffer.
     pub fn is_fine(self) -> bool {
-        matches!(self, KernelKind::Fine | KernelKind::DynamicFine | KernelKind::RateFine)
+        matches!(
+            self,
+            KernelKind::Fine
+                | KernelKind::DynamicFine
+                | KernelKind::RateFine
+                | KernelKind::MultiResolve
+                | KernelKind::MultiFine
+        )
     }
 
     /// Whether the kernel exists once per block size (coarse and fine); the
     /// other kinds exist once per program.
     pub fn per_block_size(self) -> bool {
-        matches!(self, KernelKind::Coarse | KernelKind::Fine)
+        matches!(
+            self,
+            KernelKind::Coarse
+                | KernelKind::Fine
+                | KernelKind::MultiCoarse
+                | KernelKind::MultiResolve
+                | KernelKind::MultiFine
+        )
     }
 
     /// Workgroup size of the main entry point. (The compacted fine kernel of
     /// `mrsl::Options::compact` shades one pixel per lane: [`PIXEL_WORKGROUP`].)
     pub fn workgroup_size(self) -> [u32; 3] {
-        if matches!(self, KernelKind::Fine | KernelKind::DynamicFine) {
+        if matches!(self, KernelKind::Fine | KernelKind::DynamicFine | KernelKind::MultiResolve | KernelKind::MultiFine)
+        {
             [FINE_WORKGROUP, 1, 1]
         } else if self == KernelKind::RateCoarse {
             [WORK_LIST_WORKGROUP, 1, 1]

@@ -66,6 +66,9 @@ pub struct Layout {
     /// entry point writes them, `coarse_main` reads them).
     pub neighbours: NeighbourLayout,
     pub effects: Vec<EffectLayout>,
+    /// The multi-rate mode's levels, when the program was compiled for it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub levels: Option<LevelsLayout>,
     /// What every mode the program was compiled for runs ([`Plan`]).
     pub plan: Plan,
 }
@@ -423,6 +426,29 @@ impl InterfaceLayout {
     pub fn layers(&self) -> u32 {
         self.stride_words.div_ceil(Self::WORDS_PER_TEXEL).max(1)
     }
+}
+
+/// The multi-rate mode's boundaries. The 4x4 samples shade the `coarse(4)`
+/// effects and keep `outer`'s records; the `multi_resolve` pass resolves
+/// at every pixel the `coarse(4)` effects that cross the 4x4 boundary (read
+/// by a `coarse(2)`, plain `coarse` or fine effect) into `values`; the 2x2
+/// samples shade the other coarse effects, reading those values at their
+/// pixels, and keep `inner`'s records, which the pixels resample. Each
+/// record is allocated as the block modes' is, over the effects of its
+/// level, and minimal when its `minimal` says so.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LevelsLayout {
+    /// The 4x4 level's records (`coarse(4)` effects: the 4x4 to 1x1 boundary).
+    pub outer: InterfaceLayout,
+    /// The `coarse(4)` values per pixel (the 4x4 to 2x2 boundary and the
+    /// values read per pixel): an `r32uint` texture array over the pixels
+    /// with `words` layers, a layer per word.
+    pub values: NeighbourLayout,
+    /// The 2x2 level's records (`coarse(2)` and plain `coarse` effects: the 2x2 to 1x1 boundary).
+    pub inner: InterfaceLayout,
+    /// Each effect's level, in the order of [`Layout::effects`]: 4 or 2
+    /// for a coarse effect, 1 for a fine effect or output.
+    pub block: Vec<u32>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -37,6 +37,11 @@ pub enum Mode {
     /// block modes.
     #[serde(rename = "rate-image")]
     RateImage,
+    /// Three rates in one frame: `coarse(4)` effects at 4x4 samples,
+    /// `coarse(2)` and plain `coarse` ones at 2x2 samples, fine effects per
+    /// pixel, each boundary refined and resampled as in the block modes.
+    #[serde(rename = "multi-rate")]
+    MultiRate,
 }
 
 /// A kernel as a mode names it: its kind and, for the kinds that exist per
@@ -67,7 +72,7 @@ const fn kernel(kind: KernelKind, block: Option<u32>) -> KernelRef {
 }
 
 impl Mode {
-    pub const ALL: [Mode; 7] = [
+    pub const ALL: [Mode; 8] = [
         Mode::Reference,
         Mode::Coarse2x2,
         Mode::Coarse4x4,
@@ -75,6 +80,7 @@ impl Mode {
         Mode::Hierarchical,
         Mode::Checkerboard,
         Mode::RateImage,
+        Mode::MultiRate,
     ];
 
     /// The name in messages, on the command line and in the plan.
@@ -87,6 +93,7 @@ impl Mode {
             Mode::Hierarchical => "hierarchical",
             Mode::Checkerboard => "checkerboard",
             Mode::RateImage => "rate-image",
+            Mode::MultiRate => "multi-rate",
         }
     }
 
@@ -105,6 +112,13 @@ impl Mode {
         const HIERARCHICAL: [KernelRef; 1] = [kernel(K::Hierarchical, None)];
         const CHECKERBOARD: [KernelRef; 1] = [kernel(K::Checkerboard, None)];
         const RATE_IMAGE: [KernelRef; 2] = [kernel(K::RateCoarse, None), kernel(K::RateFine, None)];
+        // The 4x4 samples, their values resolved per pixel, the 2x2 samples, the pixels.
+        const MULTI_RATE: [KernelRef; 4] = [
+            kernel(K::MultiCoarse, Some(DYNAMIC_OUTER_BLOCK)),
+            kernel(K::MultiResolve, Some(DYNAMIC_OUTER_BLOCK)),
+            kernel(K::MultiCoarse, Some(DYNAMIC_INNER_BLOCK)),
+            kernel(K::MultiFine, Some(DYNAMIC_INNER_BLOCK)),
+        ];
         match self {
             Mode::Reference => &REFERENCE,
             Mode::Coarse2x2 => &COARSE_2X2,
@@ -113,6 +127,7 @@ impl Mode {
             Mode::Hierarchical => &HIERARCHICAL,
             Mode::Checkerboard => &CHECKERBOARD,
             Mode::RateImage => &RATE_IMAGE,
+            Mode::MultiRate => &MULTI_RATE,
         }
     }
 
@@ -120,6 +135,8 @@ impl Mode {
     pub fn block_size(self) -> Option<u32> {
         match self {
             Mode::Reference | Mode::Hierarchical | Mode::Checkerboard | Mode::RateImage => None,
+            // Its levels differ per effect; its finest coarse grid is 2x2.
+            Mode::MultiRate => None,
             Mode::Coarse2x2 => Some(2),
             Mode::Coarse4x4 => Some(4),
             Mode::Dynamic => Some(DYNAMIC_OUTER_BLOCK),

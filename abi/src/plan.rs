@@ -255,6 +255,12 @@ pub enum ResourceId {
     Statistics,
     /// The per-pixel refine mask ([`crate::Layout::refine_mask`]).
     RefineMask,
+    /// The multi-rate mode's records over the sample grid of `block`: its
+    /// 4x4 level or its 2x2 level, each laid out as [`crate::LevelsLayout`] says.
+    LevelRecords { block: u32 },
+    /// The multi-rate mode's `coarse(4)` values resolved at every pixel
+    /// ([`crate::LevelsLayout::values`]).
+    LevelValues,
     /// Engine-bound: the rate-image mode's shading-rate image.
     ShadingRate,
     /// Engine-bound: output `index` of [`crate::Layout::outputs`].
@@ -498,6 +504,9 @@ pub enum SampleCount {
     Grid { block: u32, counter: Option<usize> },
     /// Word `word` of `resource`'s read-back (the rate-image mode's listed samples).
     Listed { resource: ResourceId, word: usize },
+    /// Each coarse effect's own sample grid, of the block size
+    /// [`crate::LevelsLayout::block`] gives it (the multi-rate mode).
+    Levels,
 }
 
 /// What a live coarse effect's evaluations are in a mode.

@@ -119,7 +119,8 @@ mod tests {
                 Mode::Coarse4x4,
                 Mode::Hierarchical,
                 Mode::Checkerboard,
-                Mode::RateImage
+                Mode::RateImage,
+                Mode::MultiRate
             ]))
         );
     }
@@ -129,7 +130,7 @@ mod tests {
         assert_eq!(
             parse_modes("reference,coarse8x8"),
             Err("unknown mode `coarse8x8` (expected a comma-separated list of reference, coarse2x2, coarse4x4, \
-                 dynamic, hierarchical, checkerboard, rate-image, or all)"
+                 dynamic, hierarchical, checkerboard, rate-image, multi-rate, or all)"
                 .into())
         );
         let e = parse_modes("fast,reference,,slow").unwrap_err();

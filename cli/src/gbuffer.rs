@@ -284,7 +284,7 @@ mod tests {
         assert_eq!(format_name(wgpu::TextureFormat::R32Uint).unwrap(), "r32uint");
         assert_eq!(format_name(wgpu::TextureFormat::Rgba8UnormSrgb).unwrap(), "rgba8unorm-srgb");
         assert_eq!(format_name(wgpu::TextureFormat::Rg16Float).unwrap(), "rg16float");
-        assert!(format_name(wgpu::TextureFormat::Depth32Float).is_err());
+        assert!(format_name(wgpu::TextureFormat::Depth24Plus).is_err());
     }
 
     #[test]

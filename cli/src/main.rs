@@ -49,10 +49,11 @@ enum Command {
     },
     /// Compile a program to WGSL kernels and a layout description.
     ///
-    /// Writes the kernels of the modes asked for (all by default: 11
+    /// Writes the kernels of the modes asked for (all by default: 15
     /// kernels), named <name>.KIND.bB.wgsl for the kinds that exist per
     /// block size (coarse and fine at 2 and 4, dynamic_coarse at 2,
-    /// dynamic_fine at 4) and <name>.KIND.wgsl for the others (reference,
+    /// dynamic_fine at 4, multi_coarse at 4 and 2, multi_resolve at 4,
+    /// multi_fine at 2) and <name>.KIND.wgsl for the others (reference,
     /// hierarchical, checkerboard, rate_coarse, rate_fine), and
     /// <name>.layout.json, which holds every binding and the plan of each
     /// mode, into the output directory.
@@ -66,7 +67,7 @@ enum Command {
         #[arg(long, value_enum)]
         emit: Option<Emit>,
         /// Modes to compile for, comma-separated (reference, coarse2x2, coarse4x4, dynamic,
-        /// hierarchical, checkerboard, rate-image), or all.
+        /// hierarchical, checkerboard, rate-image, multi-rate), or all.
         #[arg(long, alias = "modes", value_parser = args::parse_modes, default_value = "all")]
         mode: args::ModeList,
         /// With --emit coarse or fine: the block size of the kernel printed.
@@ -139,7 +140,8 @@ struct Bench {
     /// Image size, WIDTHxHEIGHT (default 1920x1080; repeatable with --suite).
     #[arg(long = "size", value_parser = args::parse_size)]
     sizes: Vec<(u32, u32)>,
-    /// Modes, comma-separated (reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard), or all.
+    /// Modes, comma-separated (reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard, rate-image,
+    /// multi-rate), or all.
     #[arg(long, alias = "mode", value_parser = args::parse_modes, default_value = "all")]
     modes: args::ModeList,
     /// The block and dynamic modes' knob: a float uniform of the program.
@@ -185,7 +187,8 @@ struct Render {
     /// Scene: demo, gradient, steps, sinusoid, sponza, dungeon, or a .toml scene file (docs/scenes.md).
     #[arg(long, default_value = "demo")]
     scene: String,
-    /// Modes, comma-separated (reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard), or all.
+    /// Modes, comma-separated (reference, coarse2x2, coarse4x4, dynamic, hierarchical, checkerboard, rate-image,
+    /// multi-rate), or all.
     #[arg(long, alias = "modes", value_parser = args::parse_modes, default_value = "coarse4x4")]
     mode: args::ModeList,
     /// Image size, WIDTHxHEIGHT (default: the scene file's, else 960x540).

@@ -107,7 +107,7 @@ fn render_all_skips_only_the_modes_the_device_cannot_run() {
     }
     let runs = read_json(&dir.join("three.stats.json"));
     let modes: Vec<&str> = runs.as_array().unwrap().iter().map(|r| r["mode"].as_str().unwrap()).collect();
-    assert_eq!(modes, ["reference", "coarse2x2", "coarse4x4", "dynamic", "rate-image"]);
+    assert_eq!(modes, ["reference", "coarse2x2", "coarse4x4", "dynamic", "rate-image", "multi-rate"]);
     for mode in &modes {
         assert!(dir.join(format!("three.{mode}.png")).is_file(), "{mode}'s image");
     }
@@ -168,7 +168,7 @@ fn gpu_bench_script_writes_the_suite_report() {
     assert_eq!(scenes.len(), 1, "{suite}");
     assert_eq!((scenes[0]["scene"].as_str(), scenes[0]["width"].as_u64()), (Some("sponza"), Some(48)));
     let modes = scenes[0]["modes"].as_array().unwrap();
-    assert_eq!(modes.len(), 6, "every adaptive mode");
+    assert_eq!(modes.len(), 7, "every adaptive mode");
     for m in modes {
         let figure = |key: &str| m[key].as_f64().unwrap_or_else(|| panic!("{key} of {m}"));
         for key in ["speedup", "time_ratio", "forced_ratio", "wall_ms"] {

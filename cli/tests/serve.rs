@@ -210,7 +210,7 @@ fn the_page_and_its_files_are_served(server: &Server) {
 fn examples_and_scenes_are_listed(server: &Server) {
     let examples = server.get("/api/examples").json();
     let examples = examples.as_array().unwrap();
-    assert_eq!(examples.len(), 9);
+    assert_eq!(examples.len(), 10);
     for e in examples {
         let file = e["file"].as_str().unwrap();
         assert_eq!(e["source"].as_str().unwrap(), source(file), "{file}");
@@ -232,11 +232,11 @@ fn a_program_compiles_to_its_kernels_and_layout(server: &Server) {
     assert_eq!(all["ok"], true);
     assert_eq!(all["diagnostics"], json!([]));
     let kernels = all["kernels"].as_array().unwrap();
-    assert_eq!(kernels.len(), 11, "every mode's kernels");
+    assert_eq!(kernels.len(), 15, "every mode's kernels");
     let coarse = kernels.iter().find(|k| k["kind"] == "coarse" && k["block"] == 4).unwrap();
     assert_eq!(coarse["file"], "program.coarse.b4.wgsl");
     assert!(coarse["wgsl"].as_str().unwrap().contains("@compute"));
-    assert_eq!(all["layout"]["plan"]["modes"].as_array().unwrap().len(), 7);
+    assert_eq!(all["layout"]["plan"]["modes"].as_array().unwrap().len(), 8);
     let one = server.post("/api/compile", &json!({ "source": source("demo.mrsl"), "modes": ["reference"] })).json();
     let kinds: Vec<&Value> = one["kernels"].as_array().unwrap().iter().map(|k| &k["kind"]).collect();
     assert_eq!(kinds, [&json!("reference")]);

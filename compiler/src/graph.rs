@@ -11,7 +11,7 @@ use std::collections::{BTreeSet, HashSet};
 /// What the later stages need of the graph whose nodes are effects and
 /// outputs and whose edges are uses (from the used effect to its user); the
 /// graph itself is only needed while [`build`] checks it.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct EffectGraph {
     /// Topological order, dependencies first; only effects that reach an output.
     pub order: Vec<EffectId>,
@@ -45,6 +45,32 @@ impl EffectGraph {
     }
 }
 
+/// A coarse effect's block size for the rate rules: `coarse(N)`'s N, and
+/// for plain `coarse` the finer coarse rate, 2, at which the multi-rate mode
+/// shades it (so a `coarse(4)` effect cannot read a plain one).
+pub fn rule_block(e: &crate::check::EffectInfo) -> u32 {
+    e.block.unwrap_or(crate::check::COARSE_BLOCKS[1])
+}
+
+/// E0312: coarse effect `user` reads `dep`, of a finer coarse rate.
+fn finer_rate_read(checked: &Checked, user: EffectId, dep: EffectId, span: Span) -> Diagnostic {
+    let (e, d) = (&checked.effects[user.index()], &checked.effects[dep.index()]);
+    let (eb, db) = (rule_block(e), rule_block(d));
+    let declared = if d.block.is_some() {
+        format!("declared coarse({db}) here")
+    } else {
+        format!("declared plain `coarse` here, which ranks as {db}x{db}")
+    };
+    Diagnostic::error("E0312", format!("coarse({eb}) effect `{}` reads `{}`, which is shaded at a finer rate", e.name, d.name))
+        .with_label(Label::primary(span, format!("`{}` is shaded once per {db}x{db} block", d.name)))
+        .with_label(Label::secondary(checked.effect_decl(dep).rate_span, declared))
+        .with_label(Label::secondary(checked.effect_decl(user).rate_span, format!("declared coarse({eb}) here")))
+        .with_note(format!(
+            "an effect reads effects of its own rate or a coarser one, because the {eb}x{eb} samples are shaded before the {db}x{db} ones; declare `{}` coarse({eb}), or this effect coarse({db})",
+            d.name
+        ))
+}
+
 /// Builds the graph and checks the rate rules and acyclicity.
 pub fn build(checked: &Checked) -> (EffectGraph, Vec<Diagnostic>) {
     let mut diagnostics = vec![];
@@ -70,6 +96,8 @@ pub fn build(checked: &Checked) -> (EffectGraph, Vec<Diagnostic>) {
                         .with_label(Label::secondary(checked.effect_decl(user).rate_span, "declared coarse here"))
                         .with_note("a coarse sample is shaded before any fine effect; make the dependency coarse or this effect fine"),
                 );
+            } else if e.rate == Rate::Coarse && d.rate == Rate::Coarse && rule_block(e) > rule_block(d) {
+                diagnostics.push(finer_rate_read(checked, user, dep, span));
             }
         }
     }

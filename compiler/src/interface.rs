@@ -91,15 +91,22 @@ impl Interface {
 
 /// Computes pass conditions, the interference graph and the slot allocation.
 pub fn allocate(checked: &Checked, graph: &EffectGraph) -> Interface {
+    allocate_level(checked, graph, &|_| false)
+}
+
+/// [`allocate`] for one level of the multi-rate mode: the coarse effects of
+/// `checked` (a view of the program, `crate::rates`) except those `outside`
+/// holds, which another level provides and which are never passed here.
+pub fn allocate_level(checked: &Checked, graph: &EffectGraph, outside: &dyn Fn(EffectId) -> bool) -> Interface {
     let n = checked.effects.len();
     let refines =
         |e: EffectId| checked.effects[e.index()].rate == Rate::Coarse && checked.effects[e.index()].has_refine;
     let mut conditions = vec![None; n];
     for (i, effect) in checked.effects.iter().enumerate() {
-        if effect.rate != Rate::Coarse || !graph.live[i] {
+        let me = EffectId(i as u32);
+        if effect.rate != Rate::Coarse || !graph.live[i] || outside(me) {
             continue;
         }
-        let me = EffectId(i as u32);
         let mut fine_user = false;
         let mut refining_users = vec![];
         for &user in &graph.users[i] {

@@ -148,11 +148,6 @@ pub fn build(
         })
         .collect();
     let name = |e: &crate::check::EffectId| checked.effects[e.index()].name.clone();
-    let slots = interface
-        .slots
-        .iter()
-        .map(|s| SlotLayout { offset: s.offset, size: s.size, effects: s.effects.iter().map(name).collect() })
-        .collect();
     let outputs = checked
         .effects
         .iter()
@@ -209,15 +204,7 @@ pub fn build(
         textures,
         samplers,
         channels,
-        interface: InterfaceLayout {
-            group: GROUP_STAGE,
-            binding: 0,
-            stride_words: interface.stride,
-            flag_words: interface.flag_words,
-            slots,
-            minimal: interface.exact,
-            samples: mrsl_abi::geometry::SAMPLE_GRID_RULE.into(),
-        },
+        interface: interface_layout(checked, interface),
         stats: StatsLayout {
             group: GROUP_STAGE,
             binding: 1 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
@@ -279,8 +266,35 @@ pub fn build(
         },
         outputs,
         effects,
+        // Filled in by `rates::levels_layout` when the modes include the multi-rate one.
+        levels: None,
         // Filled in from the modes by `plan::build`.
         plan: Plan { modes: vec![], resources: vec![], constants: Default::default() },
+    }
+}
+
+/// The binding of the multi-rate mode's stored values in the stage group,
+/// after the neighbour values'.
+pub fn level_values_binding(checked: &Checked) -> u32 {
+    8 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32
+}
+
+/// The record of an interface: its slots by effect name, at binding 0 of the stage group.
+pub fn interface_layout(checked: &Checked, interface: &Interface) -> InterfaceLayout {
+    let name = |e: &crate::check::EffectId| checked.effects[e.index()].name.clone();
+    let slots = interface
+        .slots
+        .iter()
+        .map(|s| SlotLayout { offset: s.offset, size: s.size, effects: s.effects.iter().map(name).collect() })
+        .collect();
+    InterfaceLayout {
+        group: GROUP_STAGE,
+        binding: 0,
+        stride_words: interface.stride,
+        flag_words: interface.flag_words,
+        slots,
+        minimal: interface.exact,
+        samples: mrsl_abi::geometry::SAMPLE_GRID_RULE.into(),
     }
 }
 

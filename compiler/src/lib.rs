@@ -37,6 +37,7 @@ mod interface;
 mod layout;
 mod limits;
 mod plan;
+mod rates;
 mod syntax;
 mod types;
 mod validate;
@@ -96,7 +97,7 @@ pub mod internals {
 /// [`compile`] generates and validates only the kernels these modes
 /// dispatch ([`Options::kernels`], from the one table [`Mode::kernels`]),
 /// and writes their passes into the layout's plan. The default is every
-/// mode: eleven kernels. A caller that runs fewer modes asks for them alone,
+/// mode: fifteen kernels. A caller that runs fewer modes asks for them alone,
 /// which takes a fraction of the time: `Options::for_modes(&[Mode::Coarse4x4])`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Options {
@@ -189,23 +190,53 @@ fn generate(
     let interface = interface::allocate(checked, graph);
     let costs = budget::evaluation_costs(checked, graph, deriv);
     let mut layout = layout::build(checked, graph, deriv, &interface, &costs);
+    let levels = options.modes.contains(&Mode::MultiRate).then(|| rates::levels(checked, graph));
+    if let Some(levels) = &levels {
+        layout.levels = Some(levels.layout(checked, layout::level_values_binding(checked)));
+    }
     layout.plan = plan::build(&layout, &options.modes);
-    let inputs = codegen::Inputs {
+    let counters = codegen::counters(checked, graph);
+    let inputs_of = |checked, graph, interface, level| codegen::Inputs {
         checked,
         graph,
-        interface: &interface,
+        interface,
         deriv,
         layout: &layout,
         file_name: &options.file_name,
         compact: options.compact,
         source,
+        // Each view writes its effects' functions differently: a cache of its own.
         cache: codegen::Cache::new(source),
+        counters: counters.clone(),
+        level,
     };
+    let inputs = inputs_of(checked, graph, &interface, codegen::ViewLevel::Program);
+    let loaded: Vec<bool> =
+        (0..checked.effects.len()).map(|i| rates::is_outer(checked, check::EffectId(i as u32))).collect();
+    let views = levels.as_ref().map(|l| {
+        let (values, words) = (l.values.as_slice(), l.words);
+        let (o, i) = (&l.outer, &l.inner);
+        (
+            inputs_of(&o.checked, &o.graph, &o.interface, codegen::ViewLevel::Outer { values, words }),
+            inputs_of(&i.checked, &i.graph, &i.interface, codegen::ViewLevel::Inner { values, words, loaded: &loaded }),
+        )
+    });
     let mut kernels = vec![];
     let wanted = options.kernels();
     let texts: Vec<(KernelKind, Option<u32>, String)> = wanted
         .into_iter()
-        .map(|k| (k.kind, k.block, codegen::write_string(&inputs, k.kind, k.block.unwrap_or(1))))
+        .map(|k| {
+            let block = k.block.unwrap_or(1);
+            let inputs = match (&views, k.kind) {
+                (Some((outer, _)), KernelKind::MultiResolve) => outer,
+                (Some((outer, _)), KernelKind::MultiCoarse) if block == mrsl_abi::geometry::DYNAMIC_OUTER_BLOCK => {
+                    outer
+                }
+                (Some((_, inner)), KernelKind::MultiCoarse | KernelKind::MultiFine) => inner,
+                _ => &inputs,
+            };
+            (k.kind, k.block, codegen::write_string(inputs, k.kind, block))
+        })
         .collect();
     // naga validation dominates compile time; the kernels are independent, so
     // they are validated on as many threads as there are kernels.

@@ -48,6 +48,7 @@ fn mode_plan(layout: &Layout, mode: Mode) -> ModePlan {
             Counts { samples: SampleCount::None, evaluations: Evaluations::Counted, work_lists: None, background: None }
         }
         Mode::RateImage => rate_image_steps(layout, &mut steps),
+        Mode::MultiRate => multi_rate_steps(layout, &mut steps),
     };
     steps.push(Step::Readback { resource: ResourceId::Statistics, bytes: None });
     let mut counts = counts;
@@ -84,6 +85,43 @@ fn block_steps(layout: &Layout, mode: Mode, steps: &mut Vec<Step>) -> Counts {
     let counter = (mode == Mode::Dynamic).then_some(layout.stats.counters.len());
     Counts {
         samples: SampleCount::Grid { block, counter },
+        evaluations: Evaluations::SamplesAndCounted,
+        work_lists: None,
+        background: None,
+    }
+}
+
+/// The multi-rate mode: the 4x4 samples of the `coarse(4)` effects, their
+/// values resolved and stored per pixel, the 2x2 samples of the other
+/// coarse effects, then the pixels.
+fn multi_rate_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
+    let (outer, inner) = (DYNAMIC_OUTER_BLOCK, DYNAMIC_INNER_BLOCK);
+    let has_outer = has_outer_effects(layout);
+    let kernel = |kind, block| KernelRef::new(kind, Some(block));
+    // Without `coarse(4)` effects the 4x4 passes dispatch nothing; they stay
+    // in the plan, so that a runtime makes their pipelines as for any mode.
+    let when = |d: Dispatch| if has_outer { vec![d] } else { vec![] };
+    let samples = when(dispatch(entry::COARSE, Workgroups::SampleGrid { block: outer }));
+    steps.push(pass(layout, "mrsl multi-rate 4x4", Stage::Coarse, kernel(KernelKind::MultiCoarse, outer), samples));
+    let resolve = when(tiles(entry::MULTI_RESOLVE));
+    steps.push(pass(layout, "mrsl multi-rate resolve", Stage::Fine, kernel(KernelKind::MultiResolve, outer), resolve));
+    let samples = dispatch(entry::COARSE, Workgroups::SampleGrid { block: inner });
+    steps.push(pass(
+        layout,
+        "mrsl multi-rate 2x2",
+        Stage::Coarse2x2,
+        kernel(KernelKind::MultiCoarse, inner),
+        vec![samples],
+    ));
+    steps.push(pass(
+        layout,
+        "mrsl multi-rate fine",
+        Stage::Fine,
+        kernel(KernelKind::MultiFine, inner),
+        vec![tiles(entry::FINE)],
+    ));
+    Counts {
+        samples: SampleCount::Levels,
         evaluations: Evaluations::SamplesAndCounted,
         work_lists: None,
         background: None,
@@ -223,14 +261,35 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
             shading_rate,
         ],
         KernelKind::RateFine => vec![buffer(interface, R::RateRecords, true), shading_rate],
+        KernelKind::MultiCoarse => {
+            let mut coarse = vec![at(interface, R::LevelRecords { block }, T::RecordStorageTexture)];
+            if block == DYNAMIC_INNER_BLOCK {
+                coarse.extend(level_values(layout));
+            }
+            coarse
+        }
+        KernelKind::MultiResolve => {
+            let mut resolve = vec![at(interface, R::LevelRecords { block }, T::RecordTexture)];
+            resolve.extend(level_values(layout));
+            resolve
+        }
+        KernelKind::MultiFine => {
+            let mut fine = vec![at(interface, R::LevelRecords { block }, T::RecordTexture)];
+            fine.extend(level_values(layout));
+            fine
+        }
     };
     // With a background rule the coarse kernels count the background samples.
-    let counts_background =
-        matches!(kernel.kind, KernelKind::Coarse | KernelKind::RateCoarse) && layout.has_background();
+    // (The multi-rate mode counts its 2x2 samples, those of its finest grid.)
+    let counts_background = match kernel.kind {
+        KernelKind::Coarse | KernelKind::RateCoarse => true,
+        KernelKind::MultiCoarse => block == DYNAMIC_INNER_BLOCK,
+        _ => false,
+    } && layout.has_background();
     if counts_background {
         bindings.push(buffer(layout.stats.binding, R::Statistics, false));
     }
-    if !kernel.kind.is_coarse() {
+    if kernel.kind.writes_outputs() {
         bindings.extend(
             layout
                 .outputs
@@ -240,6 +299,8 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
         );
     }
     let counts = kernel.kind.is_fine() || matches!(kernel.kind, KernelKind::Hierarchical | KernelKind::Checkerboard);
+    // The multi-rate resolve pass counts the `coarse(4)` effects, where there are any.
+    let counts = counts && (kernel.kind != KernelKind::MultiResolve || has_outer_effects(layout));
     if counts && !layout.stats.counters.is_empty() {
         bindings.push(buffer(layout.stats.binding, R::Statistics, false));
         let format = TextureFormat::Rg32Uint;
@@ -247,6 +308,20 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
     }
     bindings.sort_by_key(|b| b.binding);
     bindings
+}
+
+/// Whether the multi-rate mode has live `coarse(4)` effects to shade at its 4x4 level.
+fn has_outer_effects(layout: &Layout) -> bool {
+    let Some(levels) = &layout.levels else { return false };
+    let block_of = |name: &str| layout.effects.iter().position(|e| e.name == name).map(|k| levels.block[k]);
+    layout.stats.counters.iter().any(|name| block_of(name) == Some(DYNAMIC_OUTER_BLOCK))
+}
+
+/// The multi-rate mode's stored values, where the program stores any.
+fn level_values(layout: &Layout) -> Option<PassBinding> {
+    let values = &layout.levels.as_ref()?.values;
+    let ty = BindingType::WordTexture;
+    (values.words > 0).then_some(PassBinding { binding: values.binding, resource: ResourceId::LevelValues, ty })
 }
 
 /// The descriptor of a runtime-owned resource.
@@ -292,6 +367,17 @@ fn resource(layout: &Layout, id: ResourceId) -> ResourceDesc {
         R::SampleArguments => ("the rate-image dispatch arguments", words(Extent::Fixed { count: rate_words() }, 1)),
         R::Statistics => ("the statistics counters", words(Extent::Fixed { count: layout.stats_counters() as u64 }, 1)),
         R::RefineMask => ("the refine mask", Shape::Texture { format: TextureFormat::Rg32Uint }),
+        R::LevelRecords { block } => {
+            let levels = layout.levels.as_ref().expect("the multi-rate mode has levels");
+            let level = if block == DYNAMIC_OUTER_BLOCK { &levels.outer } else { &levels.inner };
+            let (texels, format) = (Extent::SampleGrid { block }, TextureFormat::Rgba32Uint);
+            ("a multi-rate level's records", Shape::TextureArray { texels, layers: level.layers(), format })
+        }
+        R::LevelValues => {
+            let layers = layout.levels.as_ref().map_or(1, |l| l.values.words.max(1));
+            let (texels, format) = (Extent::Pixels, TextureFormat::R32Uint);
+            ("the multi-rate mode's stored values", Shape::TextureArray { texels, layers, format })
+        }
         R::ShadingRate | R::Output { .. } => unreachable!("engine-bound resources have no descriptor"),
     };
     ResourceDesc { id, what: what.into(), shape, readable: id == R::RefineMask }

@@ -86,12 +86,43 @@ impl Stats {
             }
             // The rate-image mode shades the samples its tiles listed (read back from its counter).
             SampleCount::Listed { .. } => listed_samples,
+            // The grids of the levels that have live coarse effects (per effect, below).
+            SampleCount::Levels => {
+                let mut blocks: Vec<u32> = layout
+                    .effects
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, e)| e.live && e.rate == Rate::Coarse)
+                    .filter_map(|(k, _)| layout.levels.as_ref().map(|l| l.block[k]))
+                    .collect();
+                blocks.sort_unstable();
+                blocks.dedup();
+                blocks
+                    .into_iter()
+                    .map(|b| {
+                        let (nx, ny) = sample_grid(size, b);
+                        nx as u64 * ny as u64
+                    })
+                    .sum()
+            }
         };
+        // The multi-rate mode: each coarse effect's samples are those of its own grid.
+        let samples_of = |block: u32| {
+            let (nx, ny) = sample_grid(size, block);
+            nx as u64 * ny as u64
+        };
+        let level_samples = |k: usize| samples_of(layout.levels.as_ref().map_or(1, |l| l.block[k]));
         let background_pixels = counts.background.map_or(0, |b| counter(b.pixels));
         let background_samples = counts.background.and_then(|b| b.samples).map_or(0, counter);
         let mut effects = vec![];
-        for e in layout.effects.iter().filter(|e| e.live) {
+        for (k, e) in layout.effects.iter().enumerate().filter(|(_, e)| e.live) {
             let counted = || layout.stats.counters.iter().position(|c| *c == e.name).map(counter).unwrap_or(0);
+            let (samples, background_samples) = match counts.samples {
+                // Its background samples are counted at the 2x2 level (`LevelsLayout`).
+                SampleCount::Levels if level_samples(k) != samples_of(2) => (level_samples(k), 0),
+                SampleCount::Levels => (level_samples(k), background_samples),
+                _ => (samples, background_samples),
+            };
             let evaluated_samples = samples - background_samples.min(samples);
             let (coarse_evaluations, pixel_evaluations) = match (counts.evaluations, e.rate) {
                 (Evaluations::Counted, Rate::Coarse) => (0, counted()),

@@ -279,7 +279,7 @@ pub fn modes_beyond_the_device_limits_are_unsupported(gpu: &Gpu) {
 
 /// `mrsl_runtime::compile_modes` generates exactly the kernels its modes
 /// dispatch (the union of their `Mode::kernels`), for every set of modes;
-/// `compile` those of all seven.
+/// `compile` those of all eight.
 pub fn compiled_kernels_are_those_of_the_modes() {
     let source = "in float3 normal;\ncoarse effect float d = normal.y;\nfine out float4 color = float4(d);\n";
     let kernels = |program: &CompiledProgram| {
@@ -299,5 +299,5 @@ pub fn compiled_kernels_are_those_of_the_modes() {
         assert_eq!(kernels(&program), wanted, "{modes:?}");
     }
     let all = mrsl_runtime::compile(source, "modes.mrsl").unwrap();
-    assert_eq!(kernels(&all).len(), 11);
+    assert_eq!(kernels(&all).len(), 15);
 }

@@ -95,6 +95,11 @@ const GPU_TESTS: &[GpuTest] = &[
         modes::shaded_fraction_falls_from_reference_to_coarse4x4,
     ),
     ("modes::hand_made_gbuffer_reads_back", modes::hand_made_gbuffer_reads_back),
+    ("modes::three_rates_shade_each_effect_at_its_own_rate", modes::three_rates_shade_each_effect_at_its_own_rate),
+    (
+        "modes::plain_programs_render_in_multi_rate_as_in_coarse2x2",
+        modes::plain_programs_render_in_multi_rate_as_in_coarse2x2,
+    ),
     ("modes::sinusoids_at_many_angles_and_frequencies", modes::sinusoids_at_many_angles_and_frequencies),
     (
         "modes::hierarchical_interpolates_a_gradient_from_level_zero",

@@ -22,16 +22,29 @@ if (dirs.length === 0) {
   process.exit(2);
 }
 const gpu = create(['backend=null']);
-const adapter = await gpu.requestAdapter();
+let adapter = await gpu.requestAdapter();
 if (!adapter) {
   console.error('tint: Dawn gave no adapter on its null backend');
   process.exit(2);
 }
 // The limits a page gets by default: the kernels must not need more.
-const device = await adapter.requestDevice();
+let device = await adapter.requestDevice();
 let accepted = 0;
 const refused = [];
+// Dawn keeps every module of a device alive; past about a thousand of them
+// (fifteen kernels of each of 77 programs) the process aborted. A fresh
+// device (from a fresh adapter: an adapter makes one device) every
+// MODULES_PER_DEVICE modules releases the ones checked.
+const MODULES_PER_DEVICE = 200;
+let onDevice = 0;
 for (const file of dirs.flatMap(wgslFiles)) {
+  if (onDevice === MODULES_PER_DEVICE) {
+    device.destroy();
+    adapter = await gpu.requestAdapter();
+    device = await adapter.requestDevice();
+    onDevice = 0;
+  }
+  onDevice += 1;
   const code = readFileSync(file, 'utf8');
   device.pushErrorScope('validation');
   const module = device.createShaderModule({ code });

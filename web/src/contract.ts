@@ -12,7 +12,8 @@ export type Mode =
   | 'dynamic'
   | 'hierarchical'
   | 'checkerboard'
-  | 'rate-image';
+  | 'rate-image'
+  | 'multi-rate';
 
 /** Every mode, in the order the Rust runtime lists them. */
 export const MODES: readonly Mode[] = [
@@ -23,6 +24,7 @@ export const MODES: readonly Mode[] = [
   'hierarchical',
   'checkerboard',
   'rate-image',
+  'multi-rate',
 ];
 
 /** A texture format, by its WebGPU name (the layout uses the same names). */
@@ -38,6 +40,8 @@ export interface Layout {
   outputs: Output[];
   stats: StatsLayout;
   effects: EffectLayout[];
+  /** The multi-rate mode's levels: `block[k]` is effect k's (4 or 2 for a coarse effect, 1 otherwise). */
+  levels?: { block: number[] } | null;
   plan: Plan;
 }
 
@@ -200,6 +204,8 @@ export type ResourceId =
   | { id: 'sample_arguments' }
   | { id: 'statistics' }
   | { id: 'refine_mask' }
+  | { id: 'level_records'; block: number }
+  | { id: 'level_values' }
   | { id: 'shading_rate' }
   | { id: 'output'; index: number };
 
@@ -243,7 +249,8 @@ export interface Counts {
   samples:
     | { kind: 'none' }
     | { kind: 'grid'; block: number; counter: number | null }
-    | { kind: 'listed'; resource: ResourceId; word: number };
+    | { kind: 'listed'; resource: ResourceId; word: number }
+    | { kind: 'levels' };
   evaluations: 'every_pixel' | 'counted' | 'samples_and_counted';
   work_lists: { resource: ResourceId; words_per_level: number; levels: number[]; lanes: number } | null;
   background?: { pixels: number; samples: number | null } | null;

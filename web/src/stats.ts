@@ -55,6 +55,14 @@ export interface Counted {
   workLists: number[];
 }
 
+const gridSamples = (size: Size, block: number) => {
+  const [nx, ny] = sampleGrid(size, block);
+  return nx * ny;
+};
+
+/** Effect `k`'s level in the multi-rate mode (1 without levels). */
+const levelBlock = (layout: Layout, k: number) => layout.levels?.block[k] ?? 1;
+
 /** The statistics of one dispatch from its counters. */
 export function makeStats(layout: Layout, counts: Counts, mode: Mode, forceRefine: boolean, size: Size, counted: Counted, timings: Timings | null): Stats {
   const pixels = size[0] * size[1];
@@ -65,15 +73,25 @@ export function makeStats(layout: Layout, counts: Counts, mode: Mode, forceRefin
     samples = nx * ny + (counts.samples.counter === null ? 0 : counter(counts.samples.counter));
   } else if (counts.samples.kind === 'listed') {
     samples = counted.listedSamples;
+  } else if (counts.samples.kind === 'levels') {
+    // The grids of the levels that have live coarse effects.
+    const blocks = new Set(layout.effects.flatMap((e, k) => (e.live && e.rate === 'coarse' ? [levelBlock(layout, k)] : [])));
+    samples = [...blocks].reduce((sum, b) => sum + gridSamples(size, b), 0);
   }
   const backgroundPixels = counts.background ? counter(counts.background.pixels) : 0;
   const backgroundSamples = counts.background?.samples != null ? counter(counts.background.samples) : 0;
   const effects: EffectStats[] = layout.effects
-    .filter((e) => e.live)
-    .map((e) => {
+    .map((e, k) => ({ e, k }))
+    .filter(({ e }) => e.live)
+    .map(({ e, k }) => {
       const index = layout.stats.counters.indexOf(e.name);
       const countedHere = index < 0 ? 0 : counter(index);
-      const evaluatedSamples = samples - Math.min(backgroundSamples, samples);
+      // The multi-rate mode: an effect's samples are its own level's; the
+      // background samples are counted at the 2x2 level.
+      const levels = counts.samples.kind === 'levels';
+      const own = levels ? gridSamples(size, levelBlock(layout, k)) : samples;
+      const ownBackground = levels && levelBlock(layout, k) !== 2 ? 0 : backgroundSamples;
+      const evaluatedSamples = own - Math.min(ownBackground, own);
       let [coarseEvaluations, pixelEvaluations] = [0, pixels];
       if (e.rate === 'coarse' && counts.evaluations === 'counted') [coarseEvaluations, pixelEvaluations] = [0, countedHere];
       if (e.rate === 'coarse' && counts.evaluations === 'samples_and_counted') {

@@ -16,7 +16,7 @@ use std::sync::Arc;
 pub const PROGRAM_NAME: &str = "program.mrsl";
 
 /// Every example with the scene it is made for (README.md's table of the examples).
-const EXAMPLES: [(&str, &str, &str); 9] = [
+const EXAMPLES: [(&str, &str, &str); 10] = [
     ("demo", "demo", include_str!("../../../examples/demo.mrsl")),
     ("sponza_lights", "sponza", include_str!("../../../examples/sponza_lights.mrsl")),
     ("pbr_deferred", "dungeon", include_str!("../../../examples/pbr_deferred.mrsl")),
@@ -26,6 +26,7 @@ const EXAMPLES: [(&str, &str, &str); 9] = [
     ("textured_materials", "demo", include_str!("../../../examples/textured_materials.mrsl")),
     ("derivatives", "demo", include_str!("../../../examples/derivatives.mrsl")),
     ("effect_chain", "demo", include_str!("../../../examples/effect_chain.mrsl")),
+    ("three_rates", "demo", include_str!("../../../examples/three_rates.mrsl")),
 ];
 
 /// `GET /api/examples`.

@@ -1,6 +1,6 @@
 //! Which kernels one execution of the `compile` and `wellformed` targets
 //! builds. naga validation dominates the cost of a compile, so validating
-//! all the kernels of `Options::default()` (eleven) on every execution made these
+//! all the kernels of `Options::default()` (fifteen) on every execution made these
 //! targets many times slower; each execution builds the kernels of one mode
 //! instead, chosen by the input, so that every kind is still covered across
 //! executions (and a finding replays with the same kernels). The proptest

@@ -5,8 +5,8 @@
 
 use super::formats::{default_output_format, formats_for, output_format_fits};
 use super::{
-    Background, Checker, ConstId, ConstInfo, ConstValue, EffectId, EffectInfo, FunctionId, FunctionInfo, Global,
-    InputId, InputInfo, KeyCompare, UniformId, UniformInfo, UniformKind, err,
+    Background, COARSE_BLOCKS, Checker, ConstId, ConstInfo, ConstValue, EffectId, EffectInfo, FunctionId, FunctionInfo,
+    Global, InputId, InputInfo, KeyCompare, UniformId, UniformInfo, UniformKind, err,
 };
 use crate::builtins::Builtin;
 use crate::diagnostic::{Diagnostic, Label};
@@ -86,6 +86,11 @@ impl Checker<'_> {
                     self.out.effects.push(EffectInfo {
                         name: d.name.name.clone(),
                         rate: d.rate,
+                        // Checked in `check_effect_decl`: only the block sizes the kernels have.
+                        block: d
+                            .coarse_block
+                            .and_then(|(n, _)| u32::try_from(n).ok())
+                            .filter(|n| COARSE_BLOCKS.contains(n)),
                         ty,
                         item: index,
                         name_span: d.name.span,
@@ -407,6 +412,14 @@ impl Checker<'_> {
                         "effects are scalars, vectors or matrices"
                     },
                 ),
+            );
+        }
+        if let Some((n, span)) = d.coarse_block
+            && !COARSE_BLOCKS.iter().any(|&b| u64::from(b) == n)
+        {
+            self.error(
+                err("E0117", format!("there is no coarse rate of {n}x{n} blocks"), span, "expected 4 or 2")
+                    .with_note("`coarse(4)` shades one sample per 4x4 block, `coarse(2)` one per 2x2 block; plain `coarse` takes the mode's block size"),
             );
         }
         for attr in &d.attrs {

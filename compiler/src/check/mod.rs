@@ -34,6 +34,10 @@ mod typing;
 
 use names::{TYPE_NAMES, suggest};
 
+/// The block sizes `coarse(N)` may name, coarsest first: those of the
+/// multi-rate mode's levels (docs/language.md, section 8.4).
+pub const COARSE_BLOCKS: [u32; 2] = [mrsl_abi::geometry::DYNAMIC_OUTER_BLOCK, mrsl_abi::geometry::DYNAMIC_INNER_BLOCK];
+
 macro_rules! typed_id {
     ($name:ident) => {
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
@@ -127,6 +131,9 @@ pub struct FunctionInfo {
 pub struct EffectInfo {
     pub name: String,
     pub rate: Rate,
+    /// `coarse(N)`'s block size N (4 or 2); `None` for plain `coarse`, the
+    /// fine rates, and a block size E0117 rejected.
+    pub block: Option<u32>,
     pub ty: Type,
     pub item: usize,
     pub name_span: Span,
@@ -161,7 +168,7 @@ pub struct ConstValue {
 }
 
 /// The checked program: the AST plus everything the checks learned about it.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct Checked<'a> {
     pub program: &'a Program,
     pub inputs: Vec<InputInfo>,

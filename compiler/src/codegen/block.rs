@@ -8,14 +8,15 @@
 //! decisions) is in [`super::fine`]; the rate-image mode's coarse kernel
 //! reuses this one's body ([`Writer::coarse_main`]).
 
-use super::Writer;
 use super::effects::{Evaluation, Key};
 use super::fine::{CORNER_SAMPLES, Corners, LANES, Level, Resolver};
 use super::names::{
-    BACKGROUND, BLOCK_STRUCT, CORNERS_STRUCT, GID, INTERFACE, NEIGHBOURS, Name, POS, RECORD, SAMPLES, STATS, STRIDE,
+    BACKGROUND, BLOCK_STRUCT, CORNERS_STRUCT, GID, INTERFACE, LEVEL_VALUES, NEIGHBOURS, Name, PIXEL, POS, RECORD,
+    SAMPLES, STATS, STRIDE,
 };
 use super::words::{pack_words, test_bit, unpack_with};
 use super::writer::{cut, fill};
+use super::{ViewLevel, Writer};
 use crate::check::{EffectId, InputId};
 use crate::layout;
 use mrsl_abi::KernelKind;
@@ -74,6 +75,63 @@ impl Writer<'_, '_, '_> {
         if self.kind == KernelKind::DynamicFine {
             self.inner_interface_binding();
         }
+        self.level_values_binding();
+    }
+
+    /// The multi-rate mode's stored `coarse(4)` values (layout
+    /// `levels.values`): written by the resolve pass, read by the 2x2
+    /// level and the pixels; nothing in the other kernels. A texture with a
+    /// layer per word rather than a storage buffer, for the reason
+    /// `InterfaceLayout` gives: llvmpipe loads a buffer word lane by lane.
+    fn level_values_binding(&mut self) {
+        let (ViewLevel::Outer { words, .. } | ViewLevel::Inner { words, .. }) = self.i.level else { return };
+        if words == 0 || self.file == KernelKind::MultiCoarse && matches!(self.i.level, ViewLevel::Outer { .. }) {
+            return;
+        }
+        let binding = self.i.layout.levels.as_ref().expect("the multi-rate mode has levels").values.binding;
+        let outer = mrsl_abi::geometry::DYNAMIC_OUTER_BLOCK;
+        self.line(0, format!("// The coarse({outer}) values per pixel, a layer per word ({words})."));
+        let group = self.i.layout.interface.group;
+        let ty = "texture_storage_2d_array<r32uint, read_write>";
+        self.line(0, format!("@group({group}) @binding({binding}) var {LEVEL_VALUES}: {ty};"));
+        self.line(0, "");
+    }
+
+    /// `mrsl_eval_<effect>` of an effect the inner view reads from the
+    /// stored values: its value at the position's pixel, as the resolve pass stored it.
+    pub(super) fn loaded_function(&mut self, e: EffectId) {
+        let ViewLevel::Inner { values, words, .. } = self.i.level else { return };
+        let info = &self.checked().effects[e.index()];
+        let signature = self.eval_signature(e, false);
+        let Some(&(_, offset)) = values.iter().find(|(v, _)| *v == e) else {
+            // Read only by other coarse(4) effects, themselves loaded: never called.
+            self.line(0, format!("// `{}` is read only at the 4x4 level.", info.name));
+            self.line(0, format!("{signature} {{ return {}(); }}", info.ty.wgsl()));
+            self.line(0, "");
+            return;
+        };
+        self.line(0, format!("// `{}` as the resolve pass stored it at the position's pixel.", info.name));
+        self.line(0, format!("{signature} {{"));
+        debug_assert!(offset + info.ty.components() <= words);
+        self.line(1, format!("let p = {PIXEL}({POS});"));
+        let value = unpack_with(&info.ty, |k| format!("textureLoad({LEVEL_VALUES}, p, {}).x", offset + k));
+        self.line(1, format!("return {value};"));
+        self.line(0, "}");
+        self.line(0, "");
+    }
+
+    /// Whether this is the multi-rate mode's 4x4 level, which does not
+    /// count background samples: the mode counts those of its 2x2 level.
+    pub(super) fn is_outer_level(&self) -> bool {
+        self.file == KernelKind::MultiCoarse && self.block == mrsl_abi::geometry::DYNAMIC_OUTER_BLOCK
+    }
+
+    /// Whether the kernel binds the statistics for the background samples
+    /// alone: the block and rate-image coarse kernels, with a background rule.
+    pub(super) fn counts_background_samples(&self) -> bool {
+        matches!(self.kind, KernelKind::Coarse | KernelKind::RateCoarse)
+            && self.has_background()
+            && !self.is_outer_level()
     }
 
     /// Whether the kernel writes its records as texels of the record
@@ -99,7 +157,8 @@ impl Writer<'_, '_, '_> {
     /// (layout `neighbours`): `coarse_neighbours` stores them at every
     /// sample, and `mrsl_at_<effect>` reads them.
     pub(super) fn stores_neighbours(&self) -> bool {
-        self.kind == KernelKind::Coarse && self.i.layout.neighbours.words > 0
+        // The multi-rate mode's coarse kernels evaluate derivatives' neighbours in place.
+        self.file == KernelKind::Coarse && self.i.layout.neighbours.words > 0
     }
 
     /// The effects of the neighbour values, in layout order, with their word offsets.
@@ -154,7 +213,7 @@ impl Writer<'_, '_, '_> {
         if self.kind == KernelKind::DynamicCoarse {
             self.parent_refined();
         }
-        if self.kind == KernelKind::Coarse {
+        if self.file == KernelKind::Coarse {
             self.neighbours_entry();
         }
         self.coarse_main(include_str!("templates/coarse_main.wgsl"));
@@ -178,7 +237,7 @@ impl Writer<'_, '_, '_> {
             &[
                 ("WORKGROUP", &format!("{x}, {y}, {z}")),
                 ("RECORD", &record),
-                ("ENTRY", &self.kind.main_entry_point()),
+                ("ENTRY", &self.file.main_entry_point()),
                 ("WORK_GROUP", &x),
                 ("MAX_X", &mrsl_abi::geometry::RATE_ARGS_MAX_X),
             ],
@@ -193,7 +252,7 @@ impl Writer<'_, '_, '_> {
                 self.line(1, format!("var {} = 0u;", Name::RecordWord.of(w)));
             }
         }
-        if let Some((_, samples)) = self.i.layout.background_counters() {
+        if let Some((_, samples)) = self.i.layout.background_counters().filter(|_| !self.is_outer_level()) {
             let on = super::pixel::statistics_enabled();
             self.line(1, format!("if ({on} && {BACKGROUND}({POS})) {{ atomicAdd(&{STATS}[{samples}], 1u); }}"));
         }

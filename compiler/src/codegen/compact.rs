@@ -62,7 +62,7 @@ impl Writer<'_, '_, '_> {
     /// coarse effects whose lists and values fit the workgroup memory.
     pub(super) fn compacts(&self) -> bool {
         self.i.compact
-            && self.kind == mrsl_abi::KernelKind::Fine
+            && self.file == mrsl_abi::KernelKind::Fine
             && !self.coarse_live().is_empty()
             && self.compaction_bytes() <= MAX_COMPACTION_BYTES
     }

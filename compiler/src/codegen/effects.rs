@@ -6,7 +6,7 @@
 //! entry points of every family use.
 
 use super::body::{Mode, float_literal, local_name, wgsl_ident};
-use super::names::{BACKGROUND, BLOCK_SIZE, CONTROL, FORCE, NEIGHBOURS, Name, POS, REFINE};
+use super::names::{BACKGROUND, BLOCK_SIZE, CONTROL, FORCE, NEIGHBOURS, Name, OCTAHEDRAL, POS, REFINE, RGB9E5};
 use super::words::{bit, unpack_with};
 use super::writer::cut;
 use super::{Derivatives, Writer};
@@ -213,7 +213,13 @@ impl<'b> Writer<'_, '_, 'b> {
         }
         self.template(0, stage, &[]);
         match self.kind {
-            KernelKind::Coarse | KernelKind::Fine | KernelKind::DynamicFine => self.interface_bindings(),
+            // (The multi-rate kernels are written as the block kernels of their family.)
+            KernelKind::Coarse
+            | KernelKind::Fine
+            | KernelKind::DynamicFine
+            | KernelKind::MultiCoarse
+            | KernelKind::MultiResolve
+            | KernelKind::MultiFine => self.interface_bindings(),
             KernelKind::DynamicCoarse => self.dynamic_coarse_bindings(),
             KernelKind::Hierarchical => self.hierarchical_bindings(),
             KernelKind::Checkerboard => self.checkerboard_bindings(),
@@ -222,11 +228,11 @@ impl<'b> Writer<'_, '_, 'b> {
         }
         if self.counts_stats() {
             self.stats_bindings();
-        } else if matches!(self.kind, KernelKind::Coarse | KernelKind::RateCoarse) && self.has_background() {
+        } else if self.counts_background_samples() {
             // The coarse kernels count the background samples.
             self.stats_buffer();
         }
-        if !self.kind.is_coarse() {
+        if self.file.writes_outputs() {
             for o in &l.outputs {
                 self.line(
                     0,
@@ -405,7 +411,7 @@ impl<'b> Writer<'_, '_, 'b> {
 
     /// The signature of `mrsl_eval_<effect>`, or of `mrsl_val_<effect>`
     /// (`value_only`), which has no refine flag.
-    fn eval_signature(&self, e: EffectId, value_only: bool) -> String {
+    pub(super) fn eval_signature(&self, e: EffectId, value_only: bool) -> String {
         let c = self.checked();
         let info = &c.effects[e.index()];
         let mut params = vec![format!("{POS}: vec2<i32>")];
@@ -562,7 +568,8 @@ impl<'b> Writer<'_, '_, 'b> {
 
     fn live_sites(&self) -> Vec<usize> {
         let mut computed = vec![false; self.checked().effects.len()];
-        for e in self.kernel_effects() {
+        // A loaded effect's derivatives were taken where the resolve pass evaluated it.
+        for e in self.kernel_effects().into_iter().filter(|&e| !self.is_loaded(e)) {
             computed[e.index()] = true;
         }
         (0..self.i.deriv.sites.len()).filter(|&k| computed[self.i.deriv.sites[k].effect.index()]).collect()
@@ -832,15 +839,15 @@ fn visit_kept_exprs<'a>(s: &'a Stmt, skipped: &HashSet<NodeId>, f: &mut dyn FnMu
 /// The WGSL of a field of Bevy's deferred G-buffer texel `g` (a `vec4<u32>`),
 /// as Bevy 0.19's `pbr_input_from_deferred_gbuffer` decodes it.
 fn bevy_field(field: BevyField) -> String {
-    let octahedral = "mrsl_octahedral(vec2<f32>(f32(g.w & 0xfffu), f32((g.w >> 12u) & 0xfffu)) / 4095.0 * 2.0 - 1.0)";
+    let normal = "vec2<f32>(f32(g.w & 0xfffu), f32((g.w >> 12u) & 0xfffu)) / 4095.0 * 2.0 - 1.0";
     match field {
         BevyField::BaseColor => "pow(unpack4x8unorm(g.x).rgb, vec3<f32>(2.2))".into(),
         BevyField::PerceptualRoughness => "unpack4x8unorm(g.x).a".into(),
-        BevyField::Emissive => "mrsl_rgb9e5(g.y)".into(),
+        BevyField::Emissive => format!("{RGB9E5}(g.y)"),
         BevyField::Reflectance => "unpack4x8unorm(g.z).x".into(),
         BevyField::Metallic => "unpack4x8unorm(g.z).y".into(),
         BevyField::Occlusion => "unpack4x8unorm(g.z).z".into(),
-        BevyField::Normal => octahedral.into(),
+        BevyField::Normal => format!("{OCTAHEDRAL}({normal})"),
         BevyField::Flags => "(g.w >> 24u) & 0xffu".into(),
     }
 }

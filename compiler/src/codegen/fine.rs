@@ -160,7 +160,7 @@ impl<'b> Writer<'_, '_, 'b> {
 
     /// The number of `refined<w>` words of `MrslBlock`: a bit per live coarse effect.
     pub(super) fn mask_words(&self) -> u32 {
-        (self.coarse_live().len() as u32).div_ceil(32)
+        (self.i.counters.len() as u32).div_ceil(32)
     }
 
     /// `MrslBlock` from `template` (the family's fields, then `fields`
@@ -447,7 +447,6 @@ impl<'b> Writer<'_, '_, 'b> {
     /// it re-evaluates; then the effects (see [`Writer::pixel_main`]).
     pub(super) fn fine_main(&mut self) {
         let counted = self.counts_stats();
-        let coarse = self.coarse_live().len();
         self.pixel_main(
             |w, scope| {
                 if !counted {
@@ -465,10 +464,16 @@ impl<'b> Writer<'_, '_, 'b> {
                 w.statistics_on(2);
                 let mask_y = w.mask_y(last, &from_inner);
                 w.template(3, include_str!("templates/rate.wgsl"), &[("LAST", &last), ("FROM_INNER", &mask_y)]);
-                for k in 0..coarse {
+                // (A loaded effect is counted where the resolve pass evaluated it.)
+                let counted: Vec<EffectId> = w.coarse_live().into_iter().filter(|&e| !w.is_loaded(e)).collect();
+                for e in counted {
+                    let k = w.coarse_index[&e] as usize;
                     w.count_refined(k, &format!("{IS_REFINED}({LAST_BLOCK}, {k}u)"));
                 }
-                w.count_background(LAST_BLOCK);
+                // The multi-rate mode counts its background pixels once, in its last pass.
+                if w.file != KernelKind::MultiResolve {
+                    w.count_background(LAST_BLOCK);
+                }
                 w.line(2, "}");
             },
             |w, e, indent| w.effect_chain(&[e], indent, Evaluation::Kernel),

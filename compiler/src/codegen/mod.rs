@@ -92,6 +92,35 @@ pub(crate) struct Inputs<'a, 'b> {
     /// What the kernels of one compile share: build it once with
     /// [`Cache::new`] and write every kernel with the same inputs.
     pub cache: Cache,
+    /// The live coarse effects of the program in dependency order, which
+    /// number them for refine masks and statistics counters in every view.
+    pub counters: Vec<EffectId>,
+    /// The multi-rate mode's level this view of the program is
+    /// (`crate::rates`), with what its resolve pass stores per pixel.
+    pub level: ViewLevel<'b>,
+}
+
+/// Which program the inputs hold: the program itself, or a level of the
+/// multi-rate mode ([`crate::rates`]).
+#[derive(Clone, Copy)]
+pub(crate) enum ViewLevel<'b> {
+    Program,
+    /// The `coarse(4)` effects alone are coarse; the resolve pass stores `values`.
+    Outer {
+        values: &'b [(EffectId, u32)],
+        words: u32,
+    },
+    /// The `coarse(4)` effects, `loaded`, are read from `values`.
+    Inner {
+        values: &'b [(EffectId, u32)],
+        words: u32,
+        loaded: &'b [bool],
+    },
+}
+
+/// The live coarse effects of `checked` in dependency order ([`Inputs::counters`]).
+pub(crate) fn counters(checked: &Checked, graph: &EffectGraph) -> Vec<EffectId> {
+    graph.order.iter().copied().filter(|e| checked.effects[e.index()].rate == Rate::Coarse).collect()
 }
 
 /// What the kernels of one compile share, computed once: where the source's
@@ -138,7 +167,14 @@ impl Cache {
 
 /// Writes one kernel. `block` is the coarse block size (ignored by the reference kernel).
 pub(crate) fn write_string(inputs: &Inputs, kind: KernelKind, block: u32) -> String {
-    let mut w = Writer::new(inputs, kind, if kind == KernelKind::Reference { 1 } else { block });
+    // The multi-rate kernels are the block kernels over a view of the program.
+    let family = match kind {
+        KernelKind::MultiCoarse => KernelKind::Coarse,
+        KernelKind::MultiResolve | KernelKind::MultiFine => KernelKind::Fine,
+        other => other,
+    };
+    let mut w = Writer::new(inputs, family, if kind == KernelKind::Reference { 1 } else { block });
+    w.file = kind;
     w.module();
     w.code.into_string()
 }
@@ -146,7 +182,11 @@ pub(crate) fn write_string(inputs: &Inputs, kind: KernelKind, block: u32) -> Str
 /// The state of writing one kernel; every module adds its part with an `impl Writer`.
 struct Writer<'i, 'a, 'b> {
     i: &'i Inputs<'a, 'b>,
+    /// The family of kernel written: a multi-rate kernel is written as the
+    /// block kernel of its family (`file`).
     kind: KernelKind,
+    /// The kernel itself: its entry point and header.
+    file: KernelKind,
     block: u32,
     code: Code,
     /// Live coarse effects, numbered for refine masks, statistics counters and records.
@@ -155,15 +195,8 @@ struct Writer<'i, 'a, 'b> {
 
 impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
     fn new(i: &'i Inputs<'a, 'b>, kind: KernelKind, block: u32) -> Self {
-        let coarse_index = i
-            .graph
-            .order
-            .iter()
-            .filter(|e| i.checked.effects[e.index()].rate == Rate::Coarse)
-            .enumerate()
-            .map(|(k, e)| (*e, k as u32))
-            .collect();
-        Writer { i, kind, block, code: Code::default(), coarse_index }
+        let coarse_index = i.counters.iter().enumerate().map(|(k, e)| (*e, k as u32)).collect();
+        Writer { i, kind, file: kind, block, code: Code::default(), coarse_index }
     }
 
     fn checked(&self) -> &'b Checked<'a> {
@@ -206,6 +239,12 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         self.i.graph.order.iter().copied().filter(|e| self.checked().effects[e.index()].rate == Rate::Coarse).collect()
     }
 
+    /// Whether `e` is read from the stored values of the multi-rate
+    /// mode's resolve pass (the inner view's `coarse(4)` effects).
+    fn is_loaded(&self, e: EffectId) -> bool {
+        matches!(self.i.level, ViewLevel::Inner { loaded, .. } if loaded[e.index()])
+    }
+
     /// Effects this kernel computes: the coarse kernels only coarse ones.
     fn kernel_effects(&self) -> Vec<EffectId> {
         let c = self.checked();
@@ -227,7 +266,7 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             &[
                 ("VERSION", &env!("CARGO_PKG_VERSION")),
                 ("FILE", &file),
-                ("WHAT", &describe(self.kind, block)),
+                ("WHAT", &describe(self.file, block)),
                 ("BLOCK", &block),
             ],
         );
@@ -259,7 +298,9 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         let keeps_flags = self.keeps_refine_flags();
         for e in self.kernel_effects() {
             // A kernel that discards refine flags never calls `mrsl_eval_` of an effect that can refine.
-            if keeps_flags || !c.effects[e.index()].has_refine {
+            if self.is_loaded(e) {
+                self.loaded_function(e);
+            } else if keeps_flags || !c.effects[e.index()].has_refine {
                 self.cached(Piece::Effect(e, false, self.derivatives()), |w| w.eval_function(e, false));
             }
             if value_only.contains(&e) {
@@ -269,8 +310,8 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         self.derivative_helpers();
         self.neighbour_functions();
         match self.kind {
-            KernelKind::Coarse | KernelKind::DynamicCoarse => self.coarse_entry(),
-            KernelKind::Fine | KernelKind::DynamicFine => {
+            KernelKind::Coarse | KernelKind::DynamicCoarse | KernelKind::MultiCoarse => self.coarse_entry(),
+            KernelKind::Fine | KernelKind::DynamicFine | KernelKind::MultiResolve | KernelKind::MultiFine => {
                 self.fine_support();
                 self.pixel_entry();
             }
@@ -314,6 +355,18 @@ fn describe(kind: KernelKind, block: u32) -> String {
         }
         KernelKind::RateFine => {
             "rate-image mode, per pixel: resampled at the tile's rate, refined, then fine effects".to_string()
+        }
+        KernelKind::MultiCoarse if block == outer => {
+            format!("multi-rate mode, {block}x{block} level: one invocation per coarse sample, coarse({block}) effects")
+        }
+        KernelKind::MultiCoarse => format!(
+            "multi-rate mode, {block}x{block} level: one invocation per coarse sample, the coarse effects but coarse({outer})"
+        ),
+        KernelKind::MultiResolve => {
+            format!("multi-rate mode: coarse({outer}) effects resolved per pixel from {block}x{block} samples, stored")
+        }
+        KernelKind::MultiFine => {
+            format!("multi-rate mode, fine kernel, {block}x{block} blocks: coarse({outer}) values as stored")
         }
     }
 }

@@ -200,6 +200,10 @@ pub(super) const TILE_PIXEL: &str = "mrsl_tile_pixel";
 pub(super) const CONTROL: &str = "mrsl_ctl";
 /// The user uniforms (`MrslUniforms`).
 pub(super) const UNIFORMS: &str = "mrsl_u";
+/// `mrsl_octahedral(e)` and `mrsl_rgb9e5(v)`: decodings of packed channels
+/// (templates/octahedral.wgsl, templates/rgb9e5.wgsl).
+pub(super) const OCTAHEDRAL: &str = "mrsl_octahedral";
+pub(super) const RGB9E5: &str = "mrsl_rgb9e5";
 /// Whether the runtime forces refinement, in a coarse kernel.
 pub(super) const FORCE: &str = "mrsl_force";
 /// The refine flag parameter of `mrsl_eval_<effect>`.
@@ -238,6 +242,10 @@ pub(super) const LANE_PIXEL: &str = "mrsl_k";
 /// The records of the coarse samples (one level, or the dynamic mode's inner level).
 pub(super) const INTERFACE: &str = "mrsl_interface";
 pub(super) const INTERFACE2: &str = "mrsl_interface2";
+/// The multi-rate mode's `coarse(4)` values per pixel (layout `levels.values`).
+pub(super) const LEVEL_VALUES: &str = "mrsl_level_values";
+/// `mrsl_pixel(pos)`: the pixel of a position.
+pub(super) const PIXEL: &str = "mrsl_pixel";
 /// The records of the dynamic mode's outer level, as its inner coarse kernel reads them.
 pub(super) const PARENT: &str = "mrsl_parent";
 /// The neighbour values of the block coarse kernel (layout `neighbours`).
@@ -297,6 +305,8 @@ pub(super) const FIXED: &[&str] = &[
     LANE_PIXEL,
     INTERFACE,
     INTERFACE2,
+    LEVEL_VALUES,
+    PIXEL,
     PARENT,
     NEIGHBOURS,
     COMPACT_LISTS,
@@ -310,14 +320,12 @@ pub(super) const FIXED: &[&str] = &[
     BLOCK_SIZE,
     BLOCK_STRUCT,
     CORNERS_STRUCT,
-    // octahedral.wgsl, rgb9e5.wgsl: decodings of packed channels
-    "mrsl_octahedral",
-    "mrsl_rgb9e5",
+    OCTAHEDRAL,
+    RGB9E5,
     // resources.wgsl, uniforms.wgsl, stats.wgsl, positions.wgsl: bindings and position helpers
     "MrslControl",
     "MrslUniforms",
     "mrsl_refine_mask",
-    "mrsl_pixel",
     "mrsl_pair_x",
     "mrsl_pair_y",
     // derivative.wgsl, derivative_both.wgsl: the operand here, at the pair's other position

@@ -3,13 +3,15 @@
 //! tile, the in-image guard, the effects in dependency order, the output
 //! stores, and the per-workgroup statistics that must all reach a barrier.
 
-use super::Writer;
 use super::effects::Evaluation;
 use super::fine::Level;
 use super::names::{
-    BLOCK, CONTROL, CORNERS, FIRST, GRID, INNER_BLOCK, IS_REFINED, LANE_PIXEL, LOAD_CORNERS, Name, POS, WORKGROUP_STATS,
+    BLOCK, CONTROL, CORNERS, FIRST, GRID, INNER_BLOCK, IS_REFINED, LANE_PIXEL, LEVEL_VALUES, LOAD_CORNERS, Name, POS,
+    WORKGROUP_STATS,
 };
+use super::words::pack_words;
 use super::writer::cut;
+use super::{ViewLevel, Writer};
 use crate::check::EffectId;
 use crate::syntax::ast::Rate;
 use crate::types::{Scalar, Type};
@@ -128,7 +130,7 @@ impl Writer<'_, '_, '_> {
             include_str!("templates/pixel_main.wgsl"),
             &[
                 ("WORKGROUP", &format!("{x}, {y}, {z}")),
-                ("ENTRY", &self.kind.main_entry_point()),
+                ("ENTRY", &self.file.main_entry_point()),
                 ("FIRST", &if pairs { FIRST } else { POS }),
             ],
         );
@@ -193,14 +195,14 @@ impl Writer<'_, '_, '_> {
     /// The per-workgroup counters: one per coarse effect, and with a
     /// background rule one more, the background pixels.
     pub(super) fn workgroup_counters(&self) -> usize {
-        self.coarse_live().len() + usize::from(self.has_background())
+        self.i.counters.len() + usize::from(self.has_background())
     }
 
     /// Where workgroup counter `k` goes in the statistics buffer: counter `k`
     /// for a coarse effect; the background pixels after the dynamic mode's
     /// count of 2x2 samples (layout `stats`).
     pub(super) fn counter_target(&self) -> String {
-        let k = self.coarse_live().len();
+        let k = self.i.counters.len();
         if self.has_background() { format!("select(k, k + 1u, k == {k}u)") } else { "k".to_string() }
     }
 
@@ -209,7 +211,7 @@ impl Writer<'_, '_, '_> {
     /// `statistics_on` block).
     pub(super) fn count_background(&mut self, block: &str) {
         if self.has_background() {
-            let k = self.coarse_live().len();
+            let k = self.i.counters.len();
             self.line(3, format!("if ({block}.background) {{ atomicAdd(&{WORKGROUP_STATS}[{k}], 1u); }}"));
         }
     }
@@ -251,6 +253,17 @@ impl Writer<'_, '_, '_> {
             }
             let value = to_vec4(&format!("{prefix}{}", self.effect_name(*e)), &info.ty);
             self.line(indent, format!("textureStore({}, {pos}, {value});", Name::Out.of(&info.name)));
+        }
+        if let ViewLevel::Outer { values, .. } = self.i.level {
+            // The multi-rate resolve pass: the values finer levels read, stored at the pixel.
+            for &(e, offset) in values {
+                let info = &c.effects[e.index()];
+                for (j, word) in pack_words(&format!("{prefix}{}", self.effect_name(e)), &info.ty).iter().enumerate() {
+                    let layer = offset + j as u32;
+                    let store = format!("textureStore({LEVEL_VALUES}, {pos}, {layer}, vec4<u32>({word}, 0u, 0u, 0u));");
+                    self.line(indent, store);
+                }
+            }
         }
     }
 

@@ -152,8 +152,11 @@ pub enum EffectBody {
 pub struct EffectDecl {
     pub attrs: Vec<Attribute>,
     pub rate: Rate,
-    /// The span of the rate keywords (`coarse effect`, `fine out`).
+    /// The span of the rate keywords (`coarse effect`, `coarse(4) effect`, `fine out`).
     pub rate_span: Span,
+    /// `coarse(N)`: the block size N as written, and its span; `None` for
+    /// plain `coarse` and the fine rates.
+    pub coarse_block: Option<(u64, Span)>,
     pub ty: TypeName,
     pub name: Ident,
     pub body: EffectBody,

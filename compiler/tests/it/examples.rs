@@ -86,7 +86,8 @@ struct Declarations {
 
 impl Declarations {
     /// Reads the declarations that start at the beginning of a line (the
-    /// examples' style): `in`, `uniform`, `coarse effect`, `fine effect` and
+    /// examples' style): `in`, `uniform`, `coarse effect` (or `coarse(4)`,
+    /// `coarse(2)`), `fine effect` and
     /// `fine out`, each possibly after attributes such as `@key`.
     fn scan(source: &str) -> Declarations {
         let mut found = Declarations::default();
@@ -114,7 +115,7 @@ impl Declarations {
                     };
                     found.uniforms.push((name, ty));
                 }
-                ["coarse", "effect", ty, name, ..] => {
+                ["coarse" | "coarse(4)" | "coarse(2)", "effect", ty, name, ..] => {
                     found.effects.push((identifier(name), Rate::Coarse, ty.to_string()))
                 }
                 ["fine", "effect", ty, name, ..] => found.effects.push((identifier(name), Rate::Fine, ty.to_string())),

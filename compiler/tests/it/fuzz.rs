@@ -236,6 +236,8 @@ const GENERATOR_FEATURES: &[&str] = &[
     "parameter assignment",
     "early return",
     "coarse effect",
+    "coarse(4) effect",
+    "coarse(2) effect",
     "fine effect",
     "fine out",
     "@nearest",

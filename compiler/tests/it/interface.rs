@@ -243,3 +243,147 @@ fn exact_colouring_matches_brute_force() {
         assert_eq!(cost(&classes), best, "sizes {sizes:?} edges {edges:?}: got {classes:?}");
     }
 }
+
+/// The multi-rate mode's two records, each over its own level's effects:
+/// `occlusion` is read by a coarse(2) effect and per pixel (always passed),
+/// `blocker` only where the coarse(4) `shadow` refines, so they share; the
+/// 2x2 record holds only `spec`, the coarse(4) values being stored per pixel.
+#[test]
+fn each_multi_rate_level_has_its_own_minimal_record() {
+    let source = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/ok/0077_coarse4_read_per_pixel_and_at_2x2.mrsl"),
+    )
+    .unwrap();
+    let p = compile_ok(&source);
+    let levels = p.layout.levels.as_ref().expect("compiled for the multi-rate mode");
+    let sorted = |l: &mrsl_abi::InterfaceLayout| {
+        let mut s: Vec<Vec<String>> = l.slots.iter().map(|s| s.effects.clone()).collect();
+        s.sort();
+        s
+    };
+    assert_eq!(sorted(&levels.outer), names(&[&["blocker", "shadow"], &["occlusion"]]));
+    assert_eq!(sorted(&levels.inner), names(&[&["spec"]]));
+    assert_eq!((levels.outer.flag_words, levels.inner.flag_words), (1, 1));
+    let stored: Vec<&str> = levels.values.effects.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(stored, ["shadow", "occlusion"], "the coarse(4) effects a finer one reads, in dependency order");
+    assert!(levels.outer.minimal && levels.inner.minimal);
+}
+
+/// Every boundary of the multi-rate mode is minimal, on every corpus case
+/// and example: an independent solver reads the layout alone (dependencies,
+/// levels, refine bits, types), decides interference by enumerating every
+/// assignment of the level's refine flags, and finds the least total slot
+/// width over all partitions of the passed effects into non-interfering
+/// sets. The layout's slots must hold exactly the effects that can be
+/// passed, never two that interfere, and be that wide.
+#[test]
+fn multi_rate_boundaries_match_an_independent_solver_on_the_corpus() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files: Vec<std::path::PathBuf> = ["tests/data/ok", "../examples"]
+        .iter()
+        .flat_map(|dir| std::fs::read_dir(root.join(dir)).unwrap().map(|e| e.unwrap().path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "mrsl"))
+        .collect();
+    files.sort();
+    let options = mrsl::Options::for_modes(&[mrsl::Mode::MultiRate]);
+    let (mut checked, mut three_rate) = (0, 0);
+    for path in &files {
+        let source = std::fs::read_to_string(path).unwrap();
+        let p = mrsl::compile(&source, &options).unwrap_or_else(|_| panic!("{} compiles", path.display()));
+        let levels = p.layout.levels.as_ref().unwrap();
+        three_rate += usize::from(levels.block.contains(&4));
+        for (block, record) in [(4, &levels.outer), (2, &levels.inner)] {
+            if let Some(optimum) = level_optimum(&p.layout, block, path) {
+                let words: u32 = record.slots.iter().map(|s| s.size).sum();
+                assert_eq!(words, optimum, "{}: the {block}x{block} record", path.display());
+                checked += 1;
+            }
+        }
+    }
+    assert!(three_rate >= 3, "the corpus has three-rate programs ({three_rate})");
+    assert!(checked >= 2 * files.len() - 4, "solved {checked} records of {} programs", files.len());
+}
+
+/// The least total slot width of the `block` level's record, or `None` when
+/// the level has too many refine flags or passed effects to enumerate. Also
+/// checks that the record's slots are a colouring of exactly those effects.
+fn level_optimum(layout: &Layout, block: u32, path: &std::path::Path) -> Option<u32> {
+    let levels = layout.levels.as_ref().unwrap();
+    let index = |name: &str| layout.effects.iter().position(|e| e.name == name).unwrap();
+    let at_level: Vec<usize> = (0..layout.effects.len())
+        .filter(|&k| {
+            layout.effects[k].live && layout.effects[k].rate == mrsl_abi::Rate::Coarse && levels.block[k] == block
+        })
+        .collect();
+    let refinable: Vec<usize> = at_level.iter().copied().filter(|&k| layout.effects[k].refine_bit.is_some()).collect();
+    if refinable.len() > 12 {
+        return None;
+    }
+    // Users of each effect, from the dependencies.
+    let mut users = vec![vec![]; layout.effects.len()];
+    for (k, e) in layout.effects.iter().enumerate() {
+        for d in &e.depends_on {
+            users[index(d)].push(k);
+        }
+    }
+    let passed_under = |a: usize, r: &dyn Fn(usize) -> bool| {
+        !r(a)
+            && users[a].iter().any(|&u| {
+                layout.effects[u].live
+                    && (levels.block[u] < block
+                        || (levels.block[u] == block && layout.effects[u].refine_bit.is_some() && r(u)))
+            })
+    };
+    let mut passed_sets: Vec<Vec<usize>> = vec![];
+    for bits in 0u32..1 << refinable.len() {
+        let r = |k: usize| refinable.iter().position(|&x| x == k).is_some_and(|j| bits >> j & 1 == 1);
+        passed_sets.push(at_level.iter().copied().filter(|&a| passed_under(a, &r)).collect());
+    }
+    let mut passed: Vec<usize> = passed_sets.iter().flatten().copied().collect();
+    passed.sort();
+    passed.dedup();
+    let record = if block == 4 { &levels.outer } else { &levels.inner };
+    let mut in_slots: Vec<usize> = record.slots.iter().flat_map(|s| s.effects.iter().map(|n| index(n))).collect();
+    in_slots.sort();
+    assert_eq!(
+        in_slots,
+        passed,
+        "{}: the {block}x{block} record holds exactly the effects that can be passed",
+        path.display()
+    );
+    let interfere = |a: usize, b: usize| passed_sets.iter().any(|s| s.contains(&a) && s.contains(&b));
+    for slot in &record.slots {
+        for (i, a) in slot.effects.iter().enumerate() {
+            for b in &slot.effects[i + 1..] {
+                assert!(!interfere(index(a), index(b)), "{}: `{a}` and `{b}` interfere but share", path.display());
+            }
+        }
+    }
+    if passed.len() > 9 {
+        return None;
+    }
+    let width = |k: usize| layout.effects[k].ty.components();
+    let mut best = u32::MAX;
+    fn partitions(v: usize, items: &[usize], parts: &mut Vec<Vec<usize>>, visit: &mut dyn FnMut(&[Vec<usize>])) {
+        if v == items.len() {
+            return visit(parts);
+        }
+        for k in 0..parts.len() {
+            parts[k].push(items[v]);
+            partitions(v + 1, items, parts, visit);
+            parts[k].pop();
+        }
+        parts.push(vec![items[v]]);
+        partitions(v + 1, items, parts, visit);
+        parts.pop();
+    }
+    partitions(0, &passed, &mut vec![], &mut |parts| {
+        let independent =
+            parts.iter().all(|p| p.iter().enumerate().all(|(i, &a)| p[i + 1..].iter().all(|&b| !interfere(a, b))));
+        if independent {
+            best = best.min(parts.iter().map(|p| p.iter().map(|&k| width(k)).max().unwrap_or(0)).sum());
+        }
+    });
+    Some(best)
+}

@@ -25,7 +25,7 @@ pub fn compile_ok(source: &str) -> mrsl::Program {
 
 /// The kernels `Options::default()` asks for, as (kind, block size), in the
 /// canonical order of `CompiledProgram::kernels` (by kind, then block size).
-pub const DEFAULT_KERNELS: [(KernelKind, Option<u32>); 11] = [
+pub const DEFAULT_KERNELS: [(KernelKind, Option<u32>); 15] = [
     (KernelKind::Coarse, Some(2)),
     (KernelKind::Coarse, Some(4)),
     (KernelKind::Fine, Some(2)),
@@ -37,6 +37,10 @@ pub const DEFAULT_KERNELS: [(KernelKind, Option<u32>); 11] = [
     (KernelKind::Checkerboard, None),
     (KernelKind::RateCoarse, None),
     (KernelKind::RateFine, None),
+    (KernelKind::MultiCoarse, Some(2)),
+    (KernelKind::MultiCoarse, Some(4)),
+    (KernelKind::MultiResolve, Some(4)),
+    (KernelKind::MultiFine, Some(2)),
 ];
 
 /// Asserts that `program` (compiled with default options) has exactly the

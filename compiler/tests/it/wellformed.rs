@@ -6,6 +6,7 @@
 //! covers inputs (with `@key` and `@key(t)`), value uniforms, uniform arrays,
 //! textures and samplers, constants, functions (with texture and sampler
 //! parameters, early returns and calls to earlier functions), coarse effects
+//! (plain, `coarse(4)` reading only `coarse(4)` ones, and `coarse(2)`)
 //! with `refine` predicates over derivatives, fine effects and outputs (with
 //! `@nearest` and `@format`), locals, compound assignments, component
 //! assignments, `++`/`--`, `if`/`else`, `for` loops with static bounds and
@@ -290,6 +291,8 @@ struct Gen<'c> {
     /// of such a chain evaluates the next at more neighbours and a chain
     /// grows past the size budget E0701 (which `tests/it/limits.rs` covers).
     differentiating: BTreeSet<String>,
+    /// The `coarse(4)` effects: only they may read one another (E0312).
+    outer: BTreeSet<String>,
     used: BTreeSet<String>,
     /// Nodes left: bounds the program's size.
     budget: i64,
@@ -308,6 +311,7 @@ impl<'c> Gen<'c> {
             functions: vec![],
             effects: vec![],
             differentiating: BTreeSet::new(),
+            outer: BTreeSet::new(),
             used: BTreeSet::new(),
             budget: 0,
         }
@@ -626,15 +630,23 @@ impl<'c> Gen<'c> {
             };
             attr = format!("@format({}) ", self.pick(formats));
         }
+        // A coarse effect's own rate: plain (the mode's), or one of the
+        // multi-rate mode's levels; a coarse(4) one reads only coarse(4) ones.
+        let level = if rate == Rate::Coarse { self.pick(&["", "", "(4)", "(2)"]) } else { "" };
+        if level == "(4)" {
+            self.outer.insert(name.clone());
+        }
         let rate_text = match rate {
-            Rate::Coarse => "coarse effect",
-            Rate::Fine => "fine effect",
-            Rate::Out => "fine out",
+            Rate::Coarse => format!("coarse{level} effect"),
+            Rate::Fine => "fine effect".into(),
+            Rate::Out => "fine out".into(),
         };
-        self.feat(match rate {
-            Rate::Coarse => "coarse effect",
-            Rate::Fine => "fine effect",
-            Rate::Out => "fine out",
+        self.feat(match (rate, level) {
+            (Rate::Coarse, "(4)") => "coarse(4) effect",
+            (Rate::Coarse, "(2)") => "coarse(2) effect",
+            (Rate::Coarse, _) => "coarse effect",
+            (Rate::Fine, _) => "fine effect",
+            (Rate::Out, _) => "fine out",
         });
         let mut ctx = Ctx {
             body: Body::Effect(rate),
@@ -780,7 +792,9 @@ impl<'c> Gen<'c> {
                 if seen.contains(&v.name) || ctx.effect.as_deref() == Some(v.name.as_str()) {
                     continue;
                 }
-                let ok = rate != Rate::Coarse || v.kind == Kind::Effect(Rate::Coarse);
+                let outer = ctx.effect.as_ref().is_some_and(|e| self.outer.contains(e));
+                let ok = (rate != Rate::Coarse || v.kind == Kind::Effect(Rate::Coarse))
+                    && (!outer || self.outer.contains(&v.name));
                 if ok {
                     out.push(v.clone());
                 }
