@@ -63,6 +63,30 @@ fn render(
     render_color(gpu, shader, channels, &[], &[], SIZE, options).pixels
 }
 
+/// One program over the float G-buffer and one over the engine's, in every
+/// mode: each engine image within `bound` dB PSNR of the float one, and the
+/// engine program's forced refinement equal to its reference bit for bit.
+fn compare_in_every_mode(
+    gpu: &Gpu,
+    (float, float_channels): (&mut Shader, &[(String, wgpu::Texture)]),
+    (engine, engine_channels): (&mut Shader, &[(String, wgpu::Texture)]),
+    bound: f64,
+    what: &str,
+) {
+    let reference = render(gpu, engine, engine_channels, Mode::Reference, false);
+    for mode in Mode::ALL {
+        let expected = render(gpu, float, float_channels, mode, false);
+        let found = render(gpu, engine, engine_channels, mode, false);
+        let psnr = psnr_of(&found, &expected);
+        println!("  {mode}: {what} against the float G-buffer: {psnr:.1} dB");
+        assert!(psnr >= bound, "{mode}: {what}: {psnr:.1} dB against the float G-buffer");
+        if mode != Mode::Reference {
+            let forced = render(gpu, engine, engine_channels, mode, true);
+            assert_eq!(worst_ulps(&forced, &reference), 0, "{mode}: forced refinement differs from the reference");
+        }
+    }
+}
+
 /// Every mode over the engine's G-buffer against the same mode over the
 /// float one. The depth is a 32-bit float of `near / view depth`, and the
 /// position rebuilt from it through the inverse view-projection differs
@@ -76,18 +100,8 @@ pub fn depth_and_octahedral_normals_render_as_the_float_gbuffer(gpu: &Gpu) {
     let mut float = Shader::new(&gpu.device, &compile(DEMO)).unwrap();
     let mut engine = Shader::new(&gpu.device, &compile(&engine_program())).unwrap();
     engine.set_uniform_f32("inverse_view_proj", &inverse).unwrap();
-    let reference = render(gpu, &mut engine, &engine_channels, Mode::Reference, false);
-    for mode in Mode::ALL {
-        let expected = render(gpu, &mut float, &float_channels, mode, false);
-        let found = render(gpu, &mut engine, &engine_channels, mode, false);
-        let psnr = psnr_of(&found, &expected);
-        println!("  {mode}: depth + octahedral normals against the float G-buffer: {psnr:.1} dB");
-        assert!(psnr >= 60.0, "{mode}: {psnr:.1} dB against the float G-buffer");
-        if mode != Mode::Reference {
-            let forced = render(gpu, &mut engine, &engine_channels, mode, true);
-            assert_eq!(worst_ulps(&forced, &reference), 0, "{mode}: forced refinement differs from the reference");
-        }
-    }
+    let (float, engine) = ((&mut float, &float_channels[..]), (&mut engine, &engine_channels[..]));
+    compare_in_every_mode(gpu, float, engine, 60.0, "depth + octahedral normals");
 }
 
 /// examples/demo.mrsl reading its albedo and normals from Bevy's deferred G-buffer.
@@ -130,18 +144,8 @@ pub fn bevy_deferred_gbuffer_renders_as_the_float_gbuffer(gpu: &Gpu) {
     bevy_channels.push(("normal".into(), deferred));
     let mut float = Shader::new(&gpu.device, &compile(DEMO)).unwrap();
     let mut bevy = Shader::new(&gpu.device, &compile(&bevy_program())).unwrap();
-    let reference = render(gpu, &mut bevy, &bevy_channels, Mode::Reference, false);
-    for mode in Mode::ALL {
-        let expected = render(gpu, &mut float, &float_channels, mode, false);
-        let found = render(gpu, &mut bevy, &bevy_channels, mode, false);
-        let psnr = psnr_of(&found, &expected);
-        println!("  {mode}: Bevy's deferred G-buffer against the float G-buffer: {psnr:.1} dB");
-        assert!(psnr >= 40.0, "{mode}: {psnr:.1} dB against the float G-buffer");
-        if mode != Mode::Reference {
-            let forced = render(gpu, &mut bevy, &bevy_channels, mode, true);
-            assert_eq!(worst_ulps(&forced, &reference), 0, "{mode}: forced refinement differs from the reference");
-        }
-    }
+    let (float, engine) = ((&mut float, &float_channels[..]), (&mut bevy, &bevy_channels[..]));
+    compare_in_every_mode(gpu, float, engine, 40.0, "Bevy's deferred G-buffer");
 }
 
 const ENGINE: &str = include_str!("../../examples/engine/deferred.mrsl");
@@ -172,18 +176,8 @@ pub fn the_engine_example_program_renders_over_engine_formats(gpu: &Gpu) {
     let mut engine = Shader::new(&gpu.device, &compile(ENGINE)).unwrap();
     engine.set_uniform_f32("inverse_view_proj", &inverse).unwrap();
     float.set_uniform_f32("inverse_view_proj", &inverse).unwrap();
-    let reference = render(gpu, &mut engine, &engine_channels, Mode::Reference, false);
-    for mode in Mode::ALL {
-        let expected = render(gpu, &mut float, &float_channels, mode, false);
-        let found = render(gpu, &mut engine, &engine_channels, mode, false);
-        let psnr = psnr_of(&found, &expected);
-        println!("  {mode}: the engine program over depth + Rgb10a2Unorm normals: {psnr:.1} dB");
-        assert!(psnr >= 45.0, "{mode}: {psnr:.1} dB against the float G-buffer");
-        if mode != Mode::Reference {
-            let forced = render(gpu, &mut engine, &engine_channels, mode, true);
-            assert_eq!(worst_ulps(&forced, &reference), 0, "{mode}: forced refinement differs from the reference");
-        }
-    }
+    let (float, engine) = ((&mut float, &float_channels[..]), (&mut engine, &engine_channels[..]));
+    compare_in_every_mode(gpu, float, engine, 45.0, "the engine program over depth + Rgb10a2Unorm normals");
 }
 
 /// A decoded channel takes only the texture its decoding reads.
