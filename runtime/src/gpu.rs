@@ -39,7 +39,12 @@ pub fn read_buffer<T: bytemuck::Pod>(device: &wgpu::Device, buffer: &wgpu::Buffe
     device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Readback(e.to_string()))?;
     rx.recv().map_err(|e| Error::Readback(e.to_string()))?.map_err(|e| Error::Readback(e.to_string()))?;
     let data = {
+        // wgpu 30 returns the mapped view as a `Result`; wgpu 29 (built by
+        // mrsl-runtime-wgpu29, for Bevy 0.19) returns the view itself.
+        #[cfg(not(feature = "wgpu29"))]
         let view = slice.get_mapped_range().map_err(|e| Error::Readback(e.to_string()))?;
+        #[cfg(feature = "wgpu29")]
+        let view = slice.get_mapped_range();
         bytemuck::cast_slice(&view).to_vec()
     };
     buffer.unmap();

@@ -1,0 +1,102 @@
+//! Renders a Bevy 0.19 scene headless with bevy_mrsl: the per-pixel
+//! reference, an adaptive mode and that mode with refinement forced, each
+//! written as a PNG, with the adaptive image's quality against the
+//! reference and the statistics bevy_mrsl reports.
+//!
+//! ```sh
+//! cargo run --release -p bevy_mrsl --example headless -- [--mode coarse4x4] [--size 640x360] [--out out/bevy]
+//! ```
+
+mod common;
+
+use bevy_mrsl::Mode;
+use common::Capture;
+use std::path::PathBuf;
+
+struct Args {
+    mode: Mode,
+    size: (u32, u32),
+    out: PathBuf,
+}
+
+fn parse() -> Result<Args, String> {
+    let mut args = Args { mode: Mode::Coarse4x4, size: (640, 360), out: PathBuf::from("out/bevy") };
+    let mut rest = std::env::args().skip(1);
+    while let Some(flag) = rest.next() {
+        let mut value = || rest.next().ok_or_else(|| format!("{flag} needs a value"));
+        match flag.as_str() {
+            "--mode" => args.mode = value()?.parse().map_err(|e| format!("--mode: {e}"))?,
+            "--size" => {
+                let v = value()?;
+                let (w, h) = v.split_once('x').ok_or_else(|| format!("--size {v}: expected WIDTHxHEIGHT"))?;
+                let parse = |s: &str| s.parse::<u32>().ok().filter(|n| (1..=8192).contains(n));
+                args.size = match (parse(w), parse(h)) {
+                    (Some(w), Some(h)) => (w, h),
+                    _ => return Err(format!("--size {v}: width and height are 1 to 8192")),
+                };
+            }
+            "--out" => args.out = PathBuf::from(value()?),
+            "--help" | "-h" => {
+                println!("usage: headless [--mode MODE] [--size WxH] [--out DIR]\nmodes: {}", mode_names());
+                std::process::exit(0);
+            }
+            other => return Err(format!("unknown argument `{other}` (see --help)")),
+        }
+    }
+    if args.mode == Mode::Reference {
+        return Err("--mode: name an adaptive mode; the reference is always rendered".into());
+    }
+    Ok(args)
+}
+
+fn mode_names() -> String {
+    Mode::ALL.iter().map(|m| m.name()).collect::<Vec<_>>().join(", ")
+}
+
+fn main() {
+    if let Err(error) = run() {
+        eprintln!("error: {error}");
+        std::process::exit(1);
+    }
+}
+
+fn run() -> Result<(), String> {
+    let args = parse()?;
+    let capture =
+        |name: &str, mode, force_refine, composite| Capture { name: name.into(), mode, force_refine, composite };
+    let captures = vec![
+        capture("reference", Mode::Reference, false, false),
+        capture(args.mode.name(), args.mode, false, true),
+        capture(&format!("{}-forced", args.mode.name()), args.mode, true, false),
+    ];
+    let (width, height) = args.size;
+    let images = common::render(args.size, captures)?;
+    std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
+    let reference = &images[0].pixels;
+    for image in &images {
+        let path = args.out.join(format!("{}.png", image.capture.name));
+        let rgba: Vec<u8> = image
+            .pixels
+            .iter()
+            .flat_map(|p| [0, 1, 2].map(|c| mrsl_lab::color::linear_to_srgb8(p[c])).into_iter().chain([255]))
+            .collect();
+        image::save_buffer(&path, &rgba, width, height, image::ExtendedColorType::Rgba8)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        if let Some(composite) = &image.composite {
+            let path = args.out.join(format!("{}-composite.png", image.capture.name));
+            image::save_buffer(&path, composite.as_flattened(), width, height, image::ExtendedColorType::Rgba8)
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            println!("wrote {} (the camera's image: the output over Bevy's)", path.display());
+        }
+        let quality = mrsl_lab::metrics::compare(&image.pixels, reference, width, height).map_err(|e| e.to_string())?;
+        let shaded = image.stats.as_ref().map(|s| format!(", shaded {:.3}", s.shaded_fraction)).unwrap_or_default();
+        println!(
+            "wrote {} ({}: PSNR {:.2} dB, MSSIM {:.4} against the reference{shaded})",
+            path.display(),
+            image.capture.name,
+            quality.psnr,
+            quality.mssim
+        );
+    }
+    Ok(())
+}
