@@ -62,6 +62,8 @@ fn main() {
 
 fn run() -> Result<(), String> {
     let args = parse()?;
+    // SAFETY: before Bevy starts any thread.
+    unsafe { mrsl_lab::runtime_dir::ensure_xdg_runtime_dir() };
     let capture =
         |name: &str, mode, force_refine, composite| Capture { name: name.into(), mode, force_refine, composite };
     let captures = vec![

@@ -102,3 +102,41 @@ pub(crate) fn require_prepasses(mut commands: Commands, cameras: Query<(Entity, 
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Mode, MrslProgram};
+
+    fn camera(source: &str) -> MrslCamera {
+        MrslCamera::new(MrslProgram::compile(source, "test.mrsl").expect("compiles"), Mode::Coarse4x4)
+    }
+
+    #[test]
+    fn the_example_program_binds_every_channel_by_its_decoding() {
+        let camera = camera(include_str!("../examples/lighting.mrsl"));
+        let bound = resolve(&camera.program.compiled().layout, &camera).expect("every channel bound");
+        let expected = [
+            ("position", PrepassTexture::Depth),
+            ("normal", PrepassTexture::Deferred),
+            ("base_color", PrepassTexture::Deferred),
+            ("lighting_pass", PrepassTexture::DeferredLightingPassId),
+        ];
+        assert_eq!(bound, expected.map(|(n, t)| (n.to_string(), t)));
+    }
+
+    #[test]
+    fn a_channel_no_prepass_texture_stores_is_named_until_bound() {
+        let source = "@encoded(unorm) in float3 normal; in float4 albedo; in float2 motion;\n\
+                      fine out float4 color = float4(normal + albedo.rgb, motion.x);";
+        let camera = camera(source);
+        let program = camera.program.clone();
+        let layout = &program.compiled().layout;
+        assert_eq!(resolve(layout, &camera), Err(vec!["albedo".to_string()]));
+        let camera = camera.bind("albedo", PrepassTexture::Normal);
+        let bound = resolve(layout, &camera).expect("bound");
+        assert!(bound.contains(&("normal".into(), PrepassTexture::Normal)));
+        assert!(bound.contains(&("motion".into(), PrepassTexture::MotionVectors)));
+        assert!(bound.contains(&("albedo".into(), PrepassTexture::Normal)));
+    }
+}

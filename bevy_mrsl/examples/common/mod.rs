@@ -20,7 +20,7 @@ use std::time::Duration;
 pub const PROGRAM: &str = include_str!("../lighting.mrsl");
 
 /// The sky: Bevy's clear colour, which the program leaves in place (alpha 0).
-const SKY: Color = Color::linear_rgb(0.35, 0.48, 0.7);
+pub const SKY: Color = Color::linear_rgb(0.35, 0.48, 0.7);
 
 /// One image to render: a mode, refinement forced or not; with the
 /// camera's composited image too, or not.
