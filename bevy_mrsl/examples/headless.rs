@@ -3,8 +3,13 @@
 //! written as a PNG, with the adaptive image's quality against the
 //! reference and the statistics bevy_mrsl reports.
 //!
+//! With `--bench ROUNDS` it writes nothing and times the mrsl pass instead
+//! (see `common/bench.rs`): frame times without bevy_mrsl, in the reference
+//! and in the mode, interleaved, statistics off.
+//!
 //! ```sh
 //! cargo run --release -p bevy_mrsl --example headless -- [--mode coarse4x4] [--size 640x360] [--out out/bevy]
+//! cargo run --release -p bevy_mrsl --example headless -- --bench 9 --size 1280x720
 //! ```
 
 mod common;
@@ -17,10 +22,11 @@ struct Args {
     mode: Mode,
     size: (u32, u32),
     out: PathBuf,
+    bench: Option<usize>,
 }
 
 fn parse() -> Result<Args, String> {
-    let mut args = Args { mode: Mode::Coarse4x4, size: (640, 360), out: PathBuf::from("out/bevy") };
+    let mut args = Args { mode: Mode::Coarse4x4, size: (640, 360), out: PathBuf::from("out/bevy"), bench: None };
     let mut rest = std::env::args().skip(1);
     while let Some(flag) = rest.next() {
         let mut value = || rest.next().ok_or_else(|| format!("{flag} needs a value"));
@@ -36,8 +42,16 @@ fn parse() -> Result<Args, String> {
                 };
             }
             "--out" => args.out = PathBuf::from(value()?),
+            "--bench" => {
+                let v = value()?;
+                let rounds = v.parse().ok().filter(|n| (1..=1000).contains(n));
+                args.bench = Some(rounds.ok_or_else(|| format!("--bench {v}: a number of rounds, 1 to 1000"))?);
+            }
             "--help" | "-h" => {
-                println!("usage: headless [--mode MODE] [--size WxH] [--out DIR]\nmodes: {}", mode_names());
+                println!(
+                    "usage: headless [--mode MODE] [--size WxH] [--out DIR] [--bench ROUNDS]\nmodes: {}",
+                    mode_names()
+                );
                 std::process::exit(0);
             }
             other => return Err(format!("unknown argument `{other}` (see --help)")),
@@ -64,6 +78,9 @@ fn run() -> Result<(), String> {
     let args = parse()?;
     // SAFETY: before Bevy starts any thread.
     unsafe { mrsl_lab::runtime_dir::ensure_xdg_runtime_dir() };
+    if let Some(rounds) = args.bench {
+        return bench(&args, rounds);
+    }
     let capture =
         |name: &str, mode, force_refine, composite| Capture { name: name.into(), mode, force_refine, composite };
     let captures = vec![
@@ -100,5 +117,38 @@ fn run() -> Result<(), String> {
             quality.mssim
         );
     }
+    Ok(())
+}
+
+/// Frames per timed block.
+const BENCH_FRAMES: u32 = 30;
+
+fn bench(args: &Args, rounds: usize) -> Result<(), String> {
+    let (width, height) = args.size;
+    eprintln!(
+        "timing {rounds} rounds of {BENCH_FRAMES} frames without mrsl, in the reference and in {} at {width}x{height}",
+        args.mode.name()
+    );
+    let times = common::bench::bench(args.size, args.mode, rounds, BENCH_FRAMES)?;
+    let ms = |v: &[f64]| common::bench::median(v.to_vec());
+    println!(
+        "frame time (median of {} blocks): without mrsl {:.2} ms, reference {:.2} ms, {} {:.2} ms",
+        times.rounds(),
+        ms(&times.off),
+        ms(&times.reference),
+        args.mode.name(),
+        ms(&times.adaptive)
+    );
+    println!(
+        "the mrsl pass: reference {:.2} ms, {} {:.2} ms",
+        ms(&times.reference) - ms(&times.off),
+        args.mode.name(),
+        ms(&times.adaptive) - ms(&times.off)
+    );
+    println!(
+        "speedup over the reference (median of per-round ratios): the pass {:.2}x, the frame {:.2}x",
+        times.pass_speedup(),
+        times.frame_speedup()
+    );
     Ok(())
 }

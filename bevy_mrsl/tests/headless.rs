@@ -12,6 +12,8 @@
 //!   (alpha 1) and Bevy's clear colour where it does not, within one 8-bit
 //!   step (the sRGB encoding of the target against ours).
 
+// The example's benchmark, also in this module, is not used here.
+#[allow(dead_code)]
 #[path = "../examples/common/mod.rs"]
 mod common;
 

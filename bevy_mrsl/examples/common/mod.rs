@@ -16,6 +16,8 @@ use bevy_mrsl::{Mode, MrslCamera, MrslOutputs, MrslPlugin, MrslProgram, MrslRepo
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
+pub mod bench;
+
 /// The example's program.
 pub const PROGRAM: &str = include_str!("../lighting.mrsl");
 
@@ -58,7 +60,6 @@ const STALE_READBACKS: u32 = 3;
 
 /// Renders the scene at `size` once per capture, in order, in one app.
 pub fn render(size: (u32, u32), captures: Vec<Capture>) -> Result<Vec<Captured>, String> {
-    let program = MrslProgram::compile(PROGRAM, "lighting.mrsl").map_err(|e| e.to_string())?;
     let result = Arc::new(Mutex::new(None));
     let sequence = Sequence {
         captures,
@@ -67,28 +68,37 @@ pub fn render(size: (u32, u32), captures: Vec<Capture>) -> Result<Vec<Captured>,
         readbacks: 0,
         previous: None,
         source: Source::Output,
-        target: None,
         done: Vec::new(),
         result: Arc::clone(&result),
     };
-    App::new()
-        .add_plugins(
-            DefaultPlugins
-                .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
-                .set(bevy::log::LogPlugin { level: bevy::log::Level::WARN, ..default() }),
-        )
-        .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::ZERO))
-        .add_plugins(MrslPlugin)
-        .insert_resource(DefaultOpaqueRendererMethod::deferred())
-        .insert_resource(ClearColor(SKY))
-        .insert_resource(SceneSetup { size, program })
-        .insert_resource(sequence)
-        .add_systems(Startup, setup)
-        .add_systems(Update, (scene_uniforms, advance))
-        .run();
+    app(size)?.insert_resource(sequence).add_systems(Update, advance).run();
     let outcome = result.lock().unwrap().take();
     outcome.unwrap_or_else(|| Err("the app stopped before every capture was taken".into()))
 }
+
+/// The app without its driver: the scene, the camera (in the reference
+/// mode) and bevy_mrsl, headless.
+fn app(size: (u32, u32)) -> Result<App, String> {
+    let program = MrslProgram::compile(PROGRAM, "lighting.mrsl").map_err(|e| e.to_string())?;
+    let mut app = App::new();
+    app.add_plugins(
+        DefaultPlugins
+            .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
+            .set(bevy::log::LogPlugin { level: bevy::log::Level::WARN, ..default() }),
+    )
+    .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::ZERO))
+    .add_plugins(MrslPlugin)
+    .insert_resource(DefaultOpaqueRendererMethod::deferred())
+    .insert_resource(ClearColor(SKY))
+    .insert_resource(SceneSetup { size, program })
+    .add_systems(Startup, setup)
+    .add_systems(Update, scene_uniforms);
+    Ok(app)
+}
+
+/// The camera's render target.
+#[derive(Resource)]
+struct TargetImage(Handle<Image>);
 
 #[derive(Resource)]
 struct SceneSetup {
@@ -116,7 +126,6 @@ fn setup(
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
     mut images: ResMut<Assets<Image>>,
-    mut sequence: ResMut<Sequence>,
 ) {
     let ground = materials.add(StandardMaterial { base_color: Color::srgb(0.75, 0.72, 0.65), ..default() });
     commands.spawn((Mesh3d(meshes.add(Plane3d::default().mesh().size(12.0, 12.0))), MeshMaterial3d(ground)));
@@ -146,7 +155,7 @@ fn setup(
     let mut target = Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
     target.texture_descriptor.usage |= TextureUsages::COPY_SRC;
     let target = images.add(target);
-    sequence.target = Some(target.clone());
+    commands.insert_resource(TargetImage(target.clone()));
     commands.spawn((
         Camera3d::default(),
         RenderTarget::Image(target.into()),
@@ -211,8 +220,6 @@ struct Sequence {
     readbacks: u32,
     previous: Option<Vec<u8>>,
     source: Source,
-    /// The camera's render target.
-    target: Option<Handle<Image>>,
     done: Vec<Captured>,
     result: Arc<Mutex<Option<Result<Vec<Captured>, String>>>>,
 }
@@ -222,6 +229,7 @@ struct Sequence {
 fn advance(
     mut commands: Commands,
     mut sequence: ResMut<Sequence>,
+    target: Res<TargetImage>,
     mut cameras: Query<(&mut MrslCamera, Option<&MrslOutputs>, Option<&MrslReport>)>,
     readers: Query<(), With<Readback>>,
     mut exit: MessageWriter<AppExit>,
@@ -242,7 +250,7 @@ fn advance(
     }
     let image = match sequence.source {
         Source::Output => outputs.and_then(|o| o.images.first()).map(|(_, h)| h.clone()),
-        Source::Target => sequence.target.clone(),
+        Source::Target => Some(target.0.clone()),
     };
     if readers.is_empty()
         && let Some(image) = image
