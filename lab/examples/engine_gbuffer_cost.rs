@@ -28,6 +28,7 @@ fn main() {
     let pairs: usize = args.next().map_or(9, |a| a.parse().expect("PAIRS is a number"));
     let scene_name = args.next().unwrap_or_else(|| "demo".into());
     let scene = Scene::parse(&scene_name).unwrap_or_else(|| panic!("unknown scene `{scene_name}`"));
+    mrsl_lab::fixtures::locate_sponza();
     // SAFETY: before any thread starts Vulkan.
     unsafe { mrsl_lab::runtime_dir::ensure_xdg_runtime_dir() };
     let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
