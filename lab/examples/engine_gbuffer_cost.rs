@@ -57,7 +57,8 @@ fn main() {
 
     let modes = [Mode::Reference, Mode::Coarse4x4];
     let mut float_shader = shader(&gpu, DEMO, &modes);
-    let mut engine_shader = shader(&gpu, &engine_program(), &modes);
+    let mut engine_shader =
+        shader(&gpu, &engine_formats::over_depth(DEMO, "unorm").expect("the demo's channels"), &modes);
     engine_shader.set_uniform_f32("inverse_view_proj", &inverse).expect("the engine program's matrix");
     let output = gpu.output_texture("color", SIZE, wgpu::TextureFormat::Rgba32Float);
     for mode in modes {
@@ -100,16 +101,6 @@ fn main() {
             ratios.last().unwrap()
         );
     }
-}
-
-/// examples/demo.mrsl over a depth texture and `Rgb10a2Unorm` normals.
-fn engine_program() -> String {
-    let position = "@surface_key(normal, 0.05) in float3 position;";
-    let normal = "@key(0.4) in float3 normal;";
-    assert!(DEMO.contains(position) && DEMO.contains(normal), "examples/demo.mrsl declares its channels so");
-    DEMO.replace(position, "@surface_key(normal, 0.05) @depth(inverse_view_proj) in float3 position;")
-        .replace(normal, "@key(0.4) @encoded(unorm) in float3 normal;")
-        + "\nuniform float4x4 inverse_view_proj;\n"
 }
 
 fn shader(gpu: &Gpu, source: &str, modes: &[Mode]) -> Shader {

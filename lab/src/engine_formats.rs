@@ -8,6 +8,23 @@ use crate::camera::{Camera, CameraError};
 use crate::gpu::Gpu;
 use glam::{Mat4, Vec4};
 
+/// `program` (examples/demo.mrsl, or a program that declares its channels
+/// as it does) over a depth texture and normals stored as `encoding`
+/// (`@encoded(ENCODING)`): its position rebuilt with
+/// `@depth(inverse_view_proj)`, a uniform it gains. `None` when the program
+/// does not declare `position` and `normal` as the demo does.
+pub fn over_depth(program: &str, encoding: &str) -> Option<String> {
+    let position = "@surface_key(normal, 0.05) in float3 position;";
+    let normal = "@key(0.4) in float3 normal;";
+    if !(program.contains(position) && program.contains(normal)) {
+        return None;
+    }
+    let rebuilt = program
+        .replace(position, "@surface_key(normal, 0.05) @depth(inverse_view_proj) in float3 position;")
+        .replace(normal, &format!("@key(0.4) @encoded({encoding}) in float3 normal;"));
+    Some(rebuilt + "\nuniform float4x4 inverse_view_proj;\n")
+}
+
 /// The near plane the depth is projected with.
 pub const NEAR: f32 = 0.05;
 

@@ -18,12 +18,7 @@ const SIZE: (u32, u32) = (96, 54);
 
 /// examples/demo.mrsl over a depth texture and octahedral normals.
 fn engine_program() -> String {
-    let position = "@surface_key(normal, 0.05) in float3 position;";
-    let normal = "@key(0.4) in float3 normal;";
-    assert!(DEMO.contains(position) && DEMO.contains(normal), "examples/demo.mrsl declares its channels so");
-    DEMO.replace(position, "@surface_key(normal, 0.05) @depth(inverse_view_proj) in float3 position;")
-        .replace(normal, "@key(0.4) @encoded(octahedral) in float3 normal;")
-        + "\nuniform float4x4 inverse_view_proj;\n"
+    engine_formats::over_depth(DEMO, "octahedral").expect("examples/demo.mrsl declares position and normal so")
 }
 
 fn floats<'a>(data: Option<&'a ChannelData>, name: &str) -> (usize, &'a [f32]) {
