@@ -3,6 +3,10 @@
 //! written as a PNG, with the adaptive image's quality against the
 //! reference and the statistics bevy_mrsl reports.
 //!
+//! The scene is built in (`--scene spheres`), or the lab's dungeon
+//! (`--scene dungeon`, fetched by `scripts/fetch-dungeon.sh`), or any glTF
+//! file with its lights (`--gltf PATH --eye X,Y,Z --target X,Y,Z`).
+//!
 //! With `--bench ROUNDS` it writes nothing and times the mrsl pass instead
 //! (see `common/bench.rs`): frame times without bevy_mrsl, in the reference
 //! and in the mode, interleaved, statistics off.
@@ -23,10 +27,19 @@ struct Args {
     size: (u32, u32),
     out: PathBuf,
     bench: Option<usize>,
+    scene: common::Scene,
 }
 
 fn parse() -> Result<Args, String> {
-    let mut args = Args { mode: Mode::Coarse4x4, size: (640, 360), out: PathBuf::from("out/bevy"), bench: None };
+    let mut args = Args {
+        mode: Mode::Coarse4x4,
+        size: (640, 360),
+        out: PathBuf::from("out/bevy"),
+        bench: None,
+        scene: common::Scene::Spheres,
+    };
+    let mut gltf: Option<PathBuf> = None;
+    let (mut eye, mut target, mut fov) = (None, None, 60.0);
     let mut rest = std::env::args().skip(1);
     while let Some(flag) = rest.next() {
         let mut value = || rest.next().ok_or_else(|| format!("{flag} needs a value"));
@@ -42,6 +55,17 @@ fn parse() -> Result<Args, String> {
                 };
             }
             "--out" => args.out = PathBuf::from(value()?),
+            "--scene" => {
+                args.scene = match value()?.as_str() {
+                    "spheres" => common::Scene::Spheres,
+                    "dungeon" => dungeon()?,
+                    other => return Err(format!("--scene {other}: `spheres` or `dungeon` (or --gltf PATH)")),
+                }
+            }
+            "--gltf" => gltf = Some(PathBuf::from(value()?)),
+            "--eye" => eye = Some(vector(&flag, &value()?)?),
+            "--target" => target = Some(vector(&flag, &value()?)?),
+            "--fov" => fov = value()?.parse().map_err(|e| format!("--fov: {e}"))?,
             "--bench" => {
                 let v = value()?;
                 let rounds = v.parse().ok().filter(|n| (1..=1000).contains(n));
@@ -49,7 +73,8 @@ fn parse() -> Result<Args, String> {
             }
             "--help" | "-h" => {
                 println!(
-                    "usage: headless [--mode MODE] [--size WxH] [--out DIR] [--bench ROUNDS]\nmodes: {}",
+                    "usage: headless [--mode MODE] [--size WxH] [--out DIR] [--bench ROUNDS] [--scene spheres|dungeon]\n\
+                     \x20      [--gltf PATH --eye X,Y,Z --target X,Y,Z [--fov DEGREES]]\nmodes: {}",
                     mode_names()
                 );
                 std::process::exit(0);
@@ -57,10 +82,36 @@ fn parse() -> Result<Args, String> {
             other => return Err(format!("unknown argument `{other}` (see --help)")),
         }
     }
+    if let Some(path) = gltf {
+        let (Some(eye), Some(target)) = (eye, target) else {
+            return Err("--gltf needs the camera: --eye X,Y,Z --target X,Y,Z [--fov DEGREES]".into());
+        };
+        args.scene = common::Scene::Gltf { path, eye, target, fov_y_degrees: fov };
+    }
     if args.mode == Mode::Reference {
         return Err("--mode: name an adaptive mode; the reference is always rendered".into());
     }
     Ok(args)
+}
+
+/// The lab's textured dungeon (`scripts/fetch-dungeon.sh`) from its default camera.
+fn dungeon() -> Result<common::Scene, String> {
+    let path = mrsl_lab::fixtures::dungeon_path().map_err(|e| e.to_string())?;
+    let camera = mrsl_lab::scene::Scene::dungeon_camera();
+    let v = bevy::math::Vec3::from_array;
+    Ok(common::Scene::Gltf { path, eye: v(camera.eye), target: v(camera.target), fov_y_degrees: camera.fov_y_degrees })
+}
+
+fn vector(flag: &str, value: &str) -> Result<bevy::math::Vec3, String> {
+    let parts: Vec<f32> = value
+        .split(',')
+        .map(|p| p.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("{flag} {value}: {e}"))?;
+    match parts[..] {
+        [x, y, z] => Ok(bevy::math::Vec3::new(x, y, z)),
+        _ => Err(format!("{flag} {value}: expected X,Y,Z")),
+    }
 }
 
 fn mode_names() -> String {
@@ -89,7 +140,7 @@ fn run() -> Result<(), String> {
         capture(&format!("{}-forced", args.mode.name()), args.mode, true, false),
     ];
     let (width, height) = args.size;
-    let images = common::render(args.size, captures)?;
+    let images = common::render(args.size, &args.scene, captures)?;
     std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
     let reference = &images[0].pixels;
     for image in &images {
@@ -129,7 +180,7 @@ fn bench(args: &Args, rounds: usize) -> Result<(), String> {
         "timing {rounds} rounds of {BENCH_FRAMES} frames without mrsl, in the reference and in {} at {width}x{height}",
         args.mode.name()
     );
-    let times = common::bench::bench(args.size, args.mode, rounds, BENCH_FRAMES)?;
+    let times = common::bench::bench(args.size, &args.scene, args.mode, rounds, BENCH_FRAMES)?;
     let ms = |v: &[f64]| common::bench::median(v.to_vec());
     println!(
         "frame time (median of {} blocks): without mrsl {:.2} ms, reference {:.2} ms, {} {:.2} ms",

@@ -54,7 +54,7 @@ fn bevy_renders_adaptive_modes_against_the_reference() {
         captures.push(capture(mode, false, i == 0));
         captures.push(capture(mode, true, false));
     }
-    let images = common::render(SIZE, captures).expect("the Bevy app renders");
+    let images = common::render(SIZE, &common::Scene::Spheres, captures).expect("the Bevy app renders");
     let reference = &images[0];
     let (width, height) = SIZE;
     for image in &images[1..] {

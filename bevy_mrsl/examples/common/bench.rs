@@ -5,7 +5,7 @@
 //! each round gives one ratio of the reference's cost to the mode's, and the
 //! median of those ratios is the speedup (as `mrslc bench` pairs runs).
 
-use super::{SceneSetup, app};
+use super::{Scene, SceneSetup, app};
 use bevy::app::AppExit;
 use bevy::prelude::*;
 use bevy_mrsl::{Mode, MrslCamera};
@@ -77,7 +77,7 @@ struct Bench {
 }
 
 /// Runs `rounds` rounds of three blocks of `frames` frames each at `size`.
-pub fn bench(size: (u32, u32), mode: Mode, rounds: usize, frames: u32) -> Result<BenchTimes, String> {
+pub fn bench(size: (u32, u32), scene: &Scene, mode: Mode, rounds: usize, frames: u32) -> Result<BenchTimes, String> {
     let result = Arc::new(Mutex::new(None));
     let state = Bench {
         mode,
@@ -91,7 +91,7 @@ pub fn bench(size: (u32, u32), mode: Mode, rounds: usize, frames: u32) -> Result
         removed: None,
         result: Arc::clone(&result),
     };
-    app(size)?.insert_resource(state).add_systems(Update, step).run();
+    app(size, scene)?.insert_resource(state).add_systems(Update, step).run();
     let times = result.lock().unwrap().take();
     times.ok_or_else(|| "the app stopped before the benchmark ended".into())
 }

@@ -12,7 +12,10 @@ use bevy::prelude::*;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::window::ExitCondition;
+use bevy::world_serialization::WorldAsset;
+use bevy::world_serialization::WorldAssetRoot;
 use bevy_mrsl::{Mode, MrslCamera, MrslOutputs, MrslPlugin, MrslProgram, MrslReport, MrslUniforms, Stats};
+use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -54,12 +57,14 @@ enum Source {
 
 /// Frames after which a capture that never became stable fails.
 const FRAME_LIMIT: u32 = 2000;
+/// Frames after the scene has loaded before the first capture.
+const AFTER_LOAD: u32 = 30;
 /// Readbacks dropped after a mode switch: they may carry frames recorded
 /// before the switch reached the render world.
 const STALE_READBACKS: u32 = 3;
 
 /// Renders the scene at `size` once per capture, in order, in one app.
-pub fn render(size: (u32, u32), captures: Vec<Capture>) -> Result<Vec<Captured>, String> {
+pub fn render(size: (u32, u32), scene: &Scene, captures: Vec<Capture>) -> Result<Vec<Captured>, String> {
     let result = Arc::new(Mutex::new(None));
     let sequence = Sequence {
         captures,
@@ -67,30 +72,37 @@ pub fn render(size: (u32, u32), captures: Vec<Capture>) -> Result<Vec<Captured>,
         frames: 0,
         readbacks: 0,
         previous: None,
+        loaded_frames: 0,
         source: Source::Output,
         done: Vec::new(),
         result: Arc::clone(&result),
     };
-    app(size)?.insert_resource(sequence).add_systems(Update, advance).run();
+    app(size, scene)?.insert_resource(sequence).add_systems(Update, advance).run();
     let outcome = result.lock().unwrap().take();
     outcome.unwrap_or_else(|| Err("the app stopped before every capture was taken".into()))
 }
 
 /// The app without its driver: the scene, the camera (in the reference
 /// mode) and bevy_mrsl, headless.
-fn app(size: (u32, u32)) -> Result<App, String> {
+fn app(size: (u32, u32), scene: &Scene) -> Result<App, String> {
     let program = MrslProgram::compile(PROGRAM, "lighting.mrsl").map_err(|e| e.to_string())?;
+    // A glTF file loads from its own folder.
+    let assets = match scene {
+        Scene::Spheres => "assets".to_string(),
+        Scene::Gltf { path, .. } => path.parent().unwrap_or(Path::new(".")).display().to_string(),
+    };
     let mut app = App::new();
     app.add_plugins(
         DefaultPlugins
             .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
+            .set(AssetPlugin { file_path: assets, ..default() })
             .set(bevy::log::LogPlugin { level: bevy::log::Level::WARN, ..default() }),
     )
     .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::ZERO))
     .add_plugins(MrslPlugin)
     .insert_resource(DefaultOpaqueRendererMethod::deferred())
     .insert_resource(ClearColor(SKY))
-    .insert_resource(SceneSetup { size, program })
+    .insert_resource(SceneSetup { size, program, scene: scene.clone() })
     .add_systems(Startup, setup)
     .add_systems(Update, scene_uniforms);
     Ok(app)
@@ -104,7 +116,23 @@ struct TargetImage(Handle<Image>);
 struct SceneSetup {
     size: (u32, u32),
     program: MrslProgram,
+    scene: Scene,
 }
+
+/// What the camera looks at.
+#[derive(Debug, Clone)]
+pub enum Scene {
+    /// Four spheres on a ground plane under six point lights, built here.
+    Spheres,
+    /// A glTF file's first scene with its lights (`KHR_lights_punctual`),
+    /// seen from `eye` towards `target` with a vertical field of view of
+    /// `fov_y_degrees`.
+    Gltf { path: PathBuf, eye: Vec3, target: Vec3, fov_y_degrees: f32 },
+}
+
+/// The glTF scene being loaded; captures wait until it and its textures are.
+#[derive(Resource)]
+struct Loading(Handle<WorldAsset>);
 
 /// A sphere of the scene, for the program's shadows and occlusion.
 #[derive(Component)]
@@ -126,7 +154,48 @@ fn setup(
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
     mut images: ResMut<Assets<Image>>,
+    assets: Res<AssetServer>,
 ) {
+    let (width, height) = setup.size;
+    let mut target = Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
+    target.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+    let target = images.add(target);
+    commands.insert_resource(TargetImage(target.clone()));
+    let (eye, look_at, fov) = match &setup.scene {
+        Scene::Spheres => {
+            spheres(&mut commands, &mut meshes, &mut materials);
+            (Vec3::new(0.0, 1.5, 5.0), Vec3::new(0.0, 0.5, 0.0), 45.0)
+        }
+        Scene::Gltf { path, eye, target, fov_y_degrees } => {
+            let file = path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
+            let scene = assets.load(GltfAssetLabel::Scene(0).from_asset(file));
+            commands.insert_resource(Loading(scene.clone()));
+            commands.spawn(WorldAssetRoot(scene));
+            (*eye, *target, *fov_y_degrees)
+        }
+    };
+    commands.spawn((
+        Camera3d::default(),
+        RenderTarget::Image(target.into()),
+        Projection::Perspective(PerspectiveProjection { fov: fov.to_radians(), ..default() }),
+        Msaa::Off,
+        // No tonemapping: the composited image is the program's output, encoded as sRGB.
+        Tonemapping::None,
+        DepthPrepass,
+        DeferredPrepass,
+        Transform::from_translation(eye).looking_at(look_at, Vec3::Y),
+        MrslCamera::new(setup.program.clone(), Mode::Reference),
+        MrslUniforms::default(),
+    ));
+}
+
+/// Whether the scene is ready to capture: a glTF scene with its textures loaded.
+fn loaded(loading: Option<Res<Loading>>, assets: &AssetServer) -> bool {
+    loading.is_none_or(|l| assets.is_loaded_with_dependencies(&l.0))
+}
+
+/// The built-in scene: the demo's four spheres on a ground plane, six point lights.
+fn spheres(commands: &mut Commands, meshes: &mut Assets<Mesh>, materials: &mut Assets<StandardMaterial>) {
     let ground = materials.add(StandardMaterial { base_color: Color::srgb(0.75, 0.72, 0.65), ..default() });
     commands.spawn((Mesh3d(meshes.add(Plane3d::default().mesh().size(12.0, 12.0))), MeshMaterial3d(ground)));
     let colours = [
@@ -151,23 +220,6 @@ fn setup(
             Transform::from_xyz(2.6 * a.cos(), 1.3 + 0.5 * (3.0 * a).sin(), 2.6 * a.sin()),
         ));
     }
-    let (width, height) = setup.size;
-    let mut target = Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
-    target.texture_descriptor.usage |= TextureUsages::COPY_SRC;
-    let target = images.add(target);
-    commands.insert_resource(TargetImage(target.clone()));
-    commands.spawn((
-        Camera3d::default(),
-        RenderTarget::Image(target.into()),
-        Msaa::Off,
-        // No tonemapping: the composited image is the program's output, encoded as sRGB.
-        Tonemapping::None,
-        DepthPrepass,
-        DeferredPrepass,
-        Transform::from_xyz(0.0, 1.5, 5.0).looking_at(Vec3::new(0.0, 0.5, 0.0), Vec3::Y),
-        MrslCamera::new(setup.program.clone(), Mode::Reference),
-        MrslUniforms::default(),
-    ));
 }
 
 /// Copies the scene into the program's uniforms: the camera, the point
@@ -219,6 +271,8 @@ struct Sequence {
     /// Readbacks seen since the current capture's mode was set.
     readbacks: u32,
     previous: Option<Vec<u8>>,
+    /// Frames since the scene was loaded.
+    loaded_frames: u32,
     source: Source,
     done: Vec<Captured>,
     result: Arc<Mutex<Option<Result<Vec<Captured>, String>>>>,
@@ -233,7 +287,19 @@ fn advance(
     mut cameras: Query<(&mut MrslCamera, Option<&MrslOutputs>, Option<&MrslReport>)>,
     readers: Query<(), With<Readback>>,
     mut exit: MessageWriter<AppExit>,
+    loading: Option<Res<Loading>>,
+    assets: Res<AssetServer>,
 ) {
+    if !loaded(loading, &assets) {
+        sequence.loaded_frames = 0;
+        return;
+    }
+    // A loaded glTF scene still spawns its entities and uploads its meshes
+    // and textures over the next frames.
+    sequence.loaded_frames += 1;
+    if sequence.loaded_frames < AFTER_LOAD {
+        return;
+    }
     let Ok((mut camera, outputs, report)) = cameras.single_mut() else { return };
     sequence.frames += 1;
     if let Some(error) = report.and_then(|r| r.error.clone()) {
