@@ -29,9 +29,6 @@ fine out float4 color = material == 255u
     : float4(tint + float3(diffuse) + 0.1 * direction, 1.0);
 ";
 
-const ADAPTIVE: [Mode; 6] =
-    [Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic, Mode::Hierarchical, Mode::Checkerboard, Mode::RateImage];
-
 fn materials(gbuffer: &GBuffer) -> &[u32] {
     match gbuffer.channels.iter().find(|(n, _)| n == "material") {
         Some((_, ChannelData::Uint(ids))) => ids,
@@ -51,7 +48,7 @@ pub fn background_pixels_are_never_shaded_or_refined(gpu: &Gpu) {
     let count = background.iter().filter(|&&b| b).count() as u64;
     assert!(count > 200 && count < background.len() as u64 / 2, "the demo shows some sky: {count} pixels");
     let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap().pixels;
-    for mode in ADAPTIVE {
+    for mode in adaptive_modes() {
         let forced = run(gpu, &program, &gbuffer, mode, true).unwrap();
         assert_eq!(worst_ulps(&forced.pixels, &reference), 0, "{mode}: forced refinement differs from the reference");
         let rates = mrsl_lab::shading_rate::pattern(mrsl_abi::shading_rate::rate_image_size((67, 41), 8));

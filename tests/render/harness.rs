@@ -57,6 +57,12 @@ pub struct Output {
     pub width: u32,
 }
 
+/// Every mode but the reference, in `Mode::ALL`'s order: what the tests
+/// compare with the reference.
+pub fn adaptive_modes() -> impl Iterator<Item = Mode> {
+    Mode::ALL.into_iter().filter(|m| *m != Mode::Reference)
+}
+
 pub fn compile(source: &str) -> mrsl::Program {
     mrsl::compile(source, &mrsl::Options::default())
         .unwrap_or_else(|d| panic!("test program does not compile:\n{}", mrsl::render_all(&d, "test.mrsl", source)))

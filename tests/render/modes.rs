@@ -1,19 +1,9 @@
 //! Every mode against the reference of the same program.
 
-use crate::{compile, dispatch_in_turn, max_abs_diff, run, worst_ulps};
+use crate::{adaptive_modes, compile, dispatch_in_turn, max_abs_diff, run, worst_ulps};
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
 use mrsl_runtime::{DispatchOptions, Error, Mode};
-
-const COARSE_MODES: [Mode; 7] = [
-    Mode::Coarse2x2,
-    Mode::Coarse4x4,
-    Mode::Dynamic,
-    Mode::Hierarchical,
-    Mode::Checkerboard,
-    Mode::RateImage,
-    Mode::MultiRate,
-];
 
 fn examples() -> Vec<(String, String)> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
@@ -35,7 +25,7 @@ pub fn forced_refinement_equals_reference_for_every_example(gpu: &Gpu) {
     for (name, source) in examples() {
         let program = compile(&source);
         let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
-        for mode in COARSE_MODES {
+        for mode in adaptive_modes() {
             let out = run(gpu, &program, &gbuffer, mode, true).unwrap();
             let worst = worst_ulps(&out.pixels, &reference.pixels);
             assert_eq!(worst, 0, "{name} {mode}: forced refinement differs from the reference by up to {worst} ulps");
@@ -94,7 +84,7 @@ pub fn steps_keep_their_edges(gpu: &Gpu) {
     for (w, h) in [(256, 64), (131, 37)] {
         let gbuffer = Scene::Steps { count: 9 }.render(w, h);
         let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
-        for mode in COARSE_MODES {
+        for mode in adaptive_modes() {
             let out = run(gpu, &program, &gbuffer, mode, false).unwrap();
             let err = max_abs_diff(&out.pixels, &reference.pixels);
             assert!(err <= 2e-7, "{w}x{h} {mode}: a step was blended (error {err})");
@@ -204,7 +194,7 @@ pub fn silhouettes_are_never_blended(gpu: &Gpu) {
     let program = compile(PER_OBJECT);
     let gbuffer = Scene::Demo.render(203, 117);
     let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
-    for mode in COARSE_MODES {
+    for mode in adaptive_modes() {
         let out = run(gpu, &program, &gbuffer, mode, false).unwrap();
         let err = max_abs_diff(&out.pixels, &reference.pixels);
         assert!(err <= 2e-7, "{mode}: colours blended across a silhouette (error {err})");
@@ -228,7 +218,7 @@ pub fn odd_sizes_cover_every_pixel(gpu: &Gpu) {
     for (w, h) in [(1, 1), (5, 3), (2, 7), (1023, 769)] {
         let gbuffer = Scene::Gradient.render(w, h);
         let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
-        for mode in COARSE_MODES {
+        for mode in adaptive_modes() {
             let out = run(gpu, &program, &gbuffer, mode, false).unwrap();
             assert_eq!(out.pixels.len(), (w * h) as usize);
             let missing = out.pixels.iter().filter(|p| p[3] != 1.0).count();
@@ -405,7 +395,7 @@ pub fn derivative_chains_render_in_every_mode(gpu: &Gpu) {
     for (name, source, adaptive_bound) in programs {
         let compile = |modes: &[Mode]| mrsl_runtime::compile_modes(&source, "chain.mrsl", modes).unwrap();
         let reference = run(gpu, &compile(&[Mode::Reference]), &gbuffer, Mode::Reference, false).unwrap();
-        for mode in COARSE_MODES {
+        for mode in adaptive_modes() {
             let program = compile(&[mode]);
             let forced = run(gpu, &program, &gbuffer, mode, true).unwrap();
             let worst = worst_ulps(&forced.pixels, &reference.pixels);
@@ -462,7 +452,7 @@ pub fn statistics_off_changes_nothing_but_the_instrumentation(gpu: &Gpu) {
     let program = compile(&source);
     let tile = mrsl_abi::shading_rate::DEFAULT_RATE_TILE;
     let rates = mrsl_lab::shading_rate::pattern(mrsl_abi::shading_rate::rate_image_size((75, 43), tile));
-    for mode in COARSE_MODES {
+    for mode in adaptive_modes() {
         let on = DispatchOptions::new(mode);
         let off = DispatchOptions { statistics: false, ..on };
         let forced_off = DispatchOptions { force_refine: true, ..off };
@@ -515,7 +505,7 @@ pub fn refine_masks_decode_to_the_counted_effects(gpu: &Gpu) {
     let tile = mrsl_abi::shading_rate::DEFAULT_RATE_TILE;
     let rates = mrsl_lab::shading_rate::pattern(mrsl_abi::shading_rate::rate_image_size(size, tile));
     let mut partly_refined = 0;
-    for mode in COARSE_MODES {
+    for mode in adaptive_modes() {
         let [run] = dispatch_in_turn(gpu, &program, &gbuffer, &rates, [DispatchOptions::new(mode)]).unwrap();
         let stats = run.stats.unwrap();
         let mut counted = std::collections::HashMap::<&str, u64>::new();

@@ -2,7 +2,7 @@
 //! every mode, and the pieces that make it (mesh loaders, the rasteriser,
 //! scene files) checked on small inputs with known answers.
 
-use crate::{Output, compile, psnr_of as psnr, render_color};
+use crate::{Output, adaptive_modes, compile, psnr_of as psnr, render_color};
 use mrsl_lab::camera::Camera;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::mesh::{Mesh, MeshError};
@@ -618,7 +618,7 @@ pub fn sponza_lights_workload_matches_its_reference(gpu: &Gpu) {
     let mean: f32 =
         reference.pixels.iter().map(|p| p[0] + p[1] + p[2]).sum::<f32>() / (3 * reference.pixels.len()) as f32;
     assert!(mean > 0.1, "mean {mean}");
-    for mode in Mode::ALL.into_iter().filter(|m| *m != Mode::Reference) {
+    for mode in adaptive_modes() {
         let forced = run(mode, true);
         assert!(forced.pixels == reference.pixels, "{mode}: forced refinement differs from the reference");
     }

@@ -5,7 +5,7 @@
 //! they are there (listed as ignored, after a line saying why, where not).
 
 use crate::sponza::{floats, temp_dir};
-use crate::{Output, compile, psnr_of as psnr, render_color};
+use crate::{Output, adaptive_modes, compile, psnr_of as psnr, render_color};
 use libtest_mimic::Trial;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::mesh::{Mesh, MeshError, MeshWarning, TORCS_ALPHA_CUTOFF};
@@ -71,7 +71,7 @@ fn every_mode_matches_the_reference(gpu: &Gpu, scene: Scene, lit: f32, bars: (f6
     assert!(reference.pixels.iter().all(|p| p.iter().all(|v| v.is_finite())), "{scene:?}: a pixel is not finite");
     let mean = mean_of_surfaces(&reference, gpu, &plain, SIZE);
     assert!(mean > lit, "{scene:?}: the surfaces' mean is {mean}, not lit");
-    for mode in Mode::ALL.into_iter().filter(|m| *m != Mode::Reference) {
+    for mode in adaptive_modes() {
         let forced = run(mode, true);
         assert!(forced.pixels == reference.pixels, "{scene:?} {mode}: forced refinement differs from the reference");
     }
