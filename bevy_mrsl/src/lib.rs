@@ -62,7 +62,7 @@ impl Plugin for MrslPlugin {
             .insert_resource(shared)
             .init_resource::<pass::Shaders>()
             .init_resource::<composite::Pipelines>()
-            .add_systems(ExtractSchedule, extract::extract_cameras)
+            .add_systems(ExtractSchedule, (extract::extract_cameras, pass::drop_unused))
             .add_systems(Core3d, pass::run.after(Core3dSystems::Prepass).before(Core3dSystems::MainPass))
             .add_systems(Core3d, composite::run.after(Core3dSystems::MainPass).before(Core3dSystems::EarlyPostProcess));
     }

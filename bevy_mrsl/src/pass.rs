@@ -7,6 +7,7 @@ use crate::extract::ExtractedMrsl;
 use crate::report::Shared;
 use bevy::core_pipeline::prepass::ViewPrepassTextures;
 use bevy::ecs::prelude::*;
+use bevy::render::Extract;
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery};
 use bevy::render::texture::GpuImage;
@@ -18,6 +19,14 @@ use std::collections::HashMap;
 /// Each camera's program on the render device, by main-world camera.
 #[derive(Resource, Default)]
 pub(crate) struct Shaders(HashMap<Entity, CameraShader>);
+
+/// Drops the programs of cameras that no longer have an `MrslCamera` (or
+/// no longer exist), with their pipelines and buffers.
+pub(crate) fn drop_unused(mut shaders: ResMut<Shaders>, cameras: Extract<Query<Entity, With<crate::MrslCamera>>>) {
+    if shaders.0.keys().any(|camera| !cameras.contains(*camera)) {
+        shaders.0.retain(|camera, _| cameras.contains(*camera));
+    }
+}
 
 struct CameraShader {
     program: MrslProgram,
