@@ -1,15 +1,16 @@
 //! Micro-benchmark behind the block modes' record texture: what reading the
 //! four coarse samples' records around a block costs each fine-kernel lane
-//! as storage-buffer words against texels of an `rgba32uint` texture array,
-//! at 1920x1080 with two pixels per lane and six words per record (the
-//! sponza_lights workload's figures).
+//! as storage-buffer words, as texels of a sampled `rgba32uint` texture
+//! array (what the block modes bind) and as the same texels through a
+//! read-only storage binding, at 1920x1080 with two pixels per lane and six
+//! words per record (the sponza_lights workload's figures).
 //!
 //! `cargo run --release -p mrsl-lab --example record_loads [ROUNDS]`
 //!
-//! The three kernels run interleaved (the order rotates every round), each
+//! The four kernels run interleaved (the order rotates every round), each
 //! timed over 4 dispatches; it prints the median time of each and the
 //! median over rounds of each load kernel's time above the store-only
-//! kernel's, so that a slow moment of a shared machine weighs on all three.
+//! kernel's, so that a slow moment of a shared machine weighs on all four.
 
 use mrsl_lab::gpu::Gpu;
 use std::time::Instant;
@@ -45,7 +46,9 @@ fn main() {
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
         format: wgpu::TextureFormat::Rgba32Uint,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     });
     let layout =
@@ -63,7 +66,7 @@ fn main() {
         ..Default::default()
     });
     let out_view = out.create_view(&Default::default());
-    let kernels: Vec<(&str, wgpu::ComputePipeline, wgpu::BindGroup)> = ["none", "buffer", "texture"]
+    let kernels: Vec<(&str, wgpu::ComputePipeline, wgpu::BindGroup)> = ["none", "buffer", "texture", "storage"]
         .into_iter()
         .map(|name| {
             let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -80,6 +83,8 @@ fn main() {
                 "buffer" => entries.push(wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }),
                 "texture" => entries
                     .push(wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&records) }),
+                "storage" => entries
+                    .push(wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&records) }),
                 _ => {}
             }
             let group = device.create_bind_group(&wgpu::BindGroupDescriptor {

@@ -1,0 +1,132 @@
+//! Micro-benchmark behind the record modes' final pass: what reading one
+//! pixel's record (ten 32-bit words, about what sponza_lights keeps per
+//! pixel in the hierarchical mode) costs a lane at 1920x1080, as texels of
+//! the `r32uint` read-write storage array the classification writes, as
+//! the same texels through a sampled view, and packed four words to a
+//! texel of an `rgba32uint` sampled array.
+//!
+//! `cargo run --release -p mrsl-lab --example record_access [ROUNDS]`
+//!
+//! The kernels run interleaved (the order rotates every round), each timed
+//! over 4 dispatches; it prints each kernel's median time and the median
+//! over rounds of each load kernel's time above the store-only kernel's.
+
+use mrsl_lab::gpu::Gpu;
+use std::time::Instant;
+
+const SIZE: (u32, u32) = (1920, 1080);
+const WORDS: u32 = 10;
+const DISPATCHES: u32 = 4;
+const KERNELS: [&str; 7] = ["none", "storage", "sampled", "packed", "packed_storage", "float_sampled", "float_storage"];
+
+fn main() {
+    let rounds: usize = std::env::args().nth(1).map_or(9, |a| a.parse().expect("ROUNDS is a number"));
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    println!("adapter: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let texture = |label, format, layers, usage| {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width: SIZE.0, height: SIZE.1, depth_or_array_layers: layers },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: usage | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        })
+    };
+    let words = texture("words", wgpu::TextureFormat::R32Uint, WORDS, wgpu::TextureUsages::STORAGE_BINDING);
+    let packed =
+        texture("packed", wgpu::TextureFormat::Rgba32Uint, WORDS.div_ceil(4), wgpu::TextureUsages::STORAGE_BINDING);
+    let floats = texture("floats", wgpu::TextureFormat::Rgba32Float, 1, wgpu::TextureUsages::STORAGE_BINDING);
+    for (t, texel) in [(&words, 4u32), (&packed, 16), (&floats, 16)] {
+        let layers = t.size().depth_or_array_layers;
+        let data: Vec<u32> = (0..SIZE.0 * SIZE.1 * layers * texel / 4).map(|i| i.wrapping_mul(2_654_435_761)).collect();
+        let layout = wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(SIZE.0 * texel),
+            rows_per_image: Some(SIZE.1),
+        };
+        queue.write_texture(t.as_image_copy(), bytemuck::cast_slice(&data), layout, t.size());
+    }
+    let array = |t: &wgpu::Texture| {
+        t.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        })
+    };
+    let (words_view, packed_view) = (array(&words), array(&packed));
+    let floats_view = floats.create_view(&Default::default());
+    let out = gpu.output_texture("out", SIZE, wgpu::TextureFormat::R32Uint);
+    let out_view = out.create_view(&Default::default());
+    let source = include_str!("record_access.wgsl").replace("{{WORDS}}", &WORDS.to_string());
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("record_access"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let kernels: Vec<(wgpu::ComputePipeline, wgpu::BindGroup)> = KERNELS
+        .iter()
+        .map(|name| {
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(name),
+                layout: None,
+                module: &module,
+                entry_point: Some(&format!("{name}_main")),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            let view = |v| wgpu::BindingResource::TextureView(v);
+            let mut entries = vec![wgpu::BindGroupEntry { binding: 3, resource: view(&out_view) }];
+            match *name {
+                "storage" => entries.push(wgpu::BindGroupEntry { binding: 0, resource: view(&words_view) }),
+                "sampled" => entries.push(wgpu::BindGroupEntry { binding: 1, resource: view(&words_view) }),
+                "packed" => entries.push(wgpu::BindGroupEntry { binding: 2, resource: view(&packed_view) }),
+                "packed_storage" => entries.push(wgpu::BindGroupEntry { binding: 4, resource: view(&packed_view) }),
+                "float_sampled" => entries.push(wgpu::BindGroupEntry { binding: 5, resource: view(&floats_view) }),
+                "float_storage" => entries.push(wgpu::BindGroupEntry { binding: 6, resource: view(&floats_view) }),
+                _ => {}
+            }
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(name),
+                layout: &pipeline.get_bind_group_layout(0),
+                entries: &entries,
+            });
+            (pipeline, group)
+        })
+        .collect();
+
+    let time = |(pipeline, group): &(wgpu::ComputePipeline, wgpu::BindGroup)| {
+        let start = Instant::now();
+        for _ in 0..DISPATCHES {
+            let mut encoder = device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, group, &[]);
+                pass.dispatch_workgroups(SIZE.0 / 8, SIZE.1 / 8, 1);
+            }
+            queue.submit([encoder.finish()]);
+        }
+        device.poll(wgpu::PollType::wait_indefinitely()).expect("the device is alive");
+        start.elapsed().as_secs_f64() * 1000.0 / f64::from(DISPATCHES)
+    };
+    kernels.iter().for_each(|k| {
+        time(k);
+    });
+    let mut times = vec![vec![]; kernels.len()];
+    for round in 0..rounds {
+        for k in 0..kernels.len() {
+            let k = (k + round) % kernels.len();
+            times[k].push(time(&kernels[k]));
+        }
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    for (k, name) in KERNELS.iter().enumerate() {
+        let extra = median(times[k].iter().zip(&times[0]).map(|(t, none)| t - none).collect());
+        println!("{name:>8}: {:6.1} ms, loads {extra:5.1} ms (median of {rounds} rounds)", median(times[k].clone()));
+    }
+}
