@@ -13,7 +13,6 @@
 //! kernel's, so that a slow moment of a shared machine weighs on all four.
 
 use mrsl_lab::gpu::Gpu;
-use std::time::Instant;
 
 const SIZE: (u32, u32) = (1920, 1080);
 const BLOCK: u32 = 4;
@@ -97,19 +96,7 @@ fn main() {
         .collect();
 
     let time = |(_, pipeline, group): &(&str, wgpu::ComputePipeline, wgpu::BindGroup)| {
-        let start = Instant::now();
-        for _ in 0..DISPATCHES {
-            let mut encoder = device.create_command_encoder(&Default::default());
-            {
-                let mut pass = encoder.begin_compute_pass(&Default::default());
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, group, &[]);
-                pass.dispatch_workgroups(SIZE.0 / 8, SIZE.1 / 8, 1);
-            }
-            queue.submit([encoder.finish()]);
-        }
-        device.poll(wgpu::PollType::wait_indefinitely()).expect("the device is alive");
-        start.elapsed().as_secs_f64() * 1000.0 / f64::from(DISPATCHES)
+        gpu.time_dispatches(pipeline, group, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES)
     };
     kernels.iter().for_each(|k| {
         time(k);

@@ -31,6 +31,31 @@ pub fn adapters() -> Vec<wgpu::AdapterInfo> {
 }
 
 impl Gpu {
+    /// Milliseconds per dispatch of `pipeline` over `workgroups`, averaged
+    /// over `dispatches` submissions and the wait for them: the timing of
+    /// the lab's microbenchmarks (`record_loads`, `record_access`).
+    pub fn time_dispatches(
+        &self,
+        pipeline: &wgpu::ComputePipeline,
+        group: &wgpu::BindGroup,
+        workgroups: (u32, u32),
+        dispatches: u32,
+    ) -> f64 {
+        let start = std::time::Instant::now();
+        for _ in 0..dispatches {
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, group, &[]);
+                pass.dispatch_workgroups(workgroups.0, workgroups.1, 1);
+            }
+            self.queue.submit([encoder.finish()]);
+        }
+        self.device.poll(wgpu::PollType::wait_indefinitely()).expect("the device is alive");
+        start.elapsed().as_secs_f64() * 1000.0 / f64::from(dispatches)
+    }
+
     pub fn new() -> Result<Gpu, Error> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
