@@ -8,7 +8,7 @@ import { readFile } from 'node:fs/promises';
 import { join } from 'node:path';
 import { applyUniforms, loadGBuffer, loadProgram, MODES, readTexture, Shader, uniformRateImage } from '../dist/index.js';
 import { testDevice } from './support/gpu.mjs';
-import { cleanup, examples, makeFixtures, SIZE, UNIFORM_RATE } from './support/fixtures.mjs';
+import { cleanup, examples, fixturesRoot, makeFixtures, SIZE, UNIFORM_RATE } from './support/fixtures.mjs';
 import { compareImages, TOLERANCE } from './support/compare.mjs';
 
 const list = examples();
@@ -17,7 +17,7 @@ let root;
 
 before(async () => {
   gpu = await testDevice();
-  if (!gpu.skip) root = makeFixtures(list);
+  if (!gpu.skip) root = fixturesRoot();
 });
 after(() => cleanup(root));
 
@@ -57,10 +57,14 @@ for (const { name, scene } of list) {
     let gbuffer;
     let rustStats;
     let reference;
+    let instead;
     const dir = () => join(root, name);
 
+    // Each example's fixtures in its own hook, so that one example's
+    // failure fails its tests and not every example's.
     before(async () => {
       if (gpu.skip) return;
+      ({ instead } = makeFixtures(root, { name, scene }));
       const program = await loadProgram((f) => readFile(join(dir(), 'kernels', f), 'utf8'), name);
       const manifest = JSON.parse(await readFile(join(dir(), 'gbuffer', 'gbuffer.json'), 'utf8'));
       gbuffer = await loadGBuffer(gpu.device, manifest, (f) => bytes(join(dir(), 'gbuffer', f)));
@@ -72,6 +76,7 @@ for (const { name, scene } of list) {
     for (const mode of MODES) {
       test(`${mode} matches the Rust runtime`, async (t) => {
         if (gpu.skip) return t.skip(gpu.skip);
+        if (instead) t.diagnostic(instead);
         const { images, stats } = await render(gpu.device, shader, gbuffer, mode, false);
         if (mode === 'reference') reference = images;
         for (const o of shader.layout.outputs) {
