@@ -13,6 +13,7 @@
 //! kernel's, so that a slow moment of a shared machine weighs on all four.
 
 use mrsl_lab::gpu::Gpu;
+use mrsl_lab::microbench::{interleaved_rounds, median, median_above};
 
 const SIZE: (u32, u32) = (1920, 1080);
 const BLOCK: u32 = 4;
@@ -68,14 +69,6 @@ fn main() {
     let kernels: Vec<(&str, wgpu::ComputePipeline, wgpu::BindGroup)> = ["none", "buffer", "texture", "storage"]
         .into_iter()
         .map(|name| {
-            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(name),
-                layout: None,
-                module: &module,
-                entry_point: Some(&format!("{name}_main")),
-                compilation_options: Default::default(),
-                cache: None,
-            });
             let mut entries =
                 vec![wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&out_view) }];
             match name {
@@ -86,11 +79,7 @@ fn main() {
                     .push(wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&records) }),
                 _ => {}
             }
-            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(name),
-                layout: &pipeline.get_bind_group_layout(0),
-                entries: &entries,
-            });
+            let (pipeline, group) = gpu.entry_kernel(&module, &format!("{name}_main"), &entries);
             (name, pipeline, group)
         })
         .collect();
@@ -98,24 +87,11 @@ fn main() {
     let time = |(_, pipeline, group): &(&str, wgpu::ComputePipeline, wgpu::BindGroup)| {
         gpu.time_dispatches(pipeline, group, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES)
     };
-    kernels.iter().for_each(|k| {
-        time(k);
-    });
-    let mut times = vec![vec![]; kernels.len()];
-    for round in 0..rounds {
-        for k in 0..kernels.len() {
-            let k = (k + round) % kernels.len();
-            times[k].push(time(&kernels[k]));
-        }
-    }
-    let median = |mut v: Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    };
+    let times = interleaved_rounds(kernels.len(), rounds, |k| time(&kernels[k]));
     for (k, (name, ..)) in kernels.iter().enumerate() {
-        println!("{name:>8}: {:6.1} ms median of {rounds} rounds", median(times[k].clone()));
+        println!("{name:>8}: {:6.1} ms median of {rounds} rounds", median(&times[k]));
     }
-    let extra = |k: usize| median(times[k].iter().zip(&times[0]).map(|(t, none)| t - none).collect());
+    let extra = |k: usize| median_above(&times[k], &times[0]);
     let (buffer_ms, texture_ms) = (extra(1), extra(2));
     println!(
         "loads: {:.1} ms as buffer words (24 per lane), {:.1} ms as texels (8 per lane): {:.1}x",

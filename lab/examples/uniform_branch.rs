@@ -15,6 +15,7 @@
 //! over rounds of its time above the kernel without the work.
 
 use mrsl_lab::gpu::Gpu;
+use mrsl_lab::microbench::{interleaved_rounds, median, median_above};
 
 const SIZE: (u32, u32) = (1920, 1080);
 const DISPATCHES: u32 = 4;
@@ -77,14 +78,6 @@ fn main() {
     let kernels: Vec<(wgpu::ComputePipeline, wgpu::BindGroup)> = KERNELS
         .iter()
         .map(|name| {
-            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(name),
-                layout: None,
-                module: &module,
-                entry_point: Some(&format!("{name}_main")),
-                compilation_options: Default::default(),
-                cache: None,
-            });
             let view = |v| wgpu::BindingResource::TextureView(v);
             let mut entries = vec![
                 wgpu::BindGroupEntry { binding: 1, resource: view(&flags_view) },
@@ -102,36 +95,15 @@ fn main() {
                 }
                 _ => {}
             }
-            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(name),
-                layout: &pipeline.get_bind_group_layout(0),
-                entries: &entries,
-            });
-            (pipeline, group)
+            gpu.entry_kernel(&module, &format!("{name}_main"), &entries)
         })
         .collect();
     let time = |(pipeline, group): &(wgpu::ComputePipeline, wgpu::BindGroup)| {
         gpu.time_dispatches(pipeline, group, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES)
     };
-    kernels.iter().for_each(|k| {
-        time(k);
-    });
-    let mut times = vec![vec![]; kernels.len()];
-    for round in 0..rounds {
-        for k in 0..kernels.len() {
-            let k = (k + round) % kernels.len();
-            times[k].push(time(&kernels[k]));
-        }
-    }
-    let median = |mut v: Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    };
+    let times = interleaved_rounds(kernels.len(), rounds, |k| time(&kernels[k]));
     for (k, name) in KERNELS.iter().enumerate() {
-        let extra = median(times[k].iter().zip(&times[0]).map(|(t, none)| t - none).collect());
-        println!(
-            "{name:>12}: {:6.1} ms, above none {extra:5.1} ms (median of {rounds} rounds)",
-            median(times[k].clone())
-        );
+        let extra = median_above(&times[k], &times[0]);
+        println!("{name:>12}: {:6.1} ms, above none {extra:5.1} ms (median of {rounds} rounds)", median(&times[k]));
     }
 }

@@ -56,6 +56,31 @@ impl Gpu {
         start.elapsed().as_secs_f64() * 1000.0 / f64::from(dispatches)
     }
 
+    /// A microbenchmark's kernel: the pipeline of `module`'s entry point
+    /// `entry` (its layout derived from the shader) and its bind group 0 of
+    /// `entries`.
+    pub fn entry_kernel(
+        &self,
+        module: &wgpu::ShaderModule,
+        entry: &str,
+        entries: &[wgpu::BindGroupEntry],
+    ) -> (wgpu::ComputePipeline, wgpu::BindGroup) {
+        let pipeline = self.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: None,
+            module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(entry),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries,
+        });
+        (pipeline, group)
+    }
+
     pub fn new() -> Result<Gpu, Error> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {

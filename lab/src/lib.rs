@@ -51,6 +51,7 @@ pub mod material;
 pub mod mesh;
 pub mod mesh_scene;
 pub mod metrics;
+pub mod microbench;
 pub mod procedural;
 pub mod raster;
 pub mod rig;

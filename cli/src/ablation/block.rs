@@ -110,10 +110,25 @@ pub(super) fn no_fine_work(w: &str) -> Option<String> {
     })
 }
 
+/// Every pixel as the background rule leaves it: no corners loaded, no
+/// resolve, every coarse effect reading zero, the fine effects still
+/// evaluated and stored: what a pixel of a tile known to be wholly
+/// background would cost a kernel dispatched over such tiles alone.
+fn as_background(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        if t.starts_with("let mrsl_c = mrsl_corners(") {
+            return Some(format!("{}var mrsl_c: MrslCorners;", indent(l)));
+        }
+        let (pixel, _) = t.strip_prefix("let mrsl_b")?.split_once(" = mrsl_resolve(")?;
+        Some(format!("{0}var mrsl_b{pixel}: MrslBlock;\n{0}mrsl_b{pixel}.background = true;", indent(l)))
+    })
+}
+
 /// The variants. Removing the key tests or the flag reads from the full
 /// kernel would also change what is refined, so those parts are measured
 /// within the fixed cost (nothing refined), where they decide nothing.
-pub(super) const VARIANTS: [Variant; 7] = [
+pub(super) const VARIANTS: [Variant; 10] = [
     Variant {
         name: "no instrumentation",
         removes: "the statistics atomics, their barrier and the refine-mask store (`DispatchOptions::statistics` off)",
@@ -143,6 +158,21 @@ pub(super) const VARIANTS: [Variant; 7] = [
         name: "fixed cost, no resampling",
         removes: "also the resampling of the coarse effects (they read zero)",
         edits: &[nothing_refined, no_resampling],
+    },
+    Variant {
+        name: "every pixel background",
+        removes: "the corners, the resolve and every coarse effect at every pixel (as where nothing was drawn): what a tile known to be wholly background would cost",
+        edits: &[as_background],
+    },
+    Variant {
+        name: "fixed cost, no instrumentation",
+        removes: "the fixed cost as timed runs pay it: nothing refined, statistics off",
+        edits: &[nothing_refined, no_instrumentation],
+    },
+    Variant {
+        name: "every pixel background, no instrumentation",
+        removes: "the same as a background pixel costs a timed run: statistics off",
+        edits: &[as_background, no_instrumentation],
     },
     Variant {
         name: "no fine pass work",

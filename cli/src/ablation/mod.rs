@@ -161,7 +161,12 @@ pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>> {
     let times = time_rounds(args.runs.max(1), &runs, |k, mode| {
         time_run(&gpu, &mut shaders[k], &bindings, DispatchOptions::new(mode))
     })?;
-    let md = markdown(args, target, &name, &device_name, &programs, &skipped, &times);
+    let background_tiles = match target {
+        Target::Block(_) => background_tile_share(&gpu, &mut shaders[0], &bindings, args.mode)?,
+        Target::Hierarchical => None,
+    };
+    let report = Report { programs: &programs, skipped: &skipped, times: &times, background_tiles };
+    let md = markdown(args, target, &name, &device_name, &report);
     std::fs::create_dir_all(&args.out_dir).map_err(|e| anyhow!("cannot create {}: {e}", args.out_dir.display()))?;
     let path = args.out_dir.join("ablation.md");
     crate::output::write(&path, &md)?;
@@ -207,6 +212,45 @@ fn variants(
     Ok((programs, skipped))
 }
 
+/// The share of the image's pixels in tiles of the fine pass
+/// ([`mrsl_abi::geometry::TILE`] pixels a side) whose every pixel the
+/// program's background rule marks, from the refine mask of one run of the
+/// full kernel: the pixels a fine pass dispatched only over the other tiles
+/// would leave to a background kernel. `None` without a refine mask.
+fn background_tile_share(gpu: &Gpu, shader: &mut Shader, bindings: &Bindings, mode: Mode) -> Result<Option<f64>> {
+    time_run(gpu, shader, bindings, DispatchOptions::new(mode))?;
+    let Some(mask) = shader.refine_mask() else { return Ok(None) };
+    let size = (mask.width(), mask.height());
+    let texels: Vec<[u32; 2]> = bytemuck::pod_collect_to_vec(&gpu.read_texture(mask)?);
+    Ok(Some(share_in_background_tiles(&texels, size, mrsl_abi::geometry::TILE)))
+}
+
+/// The share of a `size` refine mask's pixels (`texels`, row by row) in
+/// `tile`-pixel tiles (the last ones cut at the image's edge) whose every
+/// pixel holds the background mark.
+fn share_in_background_tiles(texels: &[[u32; 2]], (w, h): (u32, u32), tile: u32) -> f64 {
+    let mut in_background_tiles = 0u64;
+    for y0 in (0..h).step_by(tile as usize) {
+        for x0 in (0..w).step_by(tile as usize) {
+            let pixels = || (y0..(y0 + tile).min(h)).flat_map(move |y| (x0..(x0 + tile).min(w)).map(move |x| (x, y)));
+            if pixels().all(|(x, y)| texels[(y * w + x) as usize] == mrsl_abi::BACKGROUND_MARK) {
+                in_background_tiles += pixels().count() as u64;
+            }
+        }
+    }
+    in_background_tiles as f64 / (f64::from(w) * f64::from(h))
+}
+
+/// What [`markdown`] reports: the programs timed, the variants left out,
+/// the times per entry (the reference, then `programs`) and, for the block
+/// modes, [`background_tile_share`].
+struct Report<'a> {
+    programs: &'a Programs,
+    skipped: &'a [&'static str],
+    times: &'a [Vec<f64>],
+    background_tiles: Option<f64>,
+}
+
 /// Times every entry of `runs` once to warm up, then in `rounds`
 /// interleaved rounds whose order rotates each round; the times per entry.
 fn time_rounds(
@@ -236,18 +280,11 @@ fn time_rounds(
     Ok(times)
 }
 
-/// The ablation report: per entry of `times` (the reference, then
-/// `programs`), its median time and its median ratio to the full kernel's
-/// time in the same round.
-fn markdown(
-    args: &AblationArgs,
-    target: Target,
-    name: &str,
-    device_name: &str,
-    programs: &Programs,
-    skipped: &[&str],
-    times: &[Vec<f64>],
-) -> String {
+/// The ablation report: per entry of the times (the reference, then the
+/// programs), its median time and its median ratio to the full kernel's
+/// time in the same round; and the background tiles' share.
+fn markdown(args: &AblationArgs, target: Target, name: &str, device_name: &str, report: &Report) -> String {
+    let (programs, skipped, times) = (report.programs, report.skipped, report.times);
     let rounds = times[1].len();
     let ratio = |at: usize| median((0..rounds).map(|r| times[at][r] / times[1][r]).collect());
     let full_ms = median(times[1].clone());
@@ -280,5 +317,35 @@ fn markdown(
     if !skipped.is_empty() {
         let _ = writeln!(md, "\nNot applicable to this program's kernel: {}.", skipped.join(", "));
     }
+    if let Some(share) = report.background_tiles {
+        let tile = mrsl_abi::geometry::TILE;
+        let _ = writeln!(
+            md,
+            "\nPixels in {tile}x{tile} tiles wholly background (every pixel marked in the full kernel's refine mask): \
+             {:.1}%.",
+            100.0 * share
+        );
+    }
     md
+}
+
+#[cfg(test)]
+mod tests {
+    use super::share_in_background_tiles;
+    use mrsl_abi::BACKGROUND_MARK;
+
+    /// A 5x3 mask in 2-pixel tiles: the tiles wholly background count,
+    /// cut ones at the edges included; one drawn pixel spoils its tile.
+    #[test]
+    fn pixels_count_only_in_tiles_wholly_background() {
+        let (w, h) = (5u32, 3u32);
+        // Drawn: pixel (1, 0), in the first tile; everything else background.
+        let texels: Vec<[u32; 2]> = (0..w * h).map(|i| if i == 1 { [0, 0] } else { BACKGROUND_MARK }).collect();
+        // Tiles: rows 0-1 x columns 0-1 (drawn), 2-3, 4; row 2 x the same three.
+        let background = 4 + 2 + 2 + 2 + 1;
+        let share = share_in_background_tiles(&texels, (w, h), 2);
+        assert_eq!(share, f64::from(background) / f64::from(w * h));
+        assert_eq!(share_in_background_tiles(&vec![[0, 0]; 15], (w, h), 2), 0.0);
+        assert_eq!(share_in_background_tiles(&vec![BACKGROUND_MARK; 15], (w, h), 8), 1.0);
+    }
 }
