@@ -30,7 +30,10 @@ pub(crate) fn drop_unused(mut shaders: ResMut<Shaders>, cameras: Extract<Query<E
 
 struct CameraShader {
     program: MrslProgram,
-    shader: Shader,
+    /// The program's kernels on the device, or why the device refused
+    /// them: kept, so that a program that fails is not rebuilt every frame
+    /// (only a new program is tried again).
+    shader: Result<Shader, String>,
     /// The mode of the last frame recorded with statistics on, whose
     /// statistics have not been read yet.
     unread: Option<Mode>,
@@ -57,38 +60,27 @@ pub(crate) fn run(
     let queue: &wgpu::Queue = &queue.0;
     let state = match shaders.0.get_mut(&mrsl.camera) {
         Some(state) if state.program.same(&mrsl.settings.program) => state,
-        _ => match Shader::new(device, mrsl.settings.program.compiled()) {
-            Ok(shader) => shaders
-                .0
-                .entry(mrsl.camera)
-                .insert_entry(CameraShader { program: mrsl.settings.program.clone(), shader, unread: None })
-                .into_mut(),
-            Err(error) => return shared.update(mrsl.camera, |r| r.error = Some(error.to_string())),
-        },
-    };
-    if let Some(mode) = state.unread.take() {
-        let stats = state.shader.read_stats(device);
-        shared.update(mrsl.camera, |r| match stats {
-            Ok(stats) => r.stats = Some((mode, stats)),
-            Err(error) => r.error = Some(error.to_string()),
-        });
-    }
-    let outcome = record(state, mrsl, view, prepass, &images, device, queue, ctx.command_encoder());
-    shared.update(mrsl.camera, |r| match outcome {
-        Ok(Outcome::Ran) => {
-            r.frames += 1;
-            r.error = None;
+        _ => {
+            let shader = Shader::new(device, mrsl.settings.program.compiled()).map_err(|e| e.to_string());
+            let state = CameraShader { program: mrsl.settings.program.clone(), shader, unread: None };
+            shaders.0.entry(mrsl.camera).insert_entry(state).into_mut()
         }
-        Ok(Outcome::Waiting) => {}
-        Err(error) => r.error = Some(error),
-    });
+    };
+    let shader = match &mut state.shader {
+        Ok(shader) => shader,
+        Err(error) => return shared.update(mrsl.camera, |r| r.frame(None, Err(error.clone()))),
+    };
+    let stats = state.unread.take().map(|mode| shader.read_stats(device).map(|s| (mode, s)).map_err(|e| e.to_string()));
+    let outcome = record(shader, &mut state.unread, mrsl, view, prepass, &images, device, queue, ctx.command_encoder());
+    shared.update(mrsl.camera, |r| r.frame(stats, outcome.map(|o| matches!(o, Outcome::Ran))));
 }
 
 /// Sets the uniforms, binds the prepass textures and outputs, and records
 /// the passes; every check is done before anything is recorded.
 #[allow(clippy::too_many_arguments)] // the render world's resources, each used once
 fn record(
-    state: &mut CameraShader,
+    shader: &mut Shader,
+    unread: &mut Option<Mode>,
     mrsl: &ExtractedMrsl,
     view: &ExtractedView,
     prepass: Option<&ViewPrepassTextures>,
@@ -98,7 +90,6 @@ fn record(
     encoder: &mut bevy::render::render_resource::CommandEncoder,
 ) -> Result<Outcome, String> {
     let settings = &mrsl.settings;
-    let shader = &mut state.shader;
     shader.supports(settings.mode).map_err(|e| e.to_string())?;
     for (name, values) in &mrsl.uniforms.0 {
         shader.set_uniform(name, values).map_err(|e| e.to_string())?;
@@ -135,7 +126,7 @@ fn record(
         ..DispatchOptions::new(settings.mode)
     };
     shader.encode(device, queue, encoder, &bindings, options).map_err(|e| e.to_string())?;
-    state.unread = settings.statistics.then_some(settings.mode);
+    *unread = settings.statistics.then_some(settings.mode);
     Ok(Outcome::Ran)
 }
 
