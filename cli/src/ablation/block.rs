@@ -114,7 +114,12 @@ pub(super) fn no_fine_work(w: &str) -> Option<String> {
 /// resolve, every coarse effect reading zero, the fine effects still
 /// evaluated and stored: what a pixel of a tile known to be wholly
 /// background would cost a kernel dispatched over such tiles alone.
+/// `None` for a program without a background rule (its blocks have no
+/// `background` field).
 fn as_background(w: &str) -> Option<String> {
+    if !w.contains("    background: bool,") {
+        return None;
+    }
     edit_lines(w, |l| {
         let t = l.trim_start();
         if t.starts_with("let mrsl_c = mrsl_corners(") {
@@ -219,5 +224,19 @@ mod tests {
                 mrsl::validate_wgsl(&edited).unwrap();
             }
         }
+    }
+
+    /// Without a background rule (no `@background` input) the background
+    /// variant has nothing to edit: it is listed as not applicable, not
+    /// made into a kernel that does not validate.
+    #[test]
+    fn the_background_variant_needs_a_background_rule() {
+        let source = "in float3 normal;\n\
+                      coarse effect float3 light { light = normal * 0.5; }\n\
+                      fine out float4 color = float4(light, 1.0);";
+        let program = mrsl::compile(source, &mrsl::Options::default()).unwrap();
+        let fine = &program.kernel(KernelKind::Fine, 4).unwrap().wgsl;
+        assert_eq!(as_background(fine), None);
+        assert!(nothing_refined(fine).is_some(), "the other variants still apply");
     }
 }

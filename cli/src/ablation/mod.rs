@@ -162,8 +162,10 @@ pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>> {
         time_run(&gpu, &mut shaders[k], &bindings, DispatchOptions::new(mode))
     })?;
     let background_tiles = match target {
-        Target::Block(_) => background_tile_share(&gpu, &mut shaders[0], &bindings, args.mode)?,
-        Target::Hierarchical => None,
+        Target::Block(_) if program.layout.background_counters().is_some() => {
+            background_tile_share(&gpu, &mut shaders[0], &bindings, args.mode)?
+        }
+        _ => None,
     };
     let report = Report { programs: &programs, skipped: &skipped, times: &times, background_tiles };
     let md = markdown(args, target, &name, &device_name, &report);
@@ -216,7 +218,8 @@ fn variants(
 /// ([`mrsl_abi::geometry::TILE`] pixels a side) whose every pixel the
 /// program's background rule marks, from the refine mask of one run of the
 /// full kernel: the pixels a fine pass dispatched only over the other tiles
-/// would leave to a background kernel. `None` without a refine mask.
+/// would leave to a background kernel (for a program with a background
+/// rule). `None` without a refine mask.
 fn background_tile_share(gpu: &Gpu, shader: &mut Shader, bindings: &Bindings, mode: Mode) -> Result<Option<f64>> {
     time_run(gpu, shader, bindings, DispatchOptions::new(mode))?;
     let Some(mask) = shader.refine_mask() else { return Ok(None) };
