@@ -83,10 +83,10 @@ fn main() {
         })
         .collect();
 
-    let time = |(pipeline, group): &(wgpu::ComputePipeline, wgpu::BindGroup)| {
+    let times = interleaved_rounds(kernels.len(), rounds, |k| {
+        let (pipeline, group) = &kernels[k];
         gpu.time_dispatches(pipeline, group, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES)
-    };
-    let times = interleaved_rounds(kernels.len(), rounds, |k| time(&kernels[k]));
+    });
     for (k, name) in KERNELS.iter().enumerate() {
         let extra = median_above(&times[k], &times[0]);
         println!("{name:>8}: {:6.1} ms, loads {extra:5.1} ms (median of {rounds} rounds)", median(&times[k]));

@@ -84,10 +84,10 @@ fn main() {
         })
         .collect();
 
-    let time = |(_, pipeline, group): &(&str, wgpu::ComputePipeline, wgpu::BindGroup)| {
+    let times = interleaved_rounds(kernels.len(), rounds, |k| {
+        let (_, pipeline, group) = &kernels[k];
         gpu.time_dispatches(pipeline, group, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES)
-    };
-    let times = interleaved_rounds(kernels.len(), rounds, |k| time(&kernels[k]));
+    });
     for (k, (name, ..)) in kernels.iter().enumerate() {
         println!("{name:>8}: {:6.1} ms median of {rounds} rounds", median(&times[k]));
     }
