@@ -46,6 +46,32 @@ fn nothing_refined_at_run_time(w: &str) -> Option<String> {
     })
 }
 
+/// The loops that re-evaluate a lane's refined pixels, deleted whole:
+/// what the kernel would cost if a loop no lane enters cost nothing. On
+/// llvmpipe it does not: a loop's body runs once with every lane masked
+/// off even when its first test breaks, so `nothing_refined` (the loops
+/// kept, never entered) still pays each coarse effect's body once.
+fn no_refinement_loops(w: &str) -> Option<String> {
+    // The indentation of the loop being deleted, once its `loop {` is seen.
+    let deleting = std::cell::RefCell::new(None::<String>);
+    let after_todo = std::cell::Cell::new(false);
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        let mut open = deleting.borrow_mut();
+        if let Some(at) = open.as_deref() {
+            if l == format!("{at}}}") {
+                *open = None;
+            }
+            return Some(String::new());
+        }
+        if after_todo.replace(t.starts_with("var mrsl_todo_")) && t == "loop {" {
+            *open = Some(indent(l).to_string());
+            return Some(String::new());
+        }
+        None
+    })
+}
+
 /// The key loads and comparisons of the resolve: every corner on each
 /// pixel's side of every key (`side_<key>` all true), or
 /// in the kernels that refine a whole block at an edge, `disc_<key>` false.
@@ -133,7 +159,7 @@ fn as_background(w: &str) -> Option<String> {
 /// The variants. Removing the key tests or the flag reads from the full
 /// kernel would also change what is refined, so those parts are measured
 /// within the fixed cost (nothing refined), where they decide nothing.
-pub(super) const VARIANTS: [Variant; 10] = [
+pub(super) const VARIANTS: [Variant; 11] = [
     Variant {
         name: "no instrumentation",
         removes: "the statistics atomics, their barrier and the refine-mask store (`DispatchOptions::statistics` off)",
@@ -166,8 +192,8 @@ pub(super) const VARIANTS: [Variant; 10] = [
     },
     Variant {
         name: "every pixel background",
-        removes: "the corners, the resolve and every coarse effect at every pixel (as where nothing was drawn): what a tile known to be wholly background would cost",
-        edits: &[as_background],
+        removes: "the corners, the resolve, the refinement loops and every coarse effect at every pixel (as where nothing was drawn): what a tile known to be wholly background would cost",
+        edits: &[as_background, no_refinement_loops],
     },
     Variant {
         name: "fixed cost, no instrumentation",
@@ -175,9 +201,14 @@ pub(super) const VARIANTS: [Variant; 10] = [
         edits: &[nothing_refined, no_instrumentation],
     },
     Variant {
+        name: "fixed cost, no refinement loops",
+        removes: "the fixed cost, statistics off, without the loops that re-evaluate refined pixels: no lane enters them here, but a SIMD machine may still run their bodies with every lane masked off",
+        edits: &[nothing_refined, no_refinement_loops, no_instrumentation],
+    },
+    Variant {
         name: "every pixel background, no instrumentation",
         removes: "the same as a background pixel costs a timed run: statistics off",
-        edits: &[as_background, no_instrumentation],
+        edits: &[as_background, no_refinement_loops, no_instrumentation],
     },
     Variant {
         name: "no fine pass work",
@@ -213,6 +244,9 @@ mod tests {
                 assert_ne!(&edited, fine, "{}", v.name);
                 mrsl::validate_wgsl(&edited).unwrap_or_else(|e| panic!("{} (block {block}): {e}", v.name));
             }
+            let unlooped = no_refinement_loops(fine).unwrap();
+            assert_eq!(unlooped.matches("loop {").count(), 0, "block {block}: a refinement loop is left");
+            assert!(fine.matches("loop {").count() >= 4, "the workload refines four coarse effects");
             // The compacted kernel takes the edits that apply to it too.
             let compacted =
                 mrsl::compile(WORKLOAD_PROGRAM, &mrsl::Options { compact: true, ..Default::default() }).unwrap();
