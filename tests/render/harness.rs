@@ -1,5 +1,6 @@
 //! Shared device and a `run` helper: one program, one G-buffer, one mode.
 
+use mrsl_abi::KernelRef;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::scene::GBuffer;
 use mrsl_runtime::{Bindings, CompiledProgram, DispatchOptions, Error, Mode, Shader, Stats};
@@ -148,6 +149,22 @@ pub struct Dispatched {
     pub refine_masks_y: Option<Vec<u32>>,
 }
 
+/// `program` with only the plan entries of `modes` and the kernels they
+/// use. A [`Shader`] makes a pipeline for every kernel its program's plan
+/// names, and the kernels are the same text whichever modes are kept, so a
+/// test that dispatches one mode need not wait for every other mode's
+/// pipelines: on SwiftShader, whose pipeline compiles take seconds each,
+/// that made `forced_refinement_equals_reference_for_every_example` take
+/// nine minutes.
+fn restricted_to(program: &CompiledProgram, modes: &[Mode]) -> CompiledProgram {
+    let mut kept = program.clone();
+    kept.layout.plan.modes.retain(|m| modes.contains(&m.mode));
+    let used: std::collections::HashSet<KernelRef> =
+        kept.layout.plan.modes.iter().flat_map(|m| m.kernels.iter().copied()).collect();
+    kept.kernels.retain(|k| used.contains(&KernelRef::new(k.kind, k.block_size)));
+    kept
+}
+
 /// Dispatches `options` one after the other with one shader over one
 /// G-buffer (prepared as [`run`] does; `rates` is the shading-rate image of
 /// `options[0].rate_tile`), reading back after each.
@@ -161,7 +178,8 @@ pub fn dispatch_in_turn<const N: usize>(
     let size = (gbuffer.width, gbuffer.height);
     let tile = options.first().map_or(mrsl_abi::shading_rate::DEFAULT_RATE_TILE, |o| o.rate_tile);
     let channels = gbuffer.upload(gpu);
-    let mut shader = Shader::new(&gpu.device, program)?;
+    let modes = options.map(|o| o.mode);
+    let mut shader = Shader::new(&gpu.device, &restricted_to(program, &modes))?;
     if let Some(block) = &program.layout.uniforms {
         for f in &block.fields {
             if f.default.is_none() {
