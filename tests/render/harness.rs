@@ -159,8 +159,7 @@ pub struct Dispatched {
 fn restricted_to(program: &CompiledProgram, modes: &[Mode]) -> CompiledProgram {
     let mut kept = program.clone();
     kept.layout.plan.modes.retain(|m| modes.contains(&m.mode));
-    let used: std::collections::HashSet<KernelRef> =
-        kept.layout.plan.modes.iter().flat_map(|m| m.kernels.iter().copied()).collect();
+    let used = Mode::kernels_of(modes);
     kept.kernels.retain(|k| used.contains(&KernelRef::new(k.kind, k.block_size)));
     kept
 }
