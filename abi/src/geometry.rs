@@ -146,6 +146,18 @@ pub fn indirect_args_offset(level: u32) -> u64 {
     u64::from(level * QUEUE_WORDS_PER_LEVEL * 4)
 }
 
+/// The block and dynamic fine kernels' tile lists: list 0 holds the surface
+/// tiles, list 1 the background tiles. Their counters are a word each; their
+/// indirect arguments (x, y, z, unused) lie [`QUEUE_WORDS_PER_LEVEL`] words
+/// apart, laid out in rows as wide as the image's tiles
+/// ([`pixel_workgroups`]): workgroup (x, y) shades entry `y * tiles_x + x`.
+pub const TILE_LISTS: u32 = 2;
+
+/// Byte offset of tile list `list`'s (0 or 1) indirect dispatch arguments.
+pub fn tile_args_offset(list: u32) -> u64 {
+    u64::from(list * QUEUE_WORDS_PER_LEVEL * 4)
+}
+
 /// Rate-image mode: shading-rate tiles per side of one `rate_list` workgroup
 /// (one invocation per tile).
 pub const RATE_LIST_TILES: u32 = 8;

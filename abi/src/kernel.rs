@@ -15,6 +15,15 @@ pub mod entry {
     pub const REFERENCE: &str = "reference_main";
     pub const DYNAMIC_COARSE: &str = "dynamic_coarse_main";
     pub const DYNAMIC_FINE: &str = "dynamic_fine_main";
+    /// The block and dynamic fine kernels, first: list every tile as a
+    /// surface tile (a pixel in it is not background) or a background tile
+    /// (every pixel is), in the tile lists (`TileLists`, `TileCounts`).
+    pub const FINE_TILES: &str = "fine_tiles";
+    /// Turn the two lists' lengths into indirect dispatch arguments (binds [`crate::GROUP_ARGS`]).
+    pub const FINE_TILE_ARGS: &str = "fine_tile_args";
+    /// Shade the background tiles (indirect): every coarse effect reads as
+    /// zero there, so no coarse sample is read and nothing is refined.
+    pub const FINE_BACKGROUND: &str = "fine_background";
     /// Hierarchical level 0: every 4th pixel, always shaded.
     pub const HIER_LEVEL0: &str = "hier_level0";
     /// Hierarchical levels 1 to 4: classify the level's pixels into its work list.
@@ -151,10 +160,12 @@ impl KernelKind {
     pub fn entry_points(self) -> &'static [&'static str] {
         match self {
             KernelKind::Coarse => &[entry::COARSE_NEIGHBOURS, entry::COARSE],
-            KernelKind::Fine => &[entry::FINE],
+            KernelKind::Fine => &[entry::FINE_TILES, entry::FINE_TILE_ARGS, entry::FINE_BACKGROUND, entry::FINE],
             KernelKind::Reference => &[entry::REFERENCE],
             KernelKind::DynamicCoarse => &[entry::DYNAMIC_COARSE],
-            KernelKind::DynamicFine => &[entry::DYNAMIC_FINE],
+            KernelKind::DynamicFine => {
+                &[entry::FINE_TILES, entry::FINE_TILE_ARGS, entry::FINE_BACKGROUND, entry::DYNAMIC_FINE]
+            }
             KernelKind::Hierarchical => &HIERARCHICAL_ENTRY_POINTS,
             KernelKind::Checkerboard => &[entry::CB_SHADE, entry::CB_FINAL],
             KernelKind::RateCoarse => &[entry::RATE_LIST, entry::RATE_ARGS, entry::RATE_COARSE],

@@ -54,7 +54,10 @@ pub struct Layout {
     /// The dynamic mode's second (2x2) level of coarse samples: records of
     /// `interface.stride_words + 1` words, the last being a validity tag.
     pub interface2: ResourceBinding,
-    /// The hierarchical (DACS) and checkerboard modes' buffers.
+    /// The hierarchical (DACS) and checkerboard modes' buffers. The block
+    /// and dynamic fine kernels' tile lists and their counts (with a
+    /// background rule) take the binding numbers of its `work_binding` and
+    /// `queue_binding` (the plan says which resource each binds).
     pub hierarchical: HierarchicalLayout,
     /// The rate-image mode's shading-rate image (`texture_2d<u32>`, one texel
     /// per tile, codes of [`crate::ShadingRate`]), read by both its kernels.

@@ -251,6 +251,14 @@ pub enum ResourceId {
     SampleCount,
     /// The indirect dispatch arguments of the rate-image mode's sample shading.
     SampleArguments,
+    /// The block and dynamic fine kernels' tile lists: a word per tile
+    /// (`x | y << 16`), the surface tiles from the front, the background
+    /// tiles from the back.
+    TileLists,
+    /// The lengths of the two tile lists (surface, background).
+    TileCounts,
+    /// The indirect dispatch arguments of the two tile lists.
+    TileArguments,
     /// The statistics counters ([`crate::StatsLayout`]).
     Statistics,
     /// The per-pixel refine mask ([`crate::Layout::refine_mask`]).

@@ -80,7 +80,13 @@ fn block_steps(layout: &Layout, mode: Mode, steps: &mut Vec<Step>) -> Counts {
     } else {
         (KernelKind::Fine, entry::FINE)
     };
-    steps.push(pass(layout, "mrsl fine", Stage::Fine, KernelRef::new(fine, Some(block)), vec![tiles(fine_entry)]));
+    let fine = KernelRef::new(fine, Some(block));
+    if layout.has_background() {
+        steps.push(Step::Clear { resource: ResourceId::TileCounts });
+        steps.push(pass(layout, "mrsl fine", Stage::Fine, fine, tile_list_dispatches(fine_entry)));
+    } else {
+        steps.push(pass(layout, "mrsl fine", Stage::Fine, fine, vec![tiles(fine_entry)]));
+    }
     // The dynamic mode's last counter counts the 2x2 samples it shaded.
     let counter = (mode == Mode::Dynamic).then_some(layout.stats.counters.len());
     Counts {
@@ -89,6 +95,31 @@ fn block_steps(layout: &Layout, mode: Mode, steps: &mut Vec<Step>) -> Counts {
         work_lists: None,
         background: None,
     }
+}
+
+/// A fine pass over tile lists: classify the tiles, turn the lists' lengths
+/// into indirect arguments, shade the background tiles with their own entry
+/// point and the surface tiles with the full one (`entry`). On llvmpipe no
+/// branch spares a lane its work, so the background pixels' savings come
+/// only from leaving them out of the full entry point's dispatch.
+fn tile_list_dispatches(entry: &str) -> Vec<Dispatch> {
+    let listed = |list| Workgroups::Indirect {
+        buffer: ResourceId::TileArguments,
+        offset: geometry::tile_args_offset(list),
+        // The arguments lay the workgroups out in rows as wide as the image's tiles.
+        at_most: None,
+        per_workgroup: mrsl_abi::geometry::FINE_WORKGROUP,
+    };
+    vec![
+        tiles(entry::FINE_TILES),
+        Dispatch {
+            entry: entry::FINE_TILE_ARGS.into(),
+            arguments: Some(ResourceId::TileArguments),
+            workgroups: Workgroups::One,
+        },
+        dispatch(entry::FINE_BACKGROUND, listed(1)),
+        dispatch(entry, listed(0)),
+    ]
 }
 
 /// The multi-rate mode: the 4x4 samples of the `coarse(4)` effects, their
@@ -279,6 +310,11 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
             fine
         }
     };
+    // With a background rule the fine kernels shade over tile lists.
+    if matches!(kernel.kind, KernelKind::Fine | KernelKind::DynamicFine) && layout.has_background() {
+        bindings.push(buffer(h.work_binding, R::TileLists, false));
+        bindings.push(buffer(h.queue_binding, R::TileCounts, false));
+    }
     // With a background rule the coarse kernels count the background samples.
     // (The multi-rate mode counts its 2x2 samples, those of its finest grid.)
     let counts_background = match kernel.kind {
@@ -365,6 +401,15 @@ fn resource(layout: &Layout, id: ResourceId) -> ResourceDesc {
         R::SampleList => ("the rate-image sample list", words(Extent::Pixels, 1)),
         R::SampleCount => ("the rate-image sample count", words(Extent::Fixed { count: rate_words() }, 1)),
         R::SampleArguments => ("the rate-image dispatch arguments", words(Extent::Fixed { count: rate_words() }, 1)),
+        R::TileLists => {
+            let tiles = Extent::Lattice { start: 0, step: geometry::TILE, odd_only: false };
+            ("the fine pass's tile lists", words(tiles, 1))
+        }
+        R::TileCounts => ("the tile-list counts", words(Extent::Fixed { count: u64::from(geometry::TILE_LISTS) }, 1)),
+        R::TileArguments => {
+            let count = u64::from(geometry::TILE_LISTS * QUEUE_WORDS_PER_LEVEL);
+            ("the tile lists' dispatch arguments", words(Extent::Fixed { count }, 1))
+        }
         R::Statistics => ("the statistics counters", words(Extent::Fixed { count: layout.stats_counters() as u64 }, 1)),
         R::RefineMask => ("the refine mask", Shape::Texture { format: TextureFormat::Rg32Uint }),
         R::LevelRecords { block } => {
@@ -408,6 +453,29 @@ mod tests {
         }
         for id in plan.modes.iter().flat_map(|m| m.resources()) {
             assert_eq!(plan.resource(id).is_none(), id.engine_bound(), "{id:?}");
+        }
+    }
+
+    /// With a background rule the block and dynamic fine passes classify
+    /// the tiles and shade the two lists indirectly; without one they shade
+    /// every tile directly.
+    #[test]
+    fn fine_passes_shade_tile_lists_only_with_a_background_rule() {
+        let body = "coarse effect float d = normal.y;\nfine out float4 color = float4(d);\n";
+        let fine_entries = |source: &str, mode: Mode| {
+            let program = crate::compile(source, &crate::Options::default()).unwrap();
+            let plan = program.layout.plan.mode(mode).unwrap().clone();
+            let fine = plan.passes().find(|p| p.stage == Stage::Fine).unwrap().clone();
+            let cleared = plan.steps.contains(&Step::Clear { resource: ResourceId::TileCounts });
+            (fine.dispatches.iter().map(|d| d.entry.clone()).collect::<Vec<_>>(), cleared)
+        };
+        let with = format!("in float3 normal;\n@background(255) in uint material;\n{body}");
+        for (mode, main) in
+            [(Mode::Coarse4x4, entry::FINE), (Mode::Coarse2x2, entry::FINE), (Mode::Dynamic, entry::DYNAMIC_FINE)]
+        {
+            let listed = vec![entry::FINE_TILES, entry::FINE_TILE_ARGS, entry::FINE_BACKGROUND, main];
+            assert_eq!(fine_entries(&with, mode), (listed.iter().map(|e| e.to_string()).collect(), true), "{mode}");
+            assert_eq!(fine_entries(&format!("in float3 normal;\n{body}"), mode), (vec![main.to_string()], false));
         }
     }
 }

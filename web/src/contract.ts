@@ -202,6 +202,9 @@ export type ResourceId =
   | { id: 'sample_list' }
   | { id: 'sample_count' }
   | { id: 'sample_arguments' }
+  | { id: 'tile_lists' }
+  | { id: 'tile_counts' }
+  | { id: 'tile_arguments' }
   | { id: 'statistics' }
   | { id: 'refine_mask' }
   | { id: 'level_records'; block: number }

@@ -589,14 +589,19 @@ impl Writer<'_, '_, '_> {
 
     /// Entry point of the block and dynamic fine kernels and of the reference kernel.
     pub(super) fn pixel_entry(&mut self) {
+        let listed = matches!(self.file, KernelKind::Fine | KernelKind::DynamicFine);
         if self.compacts() {
             self.tile_pixel_blocks(self.block, 1);
+            self.tile_list_entries();
             return self.compacted_fine_entry();
         }
         match self.kind {
             KernelKind::Fine | KernelKind::DynamicFine => self.tile_pixel_blocks(self.block, FINE_PIXELS_PER_LANE),
             // The reference kernel has no blocks; it lays its tiles out in 2x2 ones.
             _ => self.tile_pixel_blocks(2, 1),
+        }
+        if listed {
+            self.tile_list_entries();
         }
         self.fine_main();
     }

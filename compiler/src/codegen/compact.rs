@@ -94,7 +94,8 @@ impl Writer<'_, '_, '_> {
                 self.kind.main_entry_point()
             ),
         );
-        self.line(1, format!("let {POS} = {TILE_PIXEL}({WORKGROUP}.xy, {LANE});"));
+        let tile = self.surface_tile(1);
+        self.line(1, format!("let {POS} = {TILE_PIXEL}({tile}, {LANE});"));
         self.line(1, format!("let {IN} = all({POS} < {GRID}());"));
         // 1. Resolve, count, and list the pixel for each coarse effect it re-evaluates.
         self.line(1, format!("if ({IN}) {{"));
@@ -127,7 +128,7 @@ impl Writer<'_, '_, '_> {
             self.line(1, format!("// `{name}` where it is re-evaluated, one lane per listed pixel"));
             self.line(1, format!("if ({LANE} < atomicLoad(&{COMPACT_COUNTS}[{j}])) {{"));
             self.line(2, format!("let {LISTED} = {COMPACT_LISTS}[{}u + {LANE}];", j * wg));
-            self.line(2, format!("let {POS} = {TILE_PIXEL}({WORKGROUP}.xy, {LISTED});"));
+            self.line(2, format!("let {POS} = {TILE_PIXEL}({tile}, {LISTED});"));
             self.line(2, format!("let {BLOCK} = {COMPACT_BLOCKS}[{LISTED}];"));
             for (d, _) in self.checked().effects[e.index()].deps.clone() {
                 self.compacted_value(d, 2, LISTED);

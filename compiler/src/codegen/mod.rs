@@ -61,6 +61,7 @@ mod names;
 mod pixel;
 mod rate;
 mod records;
+mod tiles;
 mod words;
 mod writer;
 

@@ -196,6 +196,12 @@ pub(super) const IN: &str = "mrsl_in";
 pub(super) const GRID: &str = "mrsl_grid";
 /// `mrsl_tile_pixel(wg, li)`: the pixel of a lane of a tile.
 pub(super) const TILE_PIXEL: &str = "mrsl_tile_pixel";
+/// With tile lists: the tile a fine workgroup shades, and
+/// `mrsl_listed_tile(wg, li, list)`, which reads it from a list.
+pub(super) const TILE_ORIGIN: &str = "mrsl_tile";
+pub(super) const LISTED_TILE: &str = "mrsl_listed_tile";
+/// The refine mask (layout `refine_mask`).
+pub(super) const REFINE_MASK: &str = "mrsl_refine_mask";
 /// The control block (`MrslControl`).
 pub(super) const CONTROL: &str = "mrsl_ctl";
 /// The user uniforms (`MrslUniforms`).
@@ -282,6 +288,9 @@ pub(super) const FIXED: &[&str] = &[
     IN,
     GRID,
     TILE_PIXEL,
+    TILE_ORIGIN,
+    LISTED_TILE,
+    REFINE_MASK,
     CONTROL,
     UNIFORMS,
     FORCE,
@@ -325,7 +334,6 @@ pub(super) const FIXED: &[&str] = &[
     // resources.wgsl, uniforms.wgsl, stats.wgsl, positions.wgsl: bindings and position helpers
     "MrslControl",
     "MrslUniforms",
-    "mrsl_refine_mask",
     "mrsl_pair_x",
     "mrsl_pair_y",
     // derivative.wgsl, derivative_both.wgsl: the operand here, at the pair's other position
@@ -345,6 +353,12 @@ pub(super) const FIXED: &[&str] = &[
     "mrsl_shade",
     "mrsl_classify",
     "mrsl_mask",
+    // tile_lists.wgsl: the lists, their lengths, the workgroup's tile and whether it has surface
+    "mrsl_tiles",
+    "mrsl_tiles_n",
+    "mrsl_tile_grid",
+    "mrsl_wg_tile",
+    "mrsl_wg_surface",
     // checkerboard_*.wgsl, taps.wgsl
     "mrsl_qx",
     "mrsl_qy",

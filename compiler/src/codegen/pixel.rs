@@ -125,15 +125,11 @@ impl Writer<'_, '_, '_> {
     ) {
         let [x, y, z] = self.kind.workgroup_size();
         let pairs = matches!(self.kind, KernelKind::Fine | KernelKind::DynamicFine);
-        self.template(
-            0,
-            include_str!("templates/pixel_main.wgsl"),
-            &[
-                ("WORKGROUP", &format!("{x}, {y}, {z}")),
-                ("ENTRY", &self.file.main_entry_point()),
-                ("FIRST", &if pairs { FIRST } else { POS }),
-            ],
-        );
+        let [head, tail] = cut(include_str!("templates/pixel_main.wgsl"), &["LISTED"]);
+        let workgroup = format!("{x}, {y}, {z}");
+        self.template(0, head, &[("WORKGROUP", &workgroup), ("ENTRY", &self.file.main_entry_point())]);
+        let tile = self.surface_tile(1);
+        self.template(0, tail, &[("FIRST", &if pairs { FIRST } else { POS }), ("TILE", &tile)]);
         let counted = self.counts_stats();
         if pairs && !self.coarse_live().is_empty() {
             self.effect_major_pixels(&mut prologue);
