@@ -153,6 +153,12 @@ pub fn indirect_args_offset(level: u32) -> u64 {
 /// ([`pixel_workgroups`]): workgroup (x, y) shades entry `y * tiles_x + x`.
 pub const TILE_LISTS: u32 = 2;
 
+/// The tile list of the tiles with surface in them, which the main fine entry point shades.
+pub const SURFACE_TILE_LIST: u32 = 0;
+
+/// The tile list of the wholly-background tiles, which `fine_background` shades.
+pub const BACKGROUND_TILE_LIST: u32 = 1;
+
 /// Byte offset of tile list `list`'s (0 or 1) indirect dispatch arguments.
 pub fn tile_args_offset(list: u32) -> u64 {
     u64::from(list * QUEUE_WORDS_PER_LEVEL * 4)

@@ -108,7 +108,7 @@ fn tile_list_dispatches(entry: &str) -> Vec<Dispatch> {
         offset: geometry::tile_args_offset(list),
         // The arguments lay the workgroups out in rows as wide as the image's tiles.
         at_most: None,
-        per_workgroup: mrsl_abi::geometry::FINE_WORKGROUP,
+        per_workgroup: geometry::FINE_WORKGROUP,
     };
     vec![
         tiles(entry::FINE_TILES),
@@ -117,8 +117,8 @@ fn tile_list_dispatches(entry: &str) -> Vec<Dispatch> {
             arguments: Some(ResourceId::TileArguments),
             workgroups: Workgroups::One,
         },
-        dispatch(entry::FINE_BACKGROUND, listed(1)),
-        dispatch(entry, listed(0)),
+        dispatch(entry::FINE_BACKGROUND, listed(geometry::BACKGROUND_TILE_LIST)),
+        dispatch(entry, listed(geometry::SURFACE_TILE_LIST)),
     ]
 }
 

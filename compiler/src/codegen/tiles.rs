@@ -18,12 +18,11 @@ use super::effects::Evaluation;
 use super::names::{GRID, LANE, LISTED_TILE, POS, REFINE_MASK, TILE_ORIGIN, WORKGROUP, WORKGROUP_STATS};
 use super::pixel::statistics_enabled;
 use crate::syntax::ast::Rate;
-use mrsl_abi::geometry::{FINE_PIXELS_PER_LANE, FINE_WORKGROUP, QUEUE_WORDS_PER_LEVEL, TILE, TILE_LISTS};
+use mrsl_abi::geometry::{
+    BACKGROUND_TILE_LIST, FINE_PIXELS_PER_LANE, FINE_WORKGROUP, QUEUE_WORDS_PER_LEVEL, SURFACE_TILE_LIST, TILE,
+    TILE_LISTS,
+};
 use mrsl_abi::{BACKGROUND_MARK, BINDING_ARGS, GROUP_ARGS, GROUP_STAGE, KernelKind, entry};
-
-/// The list of surface tiles and the list of background tiles ([`TILE_LISTS`]).
-const SURFACE_TILES: u32 = 0;
-const BACKGROUND_TILES: u32 = 1;
 
 impl Writer<'_, '_, '_> {
     /// Whether the kernel shades over tile lists: the block and dynamic fine
@@ -39,7 +38,7 @@ impl Writer<'_, '_, '_> {
         if !self.lists_tiles() {
             return format!("{WORKGROUP}.xy");
         }
-        self.listed_tile(indent, SURFACE_TILES);
+        self.listed_tile(indent, SURFACE_TILE_LIST);
         TILE_ORIGIN.to_string()
     }
 
@@ -96,7 +95,7 @@ impl Writer<'_, '_, '_> {
                 entry::FINE_BACKGROUND
             ),
         );
-        self.listed_tile(1, BACKGROUND_TILES);
+        self.listed_tile(1, BACKGROUND_TILE_LIST);
         let counted = self.counts_stats();
         let order = self.i.graph.order.clone();
         for k in 0..FINE_PIXELS_PER_LANE {
