@@ -15,7 +15,8 @@ pub mod entry {
     pub const REFERENCE: &str = "reference_main";
     pub const DYNAMIC_COARSE: &str = "dynamic_coarse_main";
     pub const DYNAMIC_FINE: &str = "dynamic_fine_main";
-    /// The block and dynamic fine kernels, first: list every tile as a
+    /// The per-pixel passes that write the outputs (but the reference's and
+    /// the hierarchical mode's; see [`KernelKind::has_tile_lists`]), first: list every tile as a
     /// surface tile (a pixel in it is not background) or a background tile
     /// (every pixel is), in the tile lists (`TileLists`, `TileCounts`).
     pub const FINE_TILES: &str = "fine_tiles";
@@ -167,13 +168,25 @@ impl KernelKind {
                 &[entry::FINE_TILES, entry::FINE_TILE_ARGS, entry::FINE_BACKGROUND, entry::DYNAMIC_FINE]
             }
             KernelKind::Hierarchical => &HIERARCHICAL_ENTRY_POINTS,
-            KernelKind::Checkerboard => &[entry::CB_SHADE, entry::CB_FINAL],
+            KernelKind::Checkerboard => {
+                &[entry::CB_SHADE, entry::FINE_TILES, entry::FINE_TILE_ARGS, entry::FINE_BACKGROUND, entry::CB_FINAL]
+            }
             KernelKind::RateCoarse => &[entry::RATE_LIST, entry::RATE_ARGS, entry::RATE_COARSE],
-            KernelKind::RateFine => &[entry::RATE_FINE],
+            KernelKind::RateFine => {
+                &[entry::FINE_TILES, entry::FINE_TILE_ARGS, entry::FINE_BACKGROUND, entry::RATE_FINE]
+            }
             KernelKind::MultiCoarse => &[entry::COARSE],
             KernelKind::MultiResolve => &[entry::MULTI_RESOLVE],
-            KernelKind::MultiFine => &[entry::FINE],
+            KernelKind::MultiFine => &[entry::FINE_TILES, entry::FINE_TILE_ARGS, entry::FINE_BACKGROUND, entry::FINE],
         }
+    }
+
+    /// Whether the kernel's per-pixel pass can shade over tile lists (it has
+    /// the `fine_tiles`, `fine_tile_args` and `fine_background` entry
+    /// points, empty without a background rule): every per-pixel pass that
+    /// writes the outputs but the reference's and the hierarchical mode's.
+    pub fn has_tile_lists(self) -> bool {
+        self.entry_points().contains(&entry::FINE_TILES)
     }
 
     /// The entry point that writes the outputs (the last one dispatched).

@@ -44,7 +44,9 @@ fn mode_plan(layout: &Layout, mode: Mode) -> ModePlan {
         Mode::Checkerboard => {
             let kernel = KernelRef::new(KernelKind::Checkerboard, None);
             let shade = dispatch(entry::CB_SHADE, Workgroups::CheckerboardQuads);
-            steps.push(pass(layout, "mrsl checkerboard", Stage::Fine, kernel, vec![shade, tiles(entry::CB_FINAL)]));
+            let mut dispatches = vec![shade];
+            dispatches.extend(pixel_dispatches(layout, &mut steps, entry::CB_FINAL));
+            steps.push(pass(layout, "mrsl checkerboard", Stage::Fine, kernel, dispatches));
             Counts { samples: SampleCount::None, evaluations: Evaluations::Counted, work_lists: None, background: None }
         }
         Mode::RateImage => rate_image_steps(layout, &mut steps),
@@ -81,12 +83,8 @@ fn block_steps(layout: &Layout, mode: Mode, steps: &mut Vec<Step>) -> Counts {
         (KernelKind::Fine, entry::FINE)
     };
     let fine = KernelRef::new(fine, Some(block));
-    if layout.has_background() {
-        steps.push(Step::Clear { resource: ResourceId::TileCounts });
-        steps.push(pass(layout, "mrsl fine", Stage::Fine, fine, tile_list_dispatches(fine_entry)));
-    } else {
-        steps.push(pass(layout, "mrsl fine", Stage::Fine, fine, vec![tiles(fine_entry)]));
-    }
+    let dispatches = pixel_dispatches(layout, steps, fine_entry);
+    steps.push(pass(layout, "mrsl fine", Stage::Fine, fine, dispatches));
     // The dynamic mode's last counter counts the 2x2 samples it shaded.
     let counter = (mode == Mode::Dynamic).then_some(layout.stats.counters.len());
     Counts {
@@ -94,6 +92,18 @@ fn block_steps(layout: &Layout, mode: Mode, steps: &mut Vec<Step>) -> Counts {
         evaluations: Evaluations::SamplesAndCounted,
         work_lists: None,
         background: None,
+    }
+}
+
+/// The dispatches of a per-pixel pass that writes the outputs through
+/// `entry`: over tile lists where the program has a background rule (after
+/// a step clearing their counts), else over every tile.
+fn pixel_dispatches(layout: &Layout, steps: &mut Vec<Step>, entry: &str) -> Vec<Dispatch> {
+    if layout.has_background() {
+        steps.push(Step::Clear { resource: ResourceId::TileCounts });
+        tile_list_dispatches(entry)
+    } else {
+        vec![tiles(entry)]
     }
 }
 
@@ -144,13 +154,8 @@ fn multi_rate_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
         kernel(KernelKind::MultiCoarse, inner),
         vec![samples],
     ));
-    steps.push(pass(
-        layout,
-        "mrsl multi-rate fine",
-        Stage::Fine,
-        kernel(KernelKind::MultiFine, inner),
-        vec![tiles(entry::FINE)],
-    ));
+    let dispatches = pixel_dispatches(layout, steps, entry::FINE);
+    steps.push(pass(layout, "mrsl multi-rate fine", Stage::Fine, kernel(KernelKind::MultiFine, inner), dispatches));
     Counts {
         samples: SampleCount::Levels,
         evaluations: Evaluations::SamplesAndCounted,
@@ -226,7 +231,8 @@ fn rate_image_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
     let coarse = KernelRef::new(KernelKind::RateCoarse, None);
     steps.push(pass(layout, "mrsl rate-image coarse", Stage::Coarse, coarse, list));
     let fine = KernelRef::new(KernelKind::RateFine, None);
-    steps.push(pass(layout, "mrsl rate-image fine", Stage::Fine, fine, vec![tiles(entry::RATE_FINE)]));
+    let dispatches = pixel_dispatches(layout, steps, entry::RATE_FINE);
+    steps.push(pass(layout, "mrsl rate-image fine", Stage::Fine, fine, dispatches));
     steps.push(Step::Readback { resource: ResourceId::SampleCount, bytes: Some(4) });
     Counts {
         samples: SampleCount::Listed { resource: ResourceId::SampleCount, word: 0 },
@@ -310,8 +316,8 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
             fine
         }
     };
-    // With a background rule the fine kernels shade over tile lists.
-    if matches!(kernel.kind, KernelKind::Fine | KernelKind::DynamicFine) && layout.has_background() {
+    // With a background rule the per-pixel passes that write the outputs shade over tile lists.
+    if kernel.kind.has_tile_lists() && layout.has_background() {
         bindings.push(buffer(h.work_binding, R::TileLists, false));
         bindings.push(buffer(h.queue_binding, R::TileCounts, false));
     }

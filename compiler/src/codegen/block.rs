@@ -589,7 +589,7 @@ impl Writer<'_, '_, '_> {
 
     /// Entry point of the block and dynamic fine kernels and of the reference kernel.
     pub(super) fn pixel_entry(&mut self) {
-        let listed = matches!(self.file, KernelKind::Fine | KernelKind::DynamicFine);
+        let listed = self.file.has_tile_lists();
         if self.compacts() {
             self.tile_pixel_blocks(self.block, 1);
             self.tile_list_entries();

@@ -76,6 +76,7 @@ impl Writer<'_, '_, '_> {
         }
         self.line(0, "");
 
+        self.tile_list_entries();
         let coarse = coarse.len();
         let [head, stats, end] = cut(include_str!("templates/checkerboard_final.wgsl"), &["STATS", "COUNTS"]);
         let [value, evaluated] = cut(include_str!("templates/checkerboard_value.wgsl"), &["EVALUATE"]);

@@ -167,6 +167,7 @@ impl Writer<'_, '_, '_> {
     /// most 4x4 pixels, so 4x4 blocks keep a cell's pixels on neighbouring lanes.
     pub(super) fn rate_fine_entry(&mut self) {
         self.tile_pixel_blocks(4, 1);
+        self.tile_list_entries();
         self.fine_main();
     }
 }

@@ -1,5 +1,6 @@
-//! The tile lists of the block modes' and the dynamic mode's fine kernels,
-//! where the program has a background rule: `fine_tiles` sorts the image's
+//! The tile lists of the per-pixel passes that write the outputs (the block,
+//! dynamic, checkerboard, rate-image and multi-rate modes'), where the
+//! program has a background rule: `fine_tiles` sorts the image's
 //! tiles into surface tiles (some pixel is not background) and background
 //! tiles, `fine_tile_args` turns the two lists' lengths into indirect
 //! arguments, `fine_background` shades the background tiles and the main
@@ -22,13 +23,14 @@ use mrsl_abi::geometry::{
     BACKGROUND_TILE_LIST, FINE_PIXELS_PER_LANE, FINE_WORKGROUP, QUEUE_WORDS_PER_LEVEL, SURFACE_TILE_LIST, TILE,
     TILE_LISTS,
 };
-use mrsl_abi::{BACKGROUND_MARK, BINDING_ARGS, GROUP_ARGS, GROUP_STAGE, KernelKind, entry};
+use mrsl_abi::{BACKGROUND_MARK, BINDING_ARGS, GROUP_ARGS, GROUP_STAGE, entry};
 
 impl Writer<'_, '_, '_> {
-    /// Whether the kernel shades over tile lists: the block and dynamic fine
-    /// kernels of a program with a background rule.
+    /// Whether the kernel shades over tile lists: the per-pixel passes that
+    /// have them ([`mrsl_abi::KernelKind::has_tile_lists`]), in a program with a
+    /// background rule.
     pub(super) fn lists_tiles(&self) -> bool {
-        matches!(self.file, KernelKind::Fine | KernelKind::DynamicFine) && self.has_background()
+        self.file.has_tile_lists() && self.has_background()
     }
 
     /// The first lines of the main entry point: with tile lists, the surface
