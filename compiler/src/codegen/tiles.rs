@@ -1,6 +1,5 @@
-//! The tile lists of the per-pixel passes that write the outputs (the block,
-//! dynamic, checkerboard, rate-image and multi-rate modes'), where the
-//! program has a background rule: `fine_tiles` sorts the image's
+//! The tile lists of the per-pixel passes that write the outputs (every
+//! mode's but the reference's), where the program has a background rule: `fine_tiles` sorts the image's
 //! tiles into surface tiles (some pixel is not background) and background
 //! tiles, `fine_tile_args` turns the two lists' lengths into indirect
 //! arguments, `fine_background` shades the background tiles and the main
@@ -18,12 +17,13 @@ use super::Writer;
 use super::effects::Evaluation;
 use super::names::{GRID, LANE, LISTED_TILE, POS, REFINE_MASK, TILE_ORIGIN, WORKGROUP, WORKGROUP_STATS};
 use super::pixel::statistics_enabled;
+use super::writer::cut;
 use crate::syntax::ast::Rate;
 use mrsl_abi::geometry::{
     BACKGROUND_TILE_LIST, FINE_PIXELS_PER_LANE, FINE_WORKGROUP, QUEUE_WORDS_PER_LEVEL, SURFACE_TILE_LIST, TILE,
     TILE_LISTS,
 };
-use mrsl_abi::{BACKGROUND_MARK, BINDING_ARGS, GROUP_ARGS, GROUP_STAGE, entry};
+use mrsl_abi::{BACKGROUND_MARK, BINDING_ARGS, GROUP_ARGS, GROUP_STAGE, KernelKind, entry};
 
 impl Writer<'_, '_, '_> {
     /// Whether the kernel shades over tile lists: the per-pixel passes that
@@ -62,16 +62,29 @@ impl Writer<'_, '_, '_> {
             self.line(0, "");
             return;
         }
-        let h = &self.i.layout.hierarchical;
+        let lists = &self.i.layout.tile_lists;
+        let [head, tail] = cut(include_str!("templates/tile_lists.wgsl"), &["ARGS"]);
         self.template(
             0,
-            include_str!("templates/tile_lists.wgsl"),
+            head,
             &[
                 ("GROUP", &GROUP_STAGE),
-                ("LIST_BINDING", &h.work_binding),
-                ("COUNTS_BINDING", &h.queue_binding),
-                ("ARGS_GROUP", &GROUP_ARGS),
-                ("ARGS_BINDING", &BINDING_ARGS),
+                ("LIST_BINDING", &lists.list_binding),
+                ("COUNTS_BINDING", &lists.counts_binding),
+            ],
+        );
+        // The hierarchical kernel declares the arguments binding for its levels already.
+        if self.file != KernelKind::Hierarchical {
+            self.template(
+                0,
+                include_str!("templates/tile_args_binding.wgsl"),
+                &[("ARGS_GROUP", &GROUP_ARGS), ("ARGS_BINDING", &BINDING_ARGS)],
+            );
+        }
+        self.template(
+            0,
+            tail,
+            &[
                 ("TILE", &TILE),
                 ("LANES", &FINE_WORKGROUP),
                 ("PER_LANE", &FINE_PIXELS_PER_LANE),
