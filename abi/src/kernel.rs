@@ -15,7 +15,8 @@ pub mod entry {
     pub const REFERENCE: &str = "reference_main";
     pub const DYNAMIC_COARSE: &str = "dynamic_coarse_main";
     pub const DYNAMIC_FINE: &str = "dynamic_fine_main";
-    /// The per-pixel passes that write the outputs (but the reference's; see
+    /// The per-pixel passes that write the outputs (but the reference's and
+    /// the hierarchical mode's; see
     /// [`KernelKind::has_tile_lists`]), first: list every tile as a
     /// surface tile (a pixel in it is not background) or a background tile
     /// (every pixel is), in the tile lists (`TileLists`, `TileCounts`).
@@ -60,9 +61,8 @@ pub mod entry {
 }
 
 /// The hierarchical kernel's entry points in dispatch order: level 0, then per
-/// level 1 to 4 classify, args and (indirect) shade, then the final pass's
-/// tile lists (see [`KernelKind::has_tile_lists`]) and final.
-const HIERARCHICAL_ENTRY_POINTS: [&str; 17] = [
+/// level 1 to 4 classify, args and (indirect) shade, then final.
+const HIERARCHICAL_ENTRY_POINTS: [&str; 14] = [
     entry::HIER_LEVEL0,
     entry::HIER_CLASSIFY[0],
     entry::HIER_ARGS[0],
@@ -76,9 +76,6 @@ const HIERARCHICAL_ENTRY_POINTS: [&str; 17] = [
     entry::HIER_CLASSIFY[3],
     entry::HIER_ARGS[3],
     entry::HIER_SHADE[3],
-    entry::FINE_TILES,
-    entry::FINE_TILE_ARGS,
-    entry::FINE_BACKGROUND,
     entry::HIER_FINAL,
 ];
 
@@ -188,7 +185,8 @@ impl KernelKind {
     /// Whether the kernel's per-pixel pass can shade over tile lists (it has
     /// the `fine_tiles`, `fine_tile_args` and `fine_background` entry
     /// points, empty without a background rule): every per-pixel pass that
-    /// writes the outputs but the reference's.
+    /// writes the outputs but the reference's and the hierarchical mode's
+    /// (whose final pass measured no faster over them: docs/evaluation.md).
     pub fn has_tile_lists(self) -> bool {
         self.entry_points().contains(&entry::FINE_TILES)
     }

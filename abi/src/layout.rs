@@ -176,7 +176,7 @@ pub struct HierarchicalLayout {
 }
 
 /// The tile lists every per-pixel pass that writes the outputs (but the
-/// reference's) shades over in a program with a background rule: its
+/// reference's and the hierarchical mode's) shades over in a program with a background rule: its
 /// `fine_tiles` entry point lists each 8x8 tile as a surface tile or a
 /// wholly-background one, `fine_tile_args` writes the two lists' indirect
 /// dispatch arguments (bind group `args_group` of [`HierarchicalLayout`],

@@ -6,8 +6,7 @@
 //! refine flag among them, a small variance relative to their values) or
 //! the pixel must be shaded; pixels to shade are compacted into the level's work
 //! list, whose count the `hier_args_*` entry point turns into the indirect
-//! dispatch of `hier_shade_*`. `hier_final` reads the records per pixel
-//! (with a background rule over the surface tiles of the tile lists).
+//! dispatch of `hier_shade_*`. `hier_final` reads the records per pixel.
 //! The lattices, work-list capacities and queue layout are the runtime's
 //! too: they come from `mrsl_abi::geometry`.
 
@@ -122,7 +121,6 @@ impl Writer<'_, '_, '_> {
                 ],
             );
         }
-        self.tile_list_entries();
         let flag_words = self.i.layout.hierarchical.flag_words;
         let coarse = self.coarse_live().len();
         self.record_final(

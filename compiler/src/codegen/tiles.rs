@@ -1,5 +1,6 @@
 //! The tile lists of the per-pixel passes that write the outputs (every
-//! mode's but the reference's), where the program has a background rule: `fine_tiles` sorts the image's
+//! mode's but the reference's and the hierarchical mode's), where the
+//! program has a background rule: `fine_tiles` sorts the image's
 //! tiles into surface tiles (some pixel is not background) and background
 //! tiles, `fine_tile_args` turns the two lists' lengths into indirect
 //! arguments, `fine_background` shades the background tiles and the main
@@ -17,13 +18,12 @@ use super::Writer;
 use super::effects::Evaluation;
 use super::names::{GRID, LANE, LISTED_TILE, POS, REFINE_MASK, TILE_ORIGIN, WORKGROUP, WORKGROUP_STATS};
 use super::pixel::statistics_enabled;
-use super::writer::cut;
 use crate::syntax::ast::Rate;
 use mrsl_abi::geometry::{
     BACKGROUND_TILE_LIST, FINE_PIXELS_PER_LANE, FINE_WORKGROUP, QUEUE_WORDS_PER_LEVEL, SURFACE_TILE_LIST, TILE,
     TILE_LISTS,
 };
-use mrsl_abi::{BACKGROUND_MARK, BINDING_ARGS, GROUP_ARGS, GROUP_STAGE, KernelKind, entry};
+use mrsl_abi::{BACKGROUND_MARK, BINDING_ARGS, GROUP_ARGS, GROUP_STAGE, entry};
 
 impl Writer<'_, '_, '_> {
     /// Whether the kernel shades over tile lists: the per-pixel passes that
@@ -63,28 +63,15 @@ impl Writer<'_, '_, '_> {
             return;
         }
         let lists = &self.i.layout.tile_lists;
-        let [head, tail] = cut(include_str!("templates/tile_lists.wgsl"), &["ARGS"]);
         self.template(
             0,
-            head,
+            include_str!("templates/tile_lists.wgsl"),
             &[
                 ("GROUP", &GROUP_STAGE),
                 ("LIST_BINDING", &lists.list_binding),
                 ("COUNTS_BINDING", &lists.counts_binding),
-            ],
-        );
-        // The hierarchical kernel declares the arguments binding for its levels already.
-        if self.file != KernelKind::Hierarchical {
-            self.template(
-                0,
-                include_str!("templates/tile_args_binding.wgsl"),
-                &[("ARGS_GROUP", &GROUP_ARGS), ("ARGS_BINDING", &BINDING_ARGS)],
-            );
-        }
-        self.template(
-            0,
-            tail,
-            &[
+                ("ARGS_GROUP", &GROUP_ARGS),
+                ("ARGS_BINDING", &BINDING_ARGS),
                 ("TILE", &TILE),
                 ("LANES", &FINE_WORKGROUP),
                 ("PER_LANE", &FINE_PIXELS_PER_LANE),

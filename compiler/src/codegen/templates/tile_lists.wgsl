@@ -4,7 +4,7 @@
 // for `fine_tile_args`.
 @group({{GROUP}}) @binding({{LIST_BINDING}}) var<storage, read_write> mrsl_tiles: array<u32>;
 @group({{GROUP}}) @binding({{COUNTS_BINDING}}) var<storage, read_write> mrsl_tiles_n: array<atomic<u32>>;
-{{#ARGS}}
+@group({{ARGS_GROUP}}) @binding({{ARGS_BINDING}}) var<storage, read_write> mrsl_args: array<u32>;
 var<workgroup> mrsl_wg_tile: u32;
 var<workgroup> mrsl_wg_surface: atomic<u32>;
 
