@@ -151,16 +151,7 @@ impl Writer<'_, '_, '_> {
         }
         self.output_stores(&order, 2);
         self.line(1, "}");
-        self.template(
-            0,
-            include_str!("templates/stats_flush.wgsl"),
-            &[
-                ("COUNTERS", &self.workgroup_counters()),
-                ("TARGET", &self.counter_target()),
-                ("WORKGROUP", &PIXEL_WORKGROUP),
-                ("STATISTICS_ON", &super::pixel::statistics_enabled()),
-            ],
-        );
+        self.flush_workgroup_stats(PIXEL_WORKGROUP);
         self.line(0, "}");
     }
 

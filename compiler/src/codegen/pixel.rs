@@ -155,18 +155,24 @@ impl Writer<'_, '_, '_> {
             }
         }
         if counted {
-            self.template(
-                0,
-                include_str!("templates/stats_flush.wgsl"),
-                &[
-                    ("COUNTERS", &self.workgroup_counters()),
-                    ("TARGET", &self.counter_target()),
-                    ("WORKGROUP", &x),
-                    ("STATISTICS_ON", &statistics_enabled()),
-                ],
-            );
+            self.flush_workgroup_stats(x);
         }
         self.line(0, "}");
+    }
+
+    /// The end of a counting entry point of `lanes` lanes: the workgroup's
+    /// counters added to the statistics buffer once.
+    pub(super) fn flush_workgroup_stats(&mut self, lanes: u32) {
+        self.template(
+            0,
+            include_str!("templates/stats_flush.wgsl"),
+            &[
+                ("COUNTERS", &self.workgroup_counters()),
+                ("TARGET", &self.counter_target()),
+                ("WORKGROUP", &lanes),
+                ("STATISTICS_ON", &statistics_enabled()),
+            ],
+        );
     }
 
     /// One pixel's work at `mrsl_pos` (see [`Writer::pixel_main`]).

@@ -135,16 +135,7 @@ impl Writer<'_, '_, '_> {
             self.line(1, "}");
         }
         if counted {
-            self.template(
-                0,
-                include_str!("templates/stats_flush.wgsl"),
-                &[
-                    ("COUNTERS", &self.workgroup_counters()),
-                    ("TARGET", &self.counter_target()),
-                    ("WORKGROUP", &FINE_WORKGROUP),
-                    ("STATISTICS_ON", &statistics_enabled()),
-                ],
-            );
+            self.flush_workgroup_stats(FINE_WORKGROUP);
         }
         self.line(0, "}");
         self.line(0, "");
