@@ -10,7 +10,7 @@ use crate::types::{SampleType, TextureFormat, ValueType};
 use serde::{Deserialize, Serialize};
 
 /// The layout format this crate reads and writes (the `format` field).
-pub const LAYOUT_FORMAT: &str = "mrsl-layout/7";
+pub const LAYOUT_FORMAT: &str = "mrsl-layout/6";
 
 /// The refine mask's texel at a background pixel (x: no effect evaluated per
 /// pixel, y: all ones). A shaded pixel holds it only in a program with at
@@ -54,11 +54,11 @@ pub struct Layout {
     /// The dynamic mode's second (2x2) level of coarse samples: records of
     /// `interface.stride_words + 1` words, the last being a validity tag.
     pub interface2: ResourceBinding,
-    /// The hierarchical (DACS) and checkerboard modes' buffers.
+    /// The hierarchical (DACS) and checkerboard modes' buffers. The block
+    /// and dynamic fine kernels' tile lists and their counts (with a
+    /// background rule) take the binding numbers of its `work_binding` and
+    /// `queue_binding` (the plan says which resource each binds).
     pub hierarchical: HierarchicalLayout,
-    /// The tile lists of the per-pixel passes that write the outputs, in a
-    /// program with a background rule.
-    pub tile_lists: TileListsLayout,
     /// The rate-image mode's shading-rate image (`texture_2d<u32>`, one texel
     /// per tile, codes of [`crate::ShadingRate`]), read by both its kernels.
     /// Its coarse kernel's sample list and count take the binding numbers of
@@ -173,24 +173,6 @@ pub struct HierarchicalLayout {
     /// the `hier_args_*` entry points only: bind group `args_group`, binding 0. It is
     /// a separate group because a buffer cannot be indirect and writable in one dispatch.
     pub args_group: u32,
-}
-
-/// The tile lists every per-pixel pass that writes the outputs (but the
-/// reference's and the hierarchical mode's) shades over in a program with a background rule: its
-/// `fine_tiles` entry point lists each 8x8 tile as a surface tile or a
-/// wholly-background one, `fine_tile_args` writes the two lists' indirect
-/// dispatch arguments (bind group `args_group` of [`HierarchicalLayout`],
-/// binding 0), `fine_background` shades the background tiles and the pass's
-/// last entry point the surface tiles. Both bindings are in the stage
-/// group, at numbers no kernel uses for anything else.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TileListsLayout {
-    /// `array<u32>`, a word per tile (x | y << 16): the surface tiles from
-    /// the front, the background tiles from the back.
-    pub list_binding: u32,
-    /// `array<atomic<u32>>` of 2 words: the two lists' lengths (surface,
-    /// background), cleared before the pass.
-    pub counts_binding: u32,
 }
 
 /// The coarse effects that the block coarse kernel's derivatives read at

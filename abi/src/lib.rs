@@ -40,7 +40,7 @@ pub use kernel::{KernelKind, entry};
 pub use layout::{
     BACKGROUND_MARK, Background, BevyField, Channel, ControlBlock, Decode, EffectLayout, Field, HierarchicalLayout,
     InterfaceLayout, KeyCompare, LAYOUT_FORMAT, Layout, LevelsLayout, NeighbourLayout, NeighbourValue, Output, Rate,
-    RefineMaskTexel, Resample, ResourceBinding, ResourceKind, SlotLayout, StatsLayout, TileListsLayout, UniformBlock,
+    RefineMaskTexel, Resample, ResourceBinding, ResourceKind, SlotLayout, StatsLayout, UniformBlock,
 };
 pub use mode::{KernelRef, Mode, UnknownMode};
 pub use plan::{BindingType, Plan, ResourceId};

@@ -13,7 +13,7 @@ use mrsl_abi::{
     BINDING_CONTROL, BINDING_UNIFORMS, CONTROL_FIELDS, Channel, Control, ControlBlock, Decode, EffectLayout, Field,
     GROUP_ARGS, GROUP_GBUFFER, GROUP_RESOURCES, GROUP_STAGE, HierarchicalLayout, InterfaceLayout, LAYOUT_FORMAT,
     Layout, NeighbourLayout, NeighbourValue, Output, Plan, Resample, ResourceBinding, ResourceKind, SampleType,
-    SlotLayout, StatsLayout, TextureFormat, TileListsLayout, UniformBlock, ValueType,
+    SlotLayout, StatsLayout, TextureFormat, UniformBlock, ValueType,
 };
 use std::collections::{BTreeSet, HashMap};
 
@@ -263,11 +263,6 @@ pub fn build(
                 queue_binding: 5 + outputs,
                 args_group: GROUP_ARGS,
             }
-        },
-        // After the multi-rate mode's stored values, the last binding any kernel has.
-        tile_lists: TileListsLayout {
-            list_binding: level_values_binding(checked) + 1,
-            counts_binding: level_values_binding(checked) + 2,
         },
         outputs,
         effects,

@@ -320,8 +320,8 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
     };
     // With a background rule the per-pixel passes that write the outputs shade over tile lists.
     if kernel.kind.has_tile_lists() && layout.has_background() {
-        bindings.push(buffer(layout.tile_lists.list_binding, R::TileLists, false));
-        bindings.push(buffer(layout.tile_lists.counts_binding, R::TileCounts, false));
+        bindings.push(buffer(h.work_binding, R::TileLists, false));
+        bindings.push(buffer(h.queue_binding, R::TileCounts, false));
     }
     // With a background rule the coarse kernels count the background samples.
     // (The multi-rate mode counts its 2x2 samples, those of its finest grid.)

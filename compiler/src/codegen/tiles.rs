@@ -62,14 +62,14 @@ impl Writer<'_, '_, '_> {
             self.line(0, "");
             return;
         }
-        let lists = &self.i.layout.tile_lists;
+        let h = &self.i.layout.hierarchical;
         self.template(
             0,
             include_str!("templates/tile_lists.wgsl"),
             &[
                 ("GROUP", &GROUP_STAGE),
-                ("LIST_BINDING", &lists.list_binding),
-                ("COUNTS_BINDING", &lists.counts_binding),
+                ("LIST_BINDING", &h.work_binding),
+                ("COUNTS_BINDING", &h.queue_binding),
                 ("ARGS_GROUP", &GROUP_ARGS),
                 ("ARGS_BINDING", &BINDING_ARGS),
                 ("TILE", &TILE),
