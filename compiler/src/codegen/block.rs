@@ -589,7 +589,6 @@ impl Writer<'_, '_, '_> {
 
     /// Entry point of the block and dynamic fine kernels and of the reference kernel.
     pub(super) fn pixel_entry(&mut self) {
-        let listed = self.file.has_tile_lists();
         if self.compacts() {
             self.tile_pixel_blocks(self.block, 1);
             self.tile_list_entries();
@@ -600,9 +599,7 @@ impl Writer<'_, '_, '_> {
             // The reference kernel has no blocks; it lays its tiles out in 2x2 ones.
             _ => self.tile_pixel_blocks(2, 1),
         }
-        if listed {
-            self.tile_list_entries();
-        }
+        self.tile_list_entries();
         self.fine_main();
     }
 }

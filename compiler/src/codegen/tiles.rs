@@ -50,8 +50,12 @@ impl Writer<'_, '_, '_> {
     }
 
     /// The tile lists' bindings and helpers and the entry points before the
-    /// main one: `fine_tiles`, `fine_tile_args` and `fine_background`.
+    /// main one: `fine_tiles`, `fine_tile_args` and `fine_background`
+    /// (nothing in a kernel without them, such as the reference's).
     pub(super) fn tile_list_entries(&mut self) {
+        if !self.file.has_tile_lists() {
+            return;
+        }
         if !self.lists_tiles() {
             self.line(0, "// No background rule: the plan shades every tile with the main entry point and");
             self.line(0, "// dispatches none of these.");
