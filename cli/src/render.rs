@@ -222,10 +222,11 @@ impl Still<'_> {
         let (wall_ms, relative_to_reference) = self.wall_time(shader, mode)?;
         match relative_to_reference {
             Some(r) => eprintln!(
-                "{mode}: {wall_ms:.1} ms warm wall time, {:.2}x the reference's speed (median of {PAIRS} runs paired with the reference)",
+                "{mode}: {wall_ms:.1} ms {}, {:.2}x the reference's speed (median of {PAIRS} runs paired with the reference)",
+                crate::timing::clock(self.gpu).short(),
                 1.0 / r
             ),
-            None => eprintln!("{mode}: {wall_ms:.1} ms warm wall time"),
+            None => eprintln!("{mode}: {wall_ms:.1} ms {}", crate::timing::clock(self.gpu).short()),
         }
         let mut metrics = None;
         if args.compare {

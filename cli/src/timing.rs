@@ -1,6 +1,7 @@
-//! Wall-time measurement shared by `render --compare`, `render --frames`,
-//! `bench` and the ablation: one warm run timed from encoding to idle, runs
-//! paired with reference runs, and the median.
+//! Time measurement shared by `render --compare`, `render --frames`,
+//! `bench` and the ablation: one warm run timed (on a GPU by its
+//! timestamps, on a CPU device from encoding to idle), runs paired with
+//! reference runs, and the median.
 //!
 //! A shared machine has slow moments; pairing each run of a mode with a
 //! reference run beside it, alternately after and before it, makes a slow
@@ -17,14 +18,61 @@ use std::time::Instant;
 /// `render --compare` and `render --frames`.
 pub const PAIRS: usize = 3;
 
-/// One run of `options`, from encoding to idle: its wall time in ms.
+/// One run of `options`, in ms: on a GPU with timestamp queries the span
+/// of its passes' timestamps (the first pass's beginning to the last one's
+/// end: the shading work, without the encoding, submission and wait that a
+/// wall clock adds to a frame of a millisecond or two); elsewhere, and on a
+/// CPU device such as lavapipe, whose timestamps do not measure the shader
+/// work (docs/runtime.md, section 9), its wall time from encoding to idle.
+/// [`clock`] says which.
 pub fn time_run(gpu: &Gpu, shader: &mut Shader, bindings: &Bindings, options: DispatchOptions) -> Result<f64> {
     let start = Instant::now();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     shader.encode(&gpu.device, &gpu.queue, &mut encoder, bindings, options)?;
     gpu.queue.submit([encoder.finish()]);
     gpu.device.poll(wgpu::PollType::wait_indefinitely())?;
-    Ok(start.elapsed().as_secs_f64() * 1e3)
+    let wall = start.elapsed().as_secs_f64() * 1e3;
+    if clock(gpu) == Clock::GpuTimestamps {
+        // The period is the queue's: set here so that no caller can forget it.
+        shader.set_timestamp_period(&gpu.queue);
+        if let Some(timings) = shader.read_timings(&gpu.device)? {
+            return Ok(timings.total_ms);
+        }
+    }
+    Ok(wall)
+}
+
+/// What [`time_run`] measures on a device.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Clock {
+    /// The span of the passes' timestamps (a GPU with timestamp queries).
+    GpuTimestamps,
+    /// Wall time from encoding to idle.
+    Wall,
+}
+
+impl Clock {
+    /// How the reports name it.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Clock::GpuTimestamps => "GPU time (the span of the passes' timestamps)",
+            Clock::Wall => "wall time from encoding to idle",
+        }
+    }
+
+    /// The short name a line of progress gives a time.
+    pub fn short(self) -> &'static str {
+        match self {
+            Clock::GpuTimestamps => "GPU time",
+            Clock::Wall => "warm wall time",
+        }
+    }
+}
+
+/// The clock [`time_run`] uses on `gpu`.
+pub fn clock(gpu: &Gpu) -> Clock {
+    let timestamps = gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+    if timestamps && gpu.adapter_info.device_type != wgpu::DeviceType::Cpu { Clock::GpuTimestamps } else { Clock::Wall }
 }
 
 /// Runs `time` until the device is warm: at least [`WARM_UP_MIN`] runs,

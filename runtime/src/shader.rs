@@ -312,6 +312,18 @@ impl Shader {
         }
     }
 
+    /// Whether [`Shader::encode`] can run `mode` for a `size` image:
+    /// [`Shader::supports`], then the size against the limits of every
+    /// resource and indirect dispatch of the mode's plan (else
+    /// [`Error::BadSize`], saying which resource needs what; e.g. an
+    /// interface buffer past a 128 MiB storage binding). Lets a tool skip one
+    /// mode at a size another mode can still render.
+    pub fn supports_size(&self, mode: Mode, size: (u32, u32)) -> Result<(), Error> {
+        self.supports(mode)?;
+        let plan = self.plan.mode(mode).expect("checked by supports");
+        crate::validate::size(&self.plan, plan, size)
+    }
+
     /// Records the program's passes for one image into `encoder`. The
     /// statistics of the last dispatch can be read with [`Shader::read_stats`]
     /// after the encoder's commands were submitted.
@@ -455,10 +467,7 @@ impl Shader {
             read_buffer(device, buffer)
         };
         let counters = read(ResourceId::Statistics)?;
-        let timings = match &self.timestamps {
-            Some(t) => Some(timings(plan, &read_buffer(device, &t.readback)?, t.period_ns)),
-            None => None,
-        };
+        let timings = self.read_timings(device)?;
         let listed = match plan.counts.samples {
             SampleCount::Listed { resource, word } => read(resource)?[word] as u64,
             _ => 0,
@@ -474,6 +483,20 @@ impl Shader {
             stats.lane_utilisation = Some(if lanes == 0 { 1.0 } else { queued as f64 / lanes as f64 });
         }
         Ok(stats)
+    }
+    /// The GPU times of the last submitted dispatch's passes (waits for the
+    /// GPU), with statistics on or off; `None` where the device has no
+    /// timestamp queries. Meaningful on a GPU only: a CPU device such as
+    /// lavapipe writes a timestamp when its queue thread reaches it, not
+    /// when the shader work ends (docs/runtime.md, section 9). Call
+    /// [`Shader::set_timestamp_period`] first for times in milliseconds.
+    pub fn read_timings(&self, device: &wgpu::Device) -> Result<Option<crate::Timings>, Error> {
+        let (options, _) = self.last.ok_or_else(|| Error::Readback("nothing was dispatched yet".into()))?;
+        let plan = self.plan.mode(options.mode).expect("the last dispatch's mode has a plan");
+        match &self.timestamps {
+            Some(t) => Ok(Some(timings(plan, &read_buffer(device, &t.readback)?, t.period_ns))),
+            None => Ok(None),
+        }
     }
 }
 

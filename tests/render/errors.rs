@@ -86,6 +86,10 @@ pub fn binding_mismatches_are_typed_errors(gpu: &Gpu) {
         }
         other => panic!("expected a size error, got {other:?}"),
     }
+    // The same check without recording, per mode: the hierarchical mode
+    // cannot make its records at that size; another mode can still render.
+    assert!(matches!(shader.supports_size(Mode::Hierarchical, (16384, 16384)), Err(Error::BadSize { .. })));
+    assert!(matches!(shader.supports_size(Mode::Hierarchical, (16, 8)), Ok(())));
     // A target whose 2x2 sample grid is wider than a texture side the runtime
     // relies on (8192): the record texture could not be made.
     bindings.size = (16384, 8);

@@ -109,6 +109,8 @@ pub struct Suite {
     pub program: String,
     pub device: Device,
     pub adapters: Vec<Device>,
+    /// What the times and ratios measure ([`crate::timing::Clock::describe`]).
+    pub clock: &'static str,
     pub runs: usize,
     pub sizes: Vec<(u32, u32)>,
     pub scenes: Vec<SceneRun>,
@@ -129,8 +131,9 @@ pub fn suite(args: &SuiteArgs) -> Result<Vec<PathBuf>> {
     let gpu = Gpu::new()?;
     let device = Device::of(&gpu.adapter_info);
     let adapters: Vec<Device> = mrsl_lab::gpu::adapters().iter().map(Device::of).collect();
+    let clock = crate::timing::clock(&gpu).describe();
     eprintln!(
-        "suite: {name} on {} ({}, {}); adapters present: {}",
+        "suite: {name} on {} ({}, {}), timed by {clock}; adapters present: {}",
         device.name,
         device.backend,
         device.device_type,
@@ -163,6 +166,7 @@ pub fn suite(args: &SuiteArgs) -> Result<Vec<PathBuf>> {
         program: name,
         device,
         adapters,
+        clock,
         runs: args.runs.max(1),
         sizes: args.sizes.clone(),
         scenes,
@@ -223,7 +227,7 @@ fn measure_scene(
     let mut bound = Bound { gpu, shader, bindings, first_output, reference, size: scene.size, runs };
     let (mut modes, mut unsupported, mut background) = (vec![], vec![], 0);
     for mode in Mode::ALL.into_iter().filter(|m| *m != Mode::Reference) {
-        if let Err(e) = bound.shader.supports(mode) {
+        if let Err(e) = bound.shader.supports_size(mode, bound.size) {
             unsupported.push((mode, e.to_string()));
             continue;
         }

@@ -18,7 +18,7 @@ pub fn markdown(suite: &Suite) -> String {
     let _ = writeln!(
         md,
         "# mrsl scene suite\n\nProgram `{}`, every mode at its defaults (no per-scene tuning), on {} ({}, {}{}); \
-         adapters present: {}. Each ratio is the median over {} pairs of a run of the mode and a run of the reference \
+         adapters present: {}. Timed by {}. Each ratio is the median over {} pairs of a run of the mode and a run of the reference \
          beside it (alternately before and after); speedup = 1 / that ratio. Quality against the reference image of the \
          same program. Efficiency = speedup x coarse shaded fraction. Forced: every predicate true. Floor: the fixed \
          cost of the adaptive machinery (the block fine kernel with nothing refined; the hierarchical kernel shading \
@@ -29,6 +29,7 @@ pub fn markdown(suite: &Suite) -> String {
         d.device_type,
         if d.driver.is_empty() { String::new() } else { format!(", {}", d.driver) },
         if others.is_empty() { "none listed".into() } else { others.join("; ") },
+        suite.clock,
         suite.runs,
         suite.seconds
     );
@@ -135,11 +136,11 @@ fn summary(md: &mut String, runs: &[&SceneRun]) {
 fn scene_table(md: &mut String, run: &SceneRun) {
     let _ = writeln!(
         md,
-        "### {} ({}x{})\n\nReference {:.1} ms; background {:.1}% of the pixels.\n",
+        "### {} ({}x{})\n\nReference {} ms; background {:.1}% of the pixels.\n",
         run.scene,
         run.width,
         run.height,
-        run.reference_ms,
+        milliseconds(run.reference_ms),
         100.0 * run.background_fraction
     );
     let _ = writeln!(
@@ -151,10 +152,10 @@ fn scene_table(md: &mut String, run: &SceneRun) {
         let floor = m.floor_ratio.map_or("-".into(), |f| format!("{f:.3}"));
         let _ = writeln!(
             md,
-            "| {} | {:.2}x | {:.1} | {:.4} | {:.1} | {:.4} | {:.1}% | {:.1}% | {:.2} | {:.2} | {floor} |",
+            "| {} | {:.2}x | {} | {:.4} | {:.1} | {:.4} | {:.1}% | {:.1}% | {:.2} | {:.2} | {floor} |",
             m.mode,
             m.speedup,
-            m.wall_ms,
+            milliseconds(m.wall_ms),
             m.metrics.mssim,
             m.metrics.psnr,
             m.metrics.flip,
@@ -168,6 +169,16 @@ fn scene_table(md: &mut String, run: &SceneRun) {
         let _ = writeln!(md, "\n{mode} not run: {}", reason.replace('\n', " "));
     }
     md.push('\n');
+}
+
+/// A time in ms to three significant figures at least: a GPU's frame of
+/// 1.234 ms as that, lavapipe's of 860.4 ms to a tenth.
+fn milliseconds(ms: f64) -> String {
+    match ms {
+        ms if ms < 10.0 => format!("{ms:.3}"),
+        ms if ms < 100.0 => format!("{ms:.2}"),
+        ms => format!("{ms:.1}"),
+    }
 }
 
 #[cfg(test)]
