@@ -35,8 +35,6 @@ pub mod entry {
     pub const HIER_ARGS: [&str; 4] = ["hier_args_1", "hier_args_2", "hier_args_3", "hier_args_4"];
     /// Hierarchical levels 1 to 4: shade the compacted work list (indirect dispatch).
     pub const HIER_SHADE: [&str; 4] = ["hier_shade_1", "hier_shade_2", "hier_shade_3", "hier_shade_4"];
-    /// Hierarchical final pass: fine effects and outputs per pixel.
-    pub const HIER_FINAL: &str = "hier_final";
     /// Checkerboard: shade the coarse effects in half the 2x2 quads.
     pub const CB_SHADE: &str = "cb_shade";
     /// Checkerboard final pass: reconstruct, then fine effects and outputs per pixel.
@@ -61,8 +59,9 @@ pub mod entry {
 }
 
 /// The hierarchical kernel's entry points in dispatch order: level 0, then per
-/// level 1 to 4 classify, args and (indirect) shade, then final.
-const HIERARCHICAL_ENTRY_POINTS: [&str; 14] = [
+/// level 1 to 4 classify, args and (indirect) shade. There is no final pass:
+/// each pixel's outputs are written where its record is complete.
+const HIERARCHICAL_ENTRY_POINTS: [&str; 13] = [
     entry::HIER_LEVEL0,
     entry::HIER_CLASSIFY[0],
     entry::HIER_ARGS[0],
@@ -76,7 +75,6 @@ const HIERARCHICAL_ENTRY_POINTS: [&str; 14] = [
     entry::HIER_CLASSIFY[3],
     entry::HIER_ARGS[3],
     entry::HIER_SHADE[3],
-    entry::HIER_FINAL,
 ];
 
 /// Which kernel: each is one WGSL module with the entry points [`KernelKind::entry_points`] lists.
@@ -94,8 +92,9 @@ pub enum KernelKind {
     DynamicCoarse,
     /// Dynamic mode, per pixel: 4x4 value, else 2x2 value, else evaluated.
     DynamicFine,
-    /// Hierarchical (DACS) mode: level 0, four classified levels shading
-    /// compacted work lists, and a final per-pixel pass.
+    /// Hierarchical (DACS) mode: level 0 and four classified levels shading
+    /// compacted work lists; a pixel's outputs are written by the entry
+    /// point that completes its record.
     Hierarchical,
     /// Checkerboard baseline: coarse effects shaded in half the 2x2 quads,
     /// reconstructed in the others.
@@ -191,7 +190,8 @@ impl KernelKind {
         self.entry_points().contains(&entry::FINE_TILES)
     }
 
-    /// The entry point that writes the outputs (the last one dispatched).
+    /// The last entry point dispatched: the one that writes the outputs (in
+    /// the hierarchical kernel the last of several that do).
     pub fn main_entry_point(self) -> &'static str {
         let all = self.entry_points();
         all[all.len() - 1]
@@ -241,7 +241,8 @@ impl KernelKind {
         if matches!(self, KernelKind::Fine | KernelKind::DynamicFine | KernelKind::MultiResolve | KernelKind::MultiFine)
         {
             [FINE_WORKGROUP, 1, 1]
-        } else if self == KernelKind::RateCoarse {
+        } else if matches!(self, KernelKind::RateCoarse | KernelKind::Hierarchical) {
+            // Lanes over a work list (the hierarchical kernel's last entry point shades one).
             [WORK_LIST_WORKGROUP, 1, 1]
         } else if self.is_coarse() {
             [COARSE_WORKGROUP, COARSE_WORKGROUP, 1]

@@ -165,7 +165,7 @@ fn multi_rate_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
 }
 
 /// DACS: level 0, then per level classify into the work list, turn its
-/// count into indirect arguments and shade the list; then the final pass.
+/// count into indirect arguments and shade the list.
 fn hierarchical_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
     let kernel = KernelRef::new(KernelKind::Hierarchical, None);
     let level0 = HIERARCHICAL_LEVEL0;
@@ -190,10 +190,9 @@ fn hierarchical_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
         ));
     }
     steps.push(Step::Clear { resource: ResourceId::LevelCounts });
+    // No final pass: the entry point that completes a pixel's record writes
+    // its outputs.
     steps.push(pass(layout, "mrsl hierarchical levels", Stage::Coarse, kernel, levels));
-    // Not over tile lists: measured over the suite, they did not pay here
-    // (docs/evaluation.md, "Background tile lists").
-    steps.push(pass(layout, "mrsl hierarchical final", Stage::Fine, kernel, vec![tiles(entry::HIER_FINAL)]));
     steps.push(Step::Readback { resource: ResourceId::LevelCounts, bytes: None });
     Counts {
         samples: SampleCount::None,

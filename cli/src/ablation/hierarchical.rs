@@ -1,13 +1,13 @@
 //! The hierarchical (DACS) mode's ablation variants: edits of the
 //! hierarchical kernel, each removing one part of the machinery (level 0,
-//! the classification, the work lists and their shading, the final pass).
+//! the classification, the work lists and their shading, the outputs).
 //!
 //! The edits match the lines `compiler/src/codegen/hierarchical.rs` and its
 //! templates write: the classification's `if (disc ...) {` per effect, the
-//! level entry points' calls of `mrsl_classify` and `mrsl_shade`, the final
-//! pass's pixel guard.
+//! level entry points' calls of `mrsl_classify` and `mrsl_shade`, the calls
+//! of `mrsl_finish` that write a pixel's outputs.
 
-use super::block::{no_fine_work, no_instrumentation};
+use super::block::no_instrumentation;
 use super::{Variant, edit_lines, indent};
 use mrsl_abi::{CompiledProgram, KernelKind};
 
@@ -48,27 +48,12 @@ fn no_work_list_shading(w: &str) -> Option<String> {
     edit_lines(w, |l| l.trim_start().starts_with("mrsl_shade(vec2<i32>(i32(index % ").then(String::new))
 }
 
-/// The final pass's record reads (its coarse values read as zero).
-fn no_final_record_reads(w: &str) -> Option<String> {
-    // The type each `mrsl_hget_<e>` returns, from its signature.
-    let types: std::collections::HashMap<String, String> = w
-        .lines()
-        .filter_map(|l| {
-            let rest = l.strip_prefix("fn mrsl_hget_")?;
-            let (name, sig) = rest.split_once('(')?;
-            Some((name.to_string(), sig.rsplit_once("-> ")?.1.trim_end_matches(" {").to_string()))
-        })
-        .collect();
-    let final_pass = std::cell::Cell::new(false);
+/// The pixels' outputs: no call of `mrsl_finish` (their fine effects,
+/// outputs, refine mask and counts), wherever a pixel's record is completed.
+fn no_outputs(w: &str) -> Option<String> {
     edit_lines(w, |l| {
         let t = l.trim_start();
-        if t.starts_with("fn hier_final(") {
-            final_pass.set(true);
-        }
-        let (lhs, rhs) = t.strip_prefix("let ")?.split_once(" = mrsl_hget_")?;
-        let name = rhs.strip_suffix("(mrsl_pos);")?;
-        let ty = types.get(name)?;
-        final_pass.get().then(|| format!("{}let {lhs} = {ty}();", indent(l)))
+        (t.starts_with("mrsl_finish(") && t.ends_with(");")).then(String::new)
     })
 }
 
@@ -85,12 +70,7 @@ fn launches_only(w: &str) -> Option<String> {
 /// The variants. "Nothing shaded" is the mode's floor: what it costs where
 /// no pixel past level 0 needs shading; the ones after it take a further
 /// part out of that floor.
-pub(super) const VARIANTS: [Variant; 9] = [
-    Variant {
-        name: "no final record reads",
-        removes: "the final pass's reads of the coarse values from the records (they read as zero)",
-        edits: &[no_final_record_reads],
-    },
+pub(super) const VARIANTS: [Variant; 8] = [
     Variant {
         name: "no instrumentation",
         removes: "the statistics atomics, their barrier and the refine-mask store (`DispatchOptions::statistics` off)",
@@ -118,13 +98,13 @@ pub(super) const VARIANTS: [Variant; 9] = [
     },
     Variant {
         name: "floor, no classification",
-        removes: "also the classification of levels 1-4 (left: level 0 and the final pass)",
+        removes: "also the classification of levels 1-4 (left: level 0, its pixels' outputs)",
         edits: &[nothing_shaded, no_classification],
     },
     Variant {
-        name: "no final pass work",
-        removes: "everything the final pass does per pixel (record reads, fine effects, output stores)",
-        edits: &[no_fine_work],
+        name: "no outputs",
+        removes: "every pixel's outputs: its fine effects, output stores, refine mask and counts (`mrsl_finish`)",
+        edits: &[no_outputs],
     },
     Variant {
         name: "launches only",

@@ -6,16 +6,21 @@
 //! refine flag among them, a small variance relative to their values) or
 //! the pixel must be shaded; pixels to shade are compacted into the level's work
 //! list, whose count the `hier_args_*` entry point turns into the indirect
-//! dispatch of `hier_shade_*`. `hier_final` reads the records per pixel.
-//! The lattices, work-list capacities and queue layout are the runtime's
-//! too: they come from `mrsl_abi::geometry`.
+//! dispatch of `hier_shade_*`. A pixel's outputs are written where its
+//! record is complete, by the invocation that completed it (`mrsl_finish`:
+//! level 0 and the shading entry points after shading it, the
+//! classification where it interpolated every effect, and at a background
+//! pixel), from the values that invocation holds, so no pass reads the
+//! records again. The lattices, work-list capacities and queue layout are
+//! the runtime's too: they come from `mrsl_abi::geometry`.
 
 use super::Writer;
 use super::effects::Evaluation;
-use super::names::{CONTROL, COUNT, Name, POS, SET_WORD, WORD};
+use super::names::{CONTROL, COUNT, FINISH, Name, POS, SET_WORD, WORD};
 use super::records::{axis_neighbours, diagonal_neighbours, neighbours};
 use super::words::bit;
 use super::writer::cut;
+use crate::check::EffectId;
 use crate::types::{Scalar, Type};
 use mrsl_abi::entry;
 use mrsl_abi::geometry::{
@@ -91,6 +96,8 @@ impl Writer<'_, '_, '_> {
     /// Every entry point, in dispatch order, after the helpers they share.
     pub(super) fn hierarchical_entries(&mut self) {
         self.record_helpers();
+        self.pixel_values();
+        self.finish_function();
         self.work_lists();
         self.shade_function();
         self.level0();
@@ -100,61 +107,114 @@ impl Writer<'_, '_, '_> {
             // indirect arguments (x, y, z).
             let queue = (index as u32 + 1) * QUEUE_WORDS_PER_LEVEL;
             let neighbours = neighbours(level.neighbours);
-            self.template(
-                0,
-                include_str!("templates/level.wgsl"),
-                &[
-                    ("LEVEL", &(index + 1)),
-                    ("WHAT", &level.what),
-                    ("CLASSIFY_WORKGROUP", &lattice_workgroup()),
-                    ("CLASSIFY", &entry::HIER_CLASSIFY[index]),
-                    ("PIXEL", &lattice_pixel(*lattice)),
-                    ("NEIGHBOURS", &neighbours),
-                    ("ARGS", &entry::HIER_ARGS[index]),
-                    ("QUEUE", &queue),
-                    ("ARGS_X", &queue),
-                    ("ARGS_Y", &(queue + 1)),
-                    ("ARGS_Z", &(queue + 2)),
-                    ("WORK_GROUP_LESS_1", &(WORK_LIST_WORKGROUP - 1)),
-                    ("WORK_GROUP", &WORK_LIST_WORKGROUP),
-                    ("SHADE", &entry::HIER_SHADE[index]),
-                ],
-            );
+            let values: &super::writer::Values = &[
+                ("LEVEL", &(index + 1)),
+                ("WHAT", &level.what),
+                ("CLASSIFY_WORKGROUP", &lattice_workgroup()),
+                ("CLASSIFY", &entry::HIER_CLASSIFY[index]),
+                ("PIXEL", &lattice_pixel(*lattice)),
+                ("NEIGHBOURS", &neighbours),
+                ("ARGS", &entry::HIER_ARGS[index]),
+                ("QUEUE", &queue),
+                ("ARGS_X", &queue),
+                ("ARGS_Y", &(queue + 1)),
+                ("ARGS_Z", &(queue + 2)),
+                ("WORK_GROUP_LESS_1", &(WORK_LIST_WORKGROUP - 1)),
+                ("WORK_GROUP", &WORK_LIST_WORKGROUP),
+                ("SHADE", &entry::HIER_SHADE[index]),
+            ];
+            let [classify, shade, end] = cut(include_str!("templates/level.wgsl"), &["FLUSH_CLASSIFY", "FLUSH_SHADE"]);
+            self.template(0, classify, values);
+            self.flush_finished(COARSE_WORKGROUP * COARSE_WORKGROUP);
+            self.template(0, shade, values);
+            self.flush_finished(WORK_LIST_WORKGROUP);
+            self.template(0, end, values);
         }
+    }
+
+    /// `var<private> mrsl_pv_<effect>`: the values of the coarse effects at
+    /// the invocation's pixel as it stored them in the record, which
+    /// [`Self::finish_function`] reads instead of the record.
+    fn pixel_values(&mut self) {
+        let c = self.checked();
+        for e in self.coarse_live() {
+            let info = &c.effects[e.index()];
+            self.line(0, format!("var<private> {}: {};", Name::PixelValue.of(&info.name), info.ty.wgsl()));
+        }
+    }
+
+    /// `mrsl_finish(mrsl_pos)`: the pixel's outputs, once its record is
+    /// complete: the statistics (its refine mask and counts: the evaluated
+    /// bits of the record), then its fine effects and outputs with the
+    /// coarse values of `mrsl_pv_*`.
+    fn finish_function(&mut self) {
         let flag_words = self.i.layout.hierarchical.flag_words;
         let coarse = self.coarse_live().len();
-        self.record_final(
-            |w, _| {
-                if coarse == 0 {
-                    return;
-                }
-                let [head, end] = cut(include_str!("templates/hierarchical_final.wgsl"), &["COUNTS"]);
-                let background = w.background_here(POS);
-                let mask_y =
-                    if w.has_background() { format!("select(0u, 0xffffffffu, {background})") } else { "0u".into() };
-                w.template(
-                    0,
-                    head,
-                    &[
-                        ("FLAG_WORDS", &flag_words),
-                        ("STATISTICS_ON", &super::pixel::statistics_enabled()),
-                        ("MASK_Y", &mask_y),
-                    ],
-                );
-                for k in 0..coarse {
-                    let (word, mask) = bit(k as u32);
-                    w.count_refined(k, &format!("({WORD}({POS}, {}u) & {mask}u) != 0u", flag_words + word));
-                }
-                if w.has_background() {
-                    w.count_refined(coarse, &background);
-                }
-                w.template(0, end, &[]);
-            },
-            |w, e, indent| {
-                let name = &w.checked().effects[e.index()].name;
-                w.line(indent, format!("let {} = {}({POS});", w.effect_name(e), Name::RecordGet.of(name)));
-            },
-        );
+        let [head, statistics, body] = cut(include_str!("templates/finish.wgsl"), &["STATISTICS", "BODY"]);
+        self.template(0, head, &[]);
+        if self.counts_stats() {
+            let [open, end] = cut(include_str!("templates/finish_statistics.wgsl"), &["COUNTS"]);
+            let background = self.background_here(POS);
+            let mask_y =
+                if self.has_background() { format!("select(0u, 0xffffffffu, {background})") } else { "0u".into() };
+            self.template(
+                0,
+                open,
+                &[
+                    ("FLAG_WORDS", &flag_words),
+                    ("STATISTICS_ON", &super::pixel::statistics_enabled()),
+                    ("MASK_Y", &mask_y),
+                ],
+            );
+            for k in 0..coarse {
+                let (word, mask) = bit(k as u32);
+                let evaluated = format!("({WORD}({POS}, {}u) & {mask}u) != 0u", flag_words + word);
+                self.count_refined_at(2, k, &evaluated);
+            }
+            if self.has_background() {
+                self.count_refined_at(2, coarse, &background);
+            }
+            self.template(0, end, &[]);
+        }
+        self.template(0, statistics, &[]);
+        let mut prologue = |_: &mut Self, _| {};
+        let mut coarse_value = |w: &mut Self, e: EffectId, indent: usize| {
+            let name = &w.checked().effects[e.index()].name;
+            w.line(indent, format!("let {} = {};", w.effect_name(e), Name::PixelValue.of(name)));
+        };
+        self.pixel_body(1, &mut prologue, &mut coarse_value);
+        self.template(0, body, &[]);
+    }
+
+    /// Where the background rule makes pixel `p` background (refinement not
+    /// forced): its record holds zeros and no evaluated bit, its outputs are
+    /// written with every coarse effect as zero, and the function returns;
+    /// so it is neither shaded nor interpolated.
+    fn background_pixel(&mut self, indent: usize) {
+        if !self.has_background() {
+            return;
+        }
+        let c = self.checked();
+        let h = &self.i.layout.hierarchical;
+        self.line(indent, format!("if ({}) {{", self.background_here("p")));
+        for w in 0..h.record_words {
+            self.line(indent + 1, format!("{SET_WORD}(p, {w}u, 0u);"));
+        }
+        for e in self.coarse_live() {
+            let info = &c.effects[e.index()];
+            self.line(indent + 1, format!("{} = {}();", Name::PixelValue.of(&info.name), info.ty.wgsl()));
+        }
+        self.line(indent + 1, format!("{}(p);", FINISH));
+        self.line(indent + 1, "return;");
+        self.line(indent, "}");
+    }
+
+    /// The end of an entry point that finishes pixels: its workgroup's
+    /// statistics added up, where the kernel counts them.
+    fn flush_finished(&mut self, lanes: u32) {
+        if self.counts_stats() {
+            self.flush_workgroup_stats(lanes);
+        }
     }
 
     /// `mrsl_count` and `mrsl_work_offset`: where each level's work list
@@ -209,25 +269,24 @@ impl Writer<'_, '_, '_> {
     /// Level 0: every pixel of its lattice is shaded.
     fn level0(&mut self) {
         let coarse = self.coarse_live().len() as u32;
-        let [head, tail] = cut(include_str!("templates/level0.wgsl"), &["MASKS"]);
-        self.template(
-            0,
-            head,
-            &[
-                ("STEP", &HIERARCHICAL_LEVEL0.step),
-                ("WORKGROUP", &lattice_workgroup()),
-                ("ENTRY", &entry::HIER_LEVEL0),
-                ("PIXEL", &lattice_pixel(HIERARCHICAL_LEVEL0)),
-            ],
-        );
-        self.background_record(1);
+        let [head, entry, end] = cut(include_str!("templates/level0.wgsl"), &["MASKS", "FLUSH"]);
+        let values: &super::writer::Values = &[
+            ("STEP", &HIERARCHICAL_LEVEL0.step),
+            ("WORKGROUP", &lattice_workgroup()),
+            ("ENTRY", &entry::HIER_LEVEL0),
+            ("PIXEL", &lattice_pixel(HIERARCHICAL_LEVEL0)),
+        ];
+        self.template(0, head, values);
+        self.background_pixel(1);
         let h = &self.i.layout.hierarchical;
         for w in 0..h.mask_words {
             let bits = coarse.saturating_sub(w * 32).min(32);
             let mask = if bits == 32 { u32::MAX } else { (1u32 << bits) - 1 };
             self.line(1, format!("{SET_WORD}(p, {}u, {mask}u);", h.flag_words + w));
         }
-        self.template(0, tail, &[]);
+        self.template(0, entry, values);
+        self.flush_finished(COARSE_WORKGROUP * COARSE_WORKGROUP);
+        self.template(0, end, values);
     }
 
     /// `mrsl_classify(p, n, level)`: per coarse effect, interpolate pixel `p`
@@ -239,7 +298,7 @@ impl Writer<'_, '_, '_> {
         let [head, keys, effects, end] =
             cut(include_str!("templates/classify.wgsl"), &["BACKGROUND", "KEYS", "EFFECTS"]);
         self.template(0, head, &[]);
-        self.background_record(1);
+        self.background_pixel(1);
         self.template(0, keys, &[]);
         for key in self.keys_of(&self.coarse_live()) {
             let name = key.name;

@@ -47,6 +47,9 @@ pub(super) enum Name {
     RecordGet,
     /// `mrsl_hput_<effect>`: a coarse effect's value stored into a pixel's record.
     RecordPut,
+    /// `mrsl_pv_<effect>`: the hierarchical kernel's value of a coarse effect at the
+    /// invocation's pixel, as it stored it in the record (a private variable).
+    PixelValue,
     /// `mrsl_reconstruct_<effect>`: the checkerboard mode's reconstruction of an effect.
     Reconstruct,
     /// `mrsl_cv_<effect>`: the compacted fine pass's values of an effect, per lane.
@@ -95,7 +98,7 @@ pub(super) enum Name {
 impl Name {
     /// Every family, for the tests that check names against this module.
     #[cfg_attr(not(test), expect(dead_code, reason = "read by the tests"))]
-    pub(super) const ALL: [Name; 33] = [
+    pub(super) const ALL: [Name; 34] = [
         Name::Eval,
         Name::Val,
         Name::At,
@@ -108,6 +111,7 @@ impl Name {
         Name::Get,
         Name::RecordGet,
         Name::RecordPut,
+        Name::PixelValue,
         Name::Reconstruct,
         Name::CompactValues,
         Name::Todo,
@@ -146,6 +150,7 @@ impl Name {
             Name::Get => "mrsl_get",
             Name::RecordGet => "mrsl_hget_",
             Name::RecordPut => "mrsl_hput_",
+            Name::PixelValue => "mrsl_pv_",
             Name::Reconstruct => "mrsl_reconstruct_",
             Name::CompactValues => "mrsl_cv_",
             Name::Todo => "mrsl_todo_",
@@ -269,6 +274,8 @@ pub(super) const WORD: &str = "mrsl_word";
 pub(super) const SET_WORD: &str = "mrsl_set_word";
 /// `mrsl_count(start, step, extent)`: a hierarchical lattice's points along an axis.
 pub(super) const COUNT: &str = "mrsl_count";
+/// `mrsl_finish(pos)`: the hierarchical kernel's outputs of a pixel whose record is complete.
+pub(super) const FINISH: &str = "mrsl_finish";
 
 /// The words of one record, and the coarse kernels' block size.
 pub(super) const STRIDE: &str = "MRSL_STRIDE";
@@ -352,6 +359,8 @@ pub(super) const FIXED: &[&str] = &[
     "mrsl_work_offset",
     "mrsl_shade",
     "mrsl_classify",
+    "mrsl_level0",
+    FINISH,
     "mrsl_mask",
     // tile_lists.wgsl: the lists, their lengths, the workgroup's tile and whether it has surface
     "mrsl_tiles",

@@ -176,7 +176,7 @@ impl Writer<'_, '_, '_> {
     }
 
     /// One pixel's work at `mrsl_pos` (see [`Writer::pixel_main`]).
-    fn pixel_body(
+    pub(super) fn pixel_body(
         &mut self,
         indent: usize,
         prologue: &mut impl FnMut(&mut Self, Scope),
@@ -231,7 +231,12 @@ impl Writer<'_, '_, '_> {
     /// Counts coarse effect `k` as re-evaluated by this pixel where `condition`
     /// holds (inside a `statistics_on` block, hence the indentation).
     pub(super) fn count_refined(&mut self, k: usize, condition: &str) {
-        self.line(3, format!("if ({condition}) {{ atomicAdd(&{WORKGROUP_STATS}[{k}], 1u); }}"));
+        self.count_refined_at(3, k, condition);
+    }
+
+    /// [`Self::count_refined`] at an indentation.
+    pub(super) fn count_refined_at(&mut self, indent: usize, k: usize, condition: &str) {
+        self.line(indent, format!("if ({condition}) {{ atomicAdd(&{WORKGROUP_STATS}[{k}], 1u); }}"));
     }
 
     /// Opens the block of instrumentation a dispatch runs only with

@@ -61,23 +61,6 @@ impl Writer<'_, '_, '_> {
         self.line(0, "");
     }
 
-    /// Where the background rule makes pixel `p` background (refinement not
-    /// forced): its record holds zeros and no evaluated bit, and the entry
-    /// point returns; so it is neither shaded nor interpolated, and the
-    /// final pass reads zeros there.
-    pub(super) fn background_record(&mut self, indent: usize) {
-        if !self.has_background() {
-            return;
-        }
-        let h = &self.i.layout.hierarchical;
-        self.line(indent, format!("if ({}) {{", self.background_here("p")));
-        for w in 0..h.record_words {
-            self.line(indent + 1, format!("{SET_WORD}(p, {w}u, 0u);"));
-        }
-        self.line(indent + 1, "return;");
-        self.line(indent, "}");
-    }
-
     /// The neighbour-pair test both record modes decide with, over
     /// `ok: array<bool, 4>` and the neighbours `{points}[k]` in opposite pairs
     /// (0, 1) and (2, 3): `ok[k]` is whether neighbour k lies inside the

@@ -1,6 +1,6 @@
 // Decides, per coarse effect, whether pixel `p` interpolates its four previous-level
 // neighbours `n` (those inside the image and on its side of every key the effect
-// reads) or is shaded; queues it for shading if any effect is.
+// reads) or is shaded; queues it for shading if any effect is, else writes its outputs.
 fn mrsl_classify(p: vec2<i32>, n: array<vec2<i32>, 4>, level: u32) {
     let size = vec2<i32>(mrsl_ctl.size);
     var inside: array<bool, 4>;
@@ -16,5 +16,8 @@ fn mrsl_classify(p: vec2<i32>, n: array<vec2<i32>, 4>, level: u32) {
     if (({{ANY_MASK}}) != 0u) {
         let slot = atomicAdd(&mrsl_queue[level * {{QUEUE_WORDS}}u], 1u);
         mrsl_work[mrsl_work_offset(level) + slot] = u32(p.y) * mrsl_ctl.size.x + u32(p.x);
+    } else {
+        // Every effect interpolated: the record is complete.
+        mrsl_finish(p);
     }
 }

@@ -24,5 +24,6 @@
             mask{{WORD}} |= {{MASK}}u;
         } else {
             mrsl_hput_{{NAME}}(p, {{VALUE}});
+            mrsl_pv_{{NAME}} = {{VALUE}};
         }
     }

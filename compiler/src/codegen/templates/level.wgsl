@@ -1,9 +1,11 @@
 // Level {{LEVEL}}: {{WHAT}}.
 @compute @workgroup_size({{CLASSIFY_WORKGROUP}})
-fn {{CLASSIFY}}(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn {{CLASSIFY}}(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {
     let p = {{PIXEL}};
-    if (any(p >= vec2<i32>(mrsl_ctl.size))) { return; }
-    mrsl_classify(p, {{NEIGHBOURS}}, {{LEVEL}}u);
+    if (all(p < vec2<i32>(mrsl_ctl.size))) {
+        mrsl_classify(p, {{NEIGHBOURS}}, {{LEVEL}}u);
+    }
+{{#FLUSH_CLASSIFY}}
 }
 
 @compute @workgroup_size(1, 1, 1)
@@ -16,9 +18,11 @@ fn {{ARGS}}() {
 
 // Shades the compacted work list of the level: every lane has a pixel to shade.
 @compute @workgroup_size({{WORK_GROUP}}, 1, 1)
-fn {{SHADE}}(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= atomicLoad(&mrsl_queue[{{QUEUE}}u])) { return; }
-    let index = mrsl_work[mrsl_work_offset({{LEVEL}}u) + gid.x];
-    mrsl_shade(vec2<i32>(i32(index % mrsl_ctl.size.x), i32(index / mrsl_ctl.size.x)));
+fn {{SHADE}}(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {
+    if (gid.x < atomicLoad(&mrsl_queue[{{QUEUE}}u])) {
+        let index = mrsl_work[mrsl_work_offset({{LEVEL}}u) + gid.x];
+        mrsl_shade(vec2<i32>(i32(index % mrsl_ctl.size.x), i32(index / mrsl_ctl.size.x)));
+    }
+{{#FLUSH_SHADE}}
 }
 

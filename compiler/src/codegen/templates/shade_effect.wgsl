@@ -6,3 +6,4 @@ if ((mrsl_word(mrsl_pos, {{WORD}}u) & {{MASK}}u) != 0u) {
 } else {
     {{VAR}} = mrsl_hget_{{NAME}}(mrsl_pos);
 }
+mrsl_pv_{{NAME}} = {{VAR}};
