@@ -38,14 +38,19 @@ fn no_level0_shading(w: &str) -> Option<String> {
     edit_lines(w, |l| (l.trim_start() == "mrsl_shade(p);").then(String::new))
 }
 
-/// The classification of levels 1 to 4: their entry points return at once.
+/// The classification of levels 1 to 4, and so their pixels' outputs:
+/// their entry points do nothing but the statistics' flush.
 fn no_classification(w: &str) -> Option<String> {
-    edit_lines(w, |l| l.trim_start().starts_with("mrsl_classify(p, array<vec2<i32>, 4>(").then(String::new))
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        t.starts_with("if (mrsl_classify(p, array<vec2<i32>, 4>(").then(|| format!("{}if (false) {{", indent(l)))
+    })
 }
 
-/// The shading of the work lists (pixels are still queued and counted).
+/// The shading of the work lists (pixels are still queued and counted, and
+/// their outputs written).
 fn no_work_list_shading(w: &str) -> Option<String> {
-    edit_lines(w, |l| l.trim_start().starts_with("mrsl_shade(vec2<i32>(i32(index % ").then(String::new))
+    edit_lines(w, |l| (l.trim_start() == "mrsl_shade(listed);").then(String::new))
 }
 
 /// The pixels' outputs: no call of `mrsl_finish` (their fine effects,
@@ -98,7 +103,7 @@ pub(super) const VARIANTS: [Variant; 8] = [
     },
     Variant {
         name: "floor, no classification",
-        removes: "also the classification of levels 1-4 (left: level 0, its pixels' outputs)",
+        removes: "also the classification of levels 1-4 and their pixels' outputs (left: level 0 and its outputs)",
         edits: &[nothing_shaded, no_classification],
     },
     Variant {
@@ -140,6 +145,11 @@ mod tests {
             assert_ne!(&edited, kernel, "{}", v.name);
             mrsl::validate_wgsl(&edited).unwrap_or_else(|e| panic!("{}: {e}", v.name));
         }
+        // Each edit finds the lines of its own part and no other's: level 0
+        // shades at one call, the work lists at one per level.
+        assert_eq!(kernel.matches("mrsl_shade(p);").count(), 1);
+        assert_eq!(kernel.matches("mrsl_shade(listed);").count(), 4);
+        assert_eq!(kernel.matches("if (mrsl_classify(p, ").count(), 4);
         let floor = nothing_shaded(kernel).unwrap();
         assert!(!floor.contains("if (disc"), "the floor still tests an effect");
     }

@@ -16,7 +16,7 @@
 
 use super::Writer;
 use super::effects::Evaluation;
-use super::names::{CONTROL, COUNT, FINISH, Name, POS, SET_WORD, WORD};
+use super::names::{CONTROL, COUNT, Name, POS, SET_WORD, WORD};
 use super::records::{axis_neighbours, diagonal_neighbours, neighbours};
 use super::words::bit;
 use super::writer::cut;
@@ -187,10 +187,10 @@ impl Writer<'_, '_, '_> {
     }
 
     /// Where the background rule makes pixel `p` background (refinement not
-    /// forced): its record holds zeros and no evaluated bit, its outputs are
-    /// written with every coarse effect as zero, and the function returns;
-    /// so it is neither shaded nor interpolated.
-    fn background_pixel(&mut self, indent: usize) {
+    /// forced): its record holds zeros and no evaluated bit, every coarse
+    /// effect's value is zero for `mrsl_finish`, and the function returns
+    /// with `returns`; so it is neither shaded nor interpolated.
+    fn background_pixel(&mut self, indent: usize, returns: &str) {
         if !self.has_background() {
             return;
         }
@@ -204,8 +204,7 @@ impl Writer<'_, '_, '_> {
             let info = &c.effects[e.index()];
             self.line(indent + 1, format!("{} = {}();", Name::PixelValue.of(&info.name), info.ty.wgsl()));
         }
-        self.line(indent + 1, format!("{}(p);", FINISH));
-        self.line(indent + 1, "return;");
+        self.line(indent + 1, returns);
         self.line(indent, "}");
     }
 
@@ -277,7 +276,7 @@ impl Writer<'_, '_, '_> {
             ("PIXEL", &lattice_pixel(HIERARCHICAL_LEVEL0)),
         ];
         self.template(0, head, values);
-        self.background_pixel(1);
+        self.background_pixel(1, "return;");
         let h = &self.i.layout.hierarchical;
         for w in 0..h.mask_words {
             let bits = coarse.saturating_sub(w * 32).min(32);
@@ -298,7 +297,7 @@ impl Writer<'_, '_, '_> {
         let [head, keys, effects, end] =
             cut(include_str!("templates/classify.wgsl"), &["BACKGROUND", "KEYS", "EFFECTS"]);
         self.template(0, head, &[]);
-        self.background_pixel(1);
+        self.background_pixel(1, "return true;");
         self.template(0, keys, &[]);
         for key in self.keys_of(&self.coarse_live()) {
             let name = key.name;

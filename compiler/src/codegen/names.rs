@@ -274,8 +274,6 @@ pub(super) const WORD: &str = "mrsl_word";
 pub(super) const SET_WORD: &str = "mrsl_set_word";
 /// `mrsl_count(start, step, extent)`: a hierarchical lattice's points along an axis.
 pub(super) const COUNT: &str = "mrsl_count";
-/// `mrsl_finish(pos)`: the hierarchical kernel's outputs of a pixel whose record is complete.
-pub(super) const FINISH: &str = "mrsl_finish";
 
 /// The words of one record, and the coarse kernels' block size.
 pub(super) const STRIDE: &str = "MRSL_STRIDE";
@@ -360,7 +358,7 @@ pub(super) const FIXED: &[&str] = &[
     "mrsl_shade",
     "mrsl_classify",
     "mrsl_level0",
-    FINISH,
+    "mrsl_finish",
     "mrsl_mask",
     // tile_lists.wgsl: the lists, their lengths, the workgroup's tile and whether it has surface
     "mrsl_tiles",

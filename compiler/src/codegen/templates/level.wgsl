@@ -2,8 +2,12 @@
 @compute @workgroup_size({{CLASSIFY_WORKGROUP}})
 fn {{CLASSIFY}}(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {
     let p = {{PIXEL}};
+    // One call of mrsl_finish per entry point: a device that runs every branch
+    // with its lanes masked (llvmpipe) would run each call site.
     if (all(p < vec2<i32>(mrsl_ctl.size))) {
-        mrsl_classify(p, {{NEIGHBOURS}}, {{LEVEL}}u);
+        if (mrsl_classify(p, {{NEIGHBOURS}}, {{LEVEL}}u)) {
+            mrsl_finish(p);
+        }
     }
 {{#FLUSH_CLASSIFY}}
 }
@@ -21,7 +25,9 @@ fn {{ARGS}}() {
 fn {{SHADE}}(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {
     if (gid.x < atomicLoad(&mrsl_queue[{{QUEUE}}u])) {
         let index = mrsl_work[mrsl_work_offset({{LEVEL}}u) + gid.x];
-        mrsl_shade(vec2<i32>(i32(index % mrsl_ctl.size.x), i32(index / mrsl_ctl.size.x)));
+        let listed = vec2<i32>(i32(index % mrsl_ctl.size.x), i32(index / mrsl_ctl.size.x));
+        mrsl_shade(listed);
+        mrsl_finish(listed);
     }
 {{#FLUSH_SHADE}}
 }

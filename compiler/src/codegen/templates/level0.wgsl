@@ -1,4 +1,4 @@
-// Level 0's pixel `p`: every coarse effect is shaded.
+// Level 0's pixel `p`: every coarse effect is shaded (none at a background pixel).
 fn mrsl_level0(p: vec2<i32>) {
 {{#MASKS}}
     mrsl_shade(p);
@@ -10,6 +10,7 @@ fn {{ENTRY}}(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invoc
     let p = {{PIXEL}};
     if (all(p < vec2<i32>(mrsl_ctl.size))) {
         mrsl_level0(p);
+        mrsl_finish(p);
     }
 {{#FLUSH}}
 }
