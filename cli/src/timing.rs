@@ -81,17 +81,29 @@ pub fn clock(gpu: &Gpu) -> Clock {
 /// (once measured on lavapipe: the reference at 960x540 took 340 ms for
 /// six runs, then 175-180 ms), which one warm-up run does not cover and
 /// which would weigh on the first mode measured.
+///
+/// It also runs for at least [`WARM_UP_WALL`] of wall time: a GPU raises
+/// its clock only under load sustained for some milliseconds, and runs of
+/// a millisecond at its idle clock agree with each other too.
 pub fn warm_up(mut time: impl FnMut() -> Result<f64>) -> Result<()> {
+    let start = Instant::now();
     let mut last = time()?;
     for run in 1..WARM_UP_MAX {
         let now = time()?;
-        if run + 1 >= WARM_UP_MIN && (now - last).abs() <= 0.1 * last.min(now) {
+        let settled = run + 1 >= WARM_UP_MIN && (now - last).abs() <= 0.1 * last.min(now);
+        if settled && start.elapsed() >= WARM_UP_WALL {
             break;
         }
         last = now;
     }
+    while start.elapsed() < WARM_UP_WALL {
+        time()?;
+    }
     Ok(())
 }
+
+/// The least wall time [`warm_up`] runs for.
+pub const WARM_UP_WALL: std::time::Duration = std::time::Duration::from_millis(300);
 
 /// The fewest warm-up runs of [`warm_up`].
 pub const WARM_UP_MIN: usize = 3;

@@ -13,7 +13,7 @@ mod report;
 
 use crate::ablation::{refining_nothing, shading_nothing};
 use crate::setup::{Resources, WORKLOAD_PROGRAM, bind_scene, compile_program};
-use crate::timing::{median, paired, time_run, warm_up};
+use crate::timing::{Clock, median, paired, time_run, warm_up};
 use anyhow::{Context, Result, anyhow, bail};
 use mrsl_abi::CompiledProgram;
 use mrsl_abi::shading_rate::DEFAULT_RATE_TILE;
@@ -295,7 +295,7 @@ impl Bound<'_> {
         // The median ratio to the reference and the median wall time.
         let ratio =
             |shader: &mut Shader, bindings: &Bindings, options: DispatchOptions, runs: usize| -> Result<(f64, f64)> {
-                time_run(gpu, shader, bindings, options)?;
+                warm(gpu, || time_run(gpu, shader, bindings, options))?;
                 let p = paired(runs, options, reference, |o| time_run(gpu, shader, bindings, o))?;
                 Ok((median(p.ratios), median(p.walls)))
             };
@@ -331,7 +331,7 @@ impl Bound<'_> {
     /// the full program's shader), median over the pairs.
     fn floor_ratio(&mut self, floor: &mut Shader, options: DispatchOptions) -> Result<f64> {
         let (gpu, bindings) = (self.gpu, &self.bindings);
-        time_run(gpu, floor, bindings, options)?;
+        warm(gpu, || time_run(gpu, floor, bindings, options))?;
         let reference = DispatchOptions::new(Mode::Reference).uninstrumented();
         let shader = &mut self.shader;
         let p = paired(self.runs, options, reference, |o| match o.mode {
@@ -339,6 +339,18 @@ impl Bound<'_> {
             _ => time_run(gpu, floor, bindings, o),
         })?;
         Ok(median(p.ratios))
+    }
+}
+
+/// Before a mode's timed pairs: on a GPU, [`warm_up`], since a GPU lowers
+/// its clock while the suite compares images on the CPU between modes (an
+/// H200 idles at 345 MHz and runs at up to 1980), and runs of a millisecond
+/// or two would otherwise be timed before it climbs back; on a CPU device
+/// one run, as the suite's time there is minutes per scene.
+fn warm(gpu: &Gpu, mut time: impl FnMut() -> Result<f64>) -> Result<()> {
+    match crate::timing::clock(gpu) {
+        Clock::GpuTimestamps => warm_up(time),
+        Clock::Wall => time().map(|_| ()),
     }
 }
 
