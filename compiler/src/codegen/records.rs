@@ -1,10 +1,11 @@
 //! Per-pixel records, shared by the hierarchical and checkerboard modes:
 //! both shade coarse effects at some pixels into a record per pixel
-//! (`mrsl_values`, layout `hierarchical`), fill the other pixels' records
-//! from neighbours that were shaded, and finish with one final per-pixel
-//! pass that reads the coarse values from the records. What they share: the
+//! (`mrsl_values`, layout `hierarchical`) and fill the other pixels from
+//! neighbours that were shaded (the hierarchical kernel writes each
+//! pixel's outputs where it completes its record; the checkerboard kernel
+//! in a final per-pixel pass that reads the records). What they share: the
 //! record binding and accessors, the neighbour-pair test (neighbours in
-//! opposite pairs, only complete pairs used) and the final pass.
+//! opposite pairs, only complete pairs used) and the final pass's shape.
 
 use super::Writer;
 use super::names::{SET_WORD, WORD};
@@ -80,7 +81,7 @@ impl Writer<'_, '_, '_> {
         self.template(0, tail, &values);
     }
 
-    /// The final pass of a record mode: one lane per pixel of a tile in row
+    /// The final pass of a record mode (the checkerboard's): one lane per pixel of a tile in row
     /// order, `prologue`, then coarse effects as `coarse` writes them and
     /// the others evaluated, then the outputs (see [`Writer::pixel_main`]).
     pub(super) fn record_final(
