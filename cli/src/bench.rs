@@ -428,7 +428,7 @@ fn controller_run(
     let bar = progress_bar(args.path_frames, "controller [{bar:30}] {pos}/{len} {msg} ({elapsed})")?;
     let mut frames = vec![];
     // A CPU device's timestamps do not measure the shader work (docs/runtime.md, section 9).
-    let timestamps_meaningful = gpu.adapter_info.device_type != wgpu::DeviceType::Cpu;
+    let timestamps_meaningful = crate::timing::clock(gpu) == crate::timing::Clock::GpuTimestamps;
     let mut bench = Bench { gpu, shader, runs: 1 };
     for i in 0..args.path_frames {
         let camera = CameraPath::Walk.camera(&mesh.camera, i, args.path_frames);
