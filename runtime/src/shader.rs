@@ -335,10 +335,9 @@ impl Shader {
         bindings: &Bindings,
         options: DispatchOptions,
     ) -> Result<(), Error> {
-        self.supports(options.mode)?;
+        self.supports_size(options.mode, bindings.size)?;
         let whole = Arc::clone(&self.plan);
         let plan = whole.mode(options.mode).expect("checked by supports");
-        crate::validate::size(&whole, plan, bindings.size)?;
         crate::validate::bindings(&self.layout, plan, bindings, options.rate_tile)?;
         let uniform_bytes = match &self.layout.uniforms {
             Some(block) => Some(self.uniform_values.bytes(block)?),
@@ -484,6 +483,7 @@ impl Shader {
         }
         Ok(stats)
     }
+
     /// The GPU times of the last submitted dispatch's passes (waits for the
     /// GPU), with statistics on or off; `None` where the device has no
     /// timestamp queries. Meaningful on a GPU only: a CPU device such as

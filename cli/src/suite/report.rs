@@ -186,6 +186,13 @@ mod tests {
     use super::*;
 
     #[test]
+    fn times_keep_three_figures() {
+        assert_eq!(milliseconds(0.4412), "0.441");
+        assert_eq!(milliseconds(12.345), "12.35");
+        assert_eq!(milliseconds(860.42), "860.4");
+    }
+
+    #[test]
     fn the_geometric_mean_of_ratios() {
         assert!((geomean(&[2.0, 8.0]) - 4.0).abs() < 1e-12);
         assert!(geomean(&[]).is_nan());
