@@ -77,6 +77,22 @@ pub struct Layout {
 }
 
 impl Layout {
+    /// The most storage textures one kernel's pipeline binds in its compute
+    /// stage: the channels read through storage bindings (group 1, in every
+    /// kernel's pipeline) and the storage textures of its stage group. A
+    /// device whose `maxStorageTexturesPerShaderStage` is lower refuses that
+    /// kernel (WebGPU's default is 4).
+    pub fn storage_textures_per_stage(&self) -> u32 {
+        let channels = self.channels.iter().filter(|c| c.access == ChannelAccess::Storage).count() as u32;
+        let stage = self
+            .plan
+            .modes
+            .iter()
+            .flat_map(|m| m.passes())
+            .map(|p| p.bindings.iter().filter(|b| b.ty.is_storage_texture()).count() as u32);
+        channels + stage.max().unwrap_or(0)
+    }
+
     /// Parses a layout written by [`Layout::to_json`] (or `mrslc compile`),
     /// rejecting another format version.
     pub fn from_json(text: &str) -> Result<Layout, String> {
@@ -296,6 +312,33 @@ pub struct Channel {
     /// it is not stored as its type (absent from the JSON otherwise).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub decode: Option<Decode>,
+    /// How the kernels bind the channel's texture (absent from the JSON when
+    /// sampled, the default).
+    #[serde(default, skip_serializing_if = "ChannelAccess::is_sampled")]
+    pub access: ChannelAccess,
+}
+
+/// How the kernels bind a G-buffer channel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ChannelAccess {
+    /// A sampled texture (`texture_2d<T>` or `texture_depth_2d`) read with
+    /// `textureLoad`: any format of the channel's sample type with enough
+    /// components, `TEXTURE_BINDING`.
+    #[default]
+    Sampled,
+    /// A read-only storage texture (`texture_storage_2d<FORMAT, read>`):
+    /// exactly the channel's format, `STORAGE_BINDING`, and one storage
+    /// texture more per shader stage in every kernel's pipeline. llvmpipe
+    /// (lavapipe) reads a storage texel for about a third of what a sampled
+    /// one costs, through its sampler code.
+    Storage,
+}
+
+impl ChannelAccess {
+    pub fn is_sampled(&self) -> bool {
+        *self == ChannelAccess::Sampled
+    }
 }
 
 /// How a channel is computed from an engine's encoding of it (`@depth`,

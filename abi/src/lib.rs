@@ -38,9 +38,10 @@ mod types;
 pub use control::{CONTROL_FIELDS, Control, ControlField};
 pub use kernel::{KernelKind, entry};
 pub use layout::{
-    BACKGROUND_MARK, Background, BevyField, Channel, ControlBlock, Decode, EffectLayout, Field, HierarchicalLayout,
-    InterfaceLayout, KeyCompare, LAYOUT_FORMAT, Layout, LevelsLayout, NeighbourLayout, NeighbourValue, Output, Rate,
-    RefineMaskTexel, Resample, ResourceBinding, ResourceKind, SlotLayout, StatsLayout, UniformBlock,
+    BACKGROUND_MARK, Background, BevyField, Channel, ChannelAccess, ControlBlock, Decode, EffectLayout, Field,
+    HierarchicalLayout, InterfaceLayout, KeyCompare, LAYOUT_FORMAT, Layout, LevelsLayout, NeighbourLayout,
+    NeighbourValue, Output, Rate, RefineMaskTexel, Resample, ResourceBinding, ResourceKind, SlotLayout, StatsLayout,
+    UniformBlock,
 };
 pub use mode::{KernelRef, Mode, UnknownMode};
 pub use plan::{BindingType, Plan, ResourceId};

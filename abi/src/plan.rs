@@ -303,6 +303,16 @@ pub enum BindingType {
     WordTexture,
 }
 
+impl BindingType {
+    /// Whether it counts towards a stage's storage-texture limit.
+    pub fn is_storage_texture(self) -> bool {
+        matches!(
+            self,
+            BindingType::StorageTexture { .. } | BindingType::RecordStorageTexture | BindingType::WordTexture
+        )
+    }
+}
+
 /// A runtime-owned resource: what it is called in errors and how it is sized.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ResourceDesc {

@@ -197,6 +197,14 @@ impl TextureFormat {
         }
     }
 
+    /// Whether a shader may read it through a read-only storage binding:
+    /// every colour format here is a storage format of WebGPU's core, whose
+    /// storage textures may be read-only (WGSL's
+    /// `readonly_and_readwrite_storage_textures`); a depth format is not.
+    pub fn storage_readable(self) -> bool {
+        self != TextureFormat::Depth32Float
+    }
+
     /// Number of channels.
     pub fn components(self) -> u32 {
         match self {

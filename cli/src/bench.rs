@@ -5,7 +5,7 @@
 
 use crate::output::save_image;
 use crate::report::{self, ControllerFrame, Point};
-use crate::setup::{BoundScene, Resources, WORKLOAD_PROGRAM, bind_scene, compile_program};
+use crate::setup::{BoundScene, DeviceProgram, Resources, WORKLOAD_PROGRAM, bind_scene, compile_for_device};
 use crate::timing::{median, paired, time_run};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -178,8 +178,8 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>> {
     // The kernels of the modes measured, and of the reference every point is compared with.
     let mut modes = vec![Mode::Reference];
     modes.extend(args.modes.iter().copied().filter(|m| *m != Mode::Reference));
-    let (name, program) = compile_program(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &modes)?;
-    let gpu = Gpu::new()?;
+    let DeviceProgram { name, program, gpu } =
+        compile_for_device(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &modes)?;
     let device_name = format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
     eprintln!("bench: {name} on {device_name}, {}x{}, {} runs per point (median)", args.size.0, args.size.1, args.runs);
     std::fs::create_dir_all(&args.out_dir)

@@ -73,6 +73,12 @@ enum Command {
         /// With --emit coarse or fine: the block size of the kernel printed.
         #[arg(short, long = "block", value_parser = ["2", "4"], default_value = "4")]
         block: String,
+        /// Read the G-buffer channels through read-only storage bindings (faster on
+        /// lavapipe): the engine's textures must have exactly the layout's formats and
+        /// STORAGE_BINDING, and the device must allow the layout's storage textures per
+        /// stage (one more per channel), past WebGPU's default 4 (docs/runtime.md).
+        #[arg(long)]
+        storage_channels: bool,
     },
     /// Render a program over a scene with the wgpu runtime (lavapipe works).
     ///
@@ -326,7 +332,9 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         Command::Check { file } => check(cli.color, file),
         Command::Render(r) => Ok(written(render::render(&r.args()))),
         Command::Bench(b) => bench(b),
-        Command::Compile { file, out_dir, emit, mode, block } => compile(cli.color, file, out_dir, *emit, mode, block),
+        Command::Compile { file, out_dir, emit, mode, block, storage_channels } => {
+            compile(cli.color, file, out_dir, *emit, mode, block, *storage_channels)
+        }
         Command::Gbuffer(g) => Ok(written(gbuffer_command(g))),
         Command::Serve { host, port } => serve::serve(host, *port).map(|()| ExitCode::SUCCESS),
     }
@@ -466,9 +474,10 @@ fn compile(
     emit: Option<Emit>,
     mode: &args::ModeList,
     block: &str,
+    storage_channels: bool,
 ) -> Result<ExitCode> {
     let (name, source) = read(file)?;
-    let options = Options { file_name: name.clone(), ..Options::for_modes(&mode.0) };
+    let options = Options { file_name: name.clone(), storage_channels, ..Options::for_modes(&mode.0) };
     let program = match mrsl::compile(&source, &options) {
         Ok(p) => p,
         Err(diagnostics) => {

@@ -5,9 +5,12 @@
 use crate::args::RenderArgs;
 use crate::legend::{self, Legend};
 use crate::output::{save_heatmap, save_image, save_texels, with_suffix};
-use crate::setup::{BoundProgram, BoundScene, DEMO_PROGRAM, Resources, bind_program, bind_scene, compile_program};
+use crate::setup::{
+    BoundProgram, BoundScene, DEMO_PROGRAM, DeviceProgram, Resources, bind_program, bind_scene, compile_for_device,
+};
 use crate::timing::{PAIRS, median, paired, time_run};
 use anyhow::{Context, Result, anyhow, bail};
+use mrsl_abi::ChannelAccess;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::metrics::Metrics;
 use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader, Stats};
@@ -76,12 +79,21 @@ fn open(args: &RenderArgs) -> Result<Session> {
              examples/sponza_lights.mrsl uses the light rig of mesh scenes)"
         );
     }
-    let (name, program) = compile_program(args.program.as_deref(), ("demo.mrsl", DEMO_PROGRAM), &modes)?;
-    progress(&format!("compiled {name}: {} kernels", program.kernels.len()), start);
-
-    let start = Instant::now();
-    let gpu = Gpu::new()?;
-    progress(&format!("device: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend), start);
+    let DeviceProgram { name, program, gpu } =
+        compile_for_device(args.program.as_deref(), ("demo.mrsl", DEMO_PROGRAM), &modes)?;
+    let access = match program.layout.channels.iter().any(|c| c.access == ChannelAccess::Storage) {
+        true => "storage",
+        false => "sampled",
+    };
+    progress(
+        &format!(
+            "compiled {name}: {} kernels, G-buffer read through {access} bindings; device: {} ({:?})",
+            program.kernels.len(),
+            gpu.adapter_info.name,
+            gpu.adapter_info.backend
+        ),
+        start,
+    );
     let start = Instant::now();
     let mut scene = bind_scene(&gpu, &args.scene, args.size)?;
     let size = scene.size;

@@ -5,6 +5,7 @@
 
 use anyhow::{Result, anyhow, bail};
 use mrsl::Options;
+use mrsl_abi::ChannelAccess;
 use mrsl_lab::camera_path::CameraPath;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::mesh_scene::MeshScene;
@@ -26,13 +27,57 @@ pub const WORKLOAD_PROGRAM: &str = include_str!("../../examples/sponza_lights.mr
 /// source)`, to the kernels of `modes` alone; returns its name for messages
 /// and the program, or the diagnostics rendered.
 pub fn compile_program(path: Option<&Path>, builtin: (&str, &str), modes: &[Mode]) -> Result<(String, mrsl::Program)> {
-    let (name, source) = match path {
+    let (name, source) = read_program(path, builtin)?;
+    let program = compile(&name, &source, modes, false)?;
+    Ok((name, program))
+}
+
+/// A program compiled for the device it runs on, and that device.
+pub struct DeviceProgram {
+    /// The program's name, for messages.
+    pub name: String,
+    pub program: mrsl::Program,
+    pub gpu: Gpu,
+}
+
+/// Reads and compiles the program as [`compile_program`] does, and makes the
+/// device. The kernels read the G-buffer through read-only storage bindings
+/// (`Options::storage_channels`), for which llvmpipe charges about a third
+/// of a sampled read, where the adapter grants the storage textures that
+/// adds to every kernel (one per channel) on top of WebGPU's default limit:
+/// so a mode that the default limit refuses with sampled channels is refused
+/// with storage channels too. Where it does not, they read the channels
+/// sampled, and a note says so. The images are the same either way.
+pub fn compile_for_device(path: Option<&Path>, builtin: (&str, &str), modes: &[Mode]) -> Result<DeviceProgram> {
+    let (name, source) = read_program(path, builtin)?;
+    let program = compile(&name, &source, modes, true)?;
+    let channels = program.layout.channels.iter().filter(|c| c.access == ChannelAccess::Storage).count() as u32;
+    let wanted = wgpu::Limits::default().max_storage_textures_per_shader_stage + channels;
+    let gpu = Gpu::with_storage_textures(wanted)?;
+    let granted = gpu.device.limits().max_storage_textures_per_shader_stage;
+    if granted >= wanted {
+        return Ok(DeviceProgram { name, program, gpu });
+    }
+    eprintln!(
+        "note: {} allows {granted} storage textures per shader stage, fewer than the {wanted} that reading the \
+         G-buffer's {channels} channels through storage bindings takes: the kernels read them sampled",
+        gpu.adapter_info.name
+    );
+    let program = compile(&name, &source, modes, false)?;
+    Ok(DeviceProgram { name, program, gpu })
+}
+
+/// The program at `path`, or the built-in `(name, source)`: its name for messages and its source.
+fn read_program(path: Option<&Path>, builtin: (&str, &str)) -> Result<(String, String)> {
+    Ok(match path {
         Some(path) => (path.display().to_string(), crate::read_source(path)?),
         None => (format!("{} (built in)", builtin.0), builtin.1.to_string()),
-    };
-    let options = Options { file_name: name.clone(), ..Options::for_modes(modes) };
-    let program = mrsl::compile(&source, &options).map_err(|d| anyhow!(mrsl::render_all(&d, &name, &source)))?;
-    Ok((name, program))
+    })
+}
+
+fn compile(name: &str, source: &str, modes: &[Mode], storage_channels: bool) -> Result<mrsl::Program> {
+    let options = Options { file_name: name.to_string(), storage_channels, ..Options::for_modes(modes) };
+    mrsl::compile(source, &options).map_err(|d| anyhow!(mrsl::render_all(&d, name, source)))
 }
 
 /// A scene ready to bind: its G-buffer textures, the image size, the

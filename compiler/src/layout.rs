@@ -10,10 +10,10 @@ use crate::interface::Interface;
 use crate::syntax::ast::Rate;
 use crate::types::{Scalar, Type, round_up};
 use mrsl_abi::{
-    BINDING_CONTROL, BINDING_UNIFORMS, CONTROL_FIELDS, Channel, Control, ControlBlock, Decode, EffectLayout, Field,
-    GROUP_ARGS, GROUP_GBUFFER, GROUP_RESOURCES, GROUP_STAGE, HierarchicalLayout, InterfaceLayout, LAYOUT_FORMAT,
-    Layout, NeighbourLayout, NeighbourValue, Output, Plan, Resample, ResourceBinding, ResourceKind, SampleType,
-    SlotLayout, StatsLayout, TextureFormat, UniformBlock, ValueType,
+    BINDING_CONTROL, BINDING_UNIFORMS, CONTROL_FIELDS, Channel, ChannelAccess, Control, ControlBlock, Decode,
+    EffectLayout, Field, GROUP_ARGS, GROUP_GBUFFER, GROUP_RESOURCES, GROUP_STAGE, HierarchicalLayout, InterfaceLayout,
+    LAYOUT_FORMAT, Layout, NeighbourLayout, NeighbourValue, Output, Plan, Resample, ResourceBinding, ResourceKind,
+    SampleType, SlotLayout, StatsLayout, TextureFormat, UniformBlock, ValueType,
 };
 use std::collections::{BTreeSet, HashMap};
 
@@ -144,6 +144,7 @@ pub fn build(
                 key: input.key.clone(),
                 background: input.background,
                 decode: input.decode.clone(),
+                access: ChannelAccess::Sampled,
             }
         })
         .collect();
@@ -275,6 +276,17 @@ pub fn build(
 
 /// The binding of the multi-rate mode's stored values in the stage group,
 /// after the neighbour values'.
+/// Binds every channel whose format a storage binding can read (all but
+/// those rebuilt from depth) as a read-only storage texture
+/// ([`crate::Options::storage_channels`]).
+pub fn read_channels_from_storage(layout: &mut Layout) {
+    for channel in &mut layout.channels {
+        if channel.format.storage_readable() && channel.sample_type != SampleType::Depth {
+            channel.access = ChannelAccess::Storage;
+        }
+    }
+}
+
 pub fn level_values_binding(checked: &Checked) -> u32 {
     8 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32
 }

@@ -114,6 +114,18 @@ pub struct Options {
     /// `mrslc bench --ablation`); on GPUs, whose barriers are cheap, it is
     /// the layout He et al. describe, but it has not been measured on one.
     pub compact: bool,
+    /// Read the G-buffer channels through read-only storage texture bindings
+    /// instead of sampled ones: every channel but those rebuilt from depth
+    /// ([`mrsl_abi::ChannelAccess::Storage`] in the layout). The engine's
+    /// textures must then have exactly the layout's formats and
+    /// `STORAGE_BINDING`, and every kernel binds one storage texture more
+    /// per such channel, beyond WebGPU's default limit of 4 for most
+    /// programs ([`mrsl_abi::Layout::storage_textures_per_stage`] says how
+    /// many). The images are the same bit for bit. Off by default; on
+    /// lavapipe a storage texel costs about a third of a sampled one, and
+    /// the hierarchical mode, which loads the key channels of five pixels
+    /// per pixel, gains most (docs/evaluation.md).
+    pub storage_channels: bool,
 }
 
 impl Default for Options {
@@ -125,7 +137,7 @@ impl Default for Options {
 impl Options {
     /// Options that compile for `modes` alone.
     pub fn for_modes(modes: &[Mode]) -> Options {
-        Options { modes: modes.to_vec(), file_name: "program.mrsl".into(), compact: false }
+        Options { modes: modes.to_vec(), file_name: "program.mrsl".into(), compact: false, storage_channels: false }
     }
 
     /// The kernels [`compile`] generates with these options: those of the
@@ -190,6 +202,9 @@ fn generate(
     let interface = interface::allocate(checked, graph);
     let costs = budget::evaluation_costs(checked, graph, deriv);
     let mut layout = layout::build(checked, graph, deriv, &interface, &costs);
+    if options.storage_channels {
+        layout::read_channels_from_storage(&mut layout);
+    }
     let levels = options.modes.contains(&Mode::MultiRate).then(|| rates::levels(checked, graph));
     if let Some(levels) = &levels {
         layout.levels = Some(levels.layout(checked, layout::level_values_binding(checked)));

@@ -81,7 +81,17 @@ impl Gpu {
         (pipeline, group)
     }
 
+    /// The default adapter with WebGPU's default limits (those every
+    /// browser gives), at the adapter's largest image sizes.
     pub fn new() -> Result<Gpu, Error> {
+        Gpu::with_storage_textures(wgpu::Limits::default().max_storage_textures_per_shader_stage)
+    }
+
+    /// The same, with up to `per_stage` storage textures per shader stage
+    /// where the adapter allows as many (else the adapter's most): what
+    /// kernels that read the G-buffer through storage bindings need
+    /// (`mrsl::Options::storage_channels`).
+    pub fn with_storage_textures(per_stage: u32) -> Result<Gpu, Error> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
@@ -92,18 +102,26 @@ impl Gpu {
         .map_err(|e| Error::NoAdapter(format!("{e} (on a machine without a GPU, install Mesa's lavapipe: apt-get install mesa-vulkan-drivers libvulkan1)")))?;
         let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
         let features = adapter.features() & wanted;
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("mrsl"),
-            required_features: features,
-            required_limits: wgpu::Limits::default().using_resolution(adapter.limits()),
-            ..Default::default()
-        }))
+        let (device, queue) = pollster::block_on(
+            adapter.request_device(&wgpu::DeviceDescriptor {
+                label: Some("mrsl"),
+                required_features: features,
+                required_limits: wgpu::Limits {
+                    max_storage_textures_per_shader_stage: per_stage
+                        .min(adapter.limits().max_storage_textures_per_shader_stage)
+                        .max(wgpu::Limits::default().max_storage_textures_per_shader_stage),
+                    ..wgpu::Limits::default().using_resolution(adapter.limits())
+                },
+                ..Default::default()
+            }),
+        )
         .map_err(|e| Error::Device(e.to_string()))?;
         Ok(Gpu { adapter_info: adapter.get_info(), device, queue })
     }
 
     /// Creates a 2D texture and fills it with `data` (tightly packed rows);
-    /// it can be sampled, and read back with [`Gpu::read_texture`].
+    /// it can be sampled, read through a storage binding where its format
+    /// allows ([`storage_readable`]), and read back with [`Gpu::read_texture`].
     pub fn texture_with_data(
         &self,
         label: &str,
@@ -111,8 +129,10 @@ impl Gpu {
         format: wgpu::TextureFormat,
         data: &[u8],
     ) -> wgpu::Texture {
-        let usage =
-            wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC;
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_DST
+            | wgpu::TextureUsages::COPY_SRC
+            | storage_readable(format);
         let texture = self.texture_2d(label, size, format, usage);
         let bytes_per_pixel = format.block_copy_size(None).unwrap_or(4);
         self.queue.write_texture(
@@ -180,4 +200,12 @@ impl Gpu {
     pub fn read_rgba32f(&self, texture: &wgpu::Texture) -> Result<Vec<[f32; 4]>, Error> {
         Ok(bytemuck::pod_collect_to_vec(&self.read_texture(texture)?))
     }
+}
+
+/// `STORAGE_BINDING` where every device can read `format` through a storage
+/// binding, else no usage: the G-buffer textures the lab makes can then be
+/// bound either way (`mrsl_abi::ChannelAccess`).
+pub fn storage_readable(format: wgpu::TextureFormat) -> wgpu::TextureUsages {
+    let features = format.guaranteed_format_features(wgpu::Features::empty());
+    features.allowed_usages & wgpu::TextureUsages::STORAGE_BINDING
 }

@@ -542,7 +542,8 @@ impl Rasterizer {
             .map(|&(name, format)| {
                 let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
                     | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC;
+                    | wgpu::TextureUsages::COPY_SRC
+                    | crate::gpu::storage_readable(format);
                 (name.to_string(), texture(name, format, usage))
             })
             .collect();

@@ -26,6 +26,12 @@ pub enum Error {
         "G-buffer channel `{channel}` is rebuilt from depth (`@depth`), so it binds the engine's depth texture (Depth32Float, Depth24Plus, Depth16Unorm or a depth-stencil format), but a {found:?} texture was bound"
     )]
     ChannelNotDepth { channel: String, found: wgpu::TextureFormat },
+    /// A channel the kernels read through a storage binding
+    /// ([`mrsl_abi::ChannelAccess::Storage`]), whose format must be the layout's.
+    #[error(
+        "G-buffer channel `{channel}` has format {found:?}, but the kernels read it through a storage binding of format {expected:?}, which takes no other: bind a {expected:?} texture, or compile without storage channels (`Options::storage_channels`) to read it sampled"
+    )]
+    ChannelStorageFormat { channel: String, expected: wgpu::TextureFormat, found: wgpu::TextureFormat },
     #[error(
         "G-buffer channel `{channel}` was not created with TextureUsages::{missing}, which the kernels need to read it: add it to the texture's usage"
     )]

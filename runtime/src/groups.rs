@@ -6,7 +6,7 @@
 use crate::shader::Bindings;
 use crate::wgpu_format;
 use mrsl_abi::plan::{BindingType, PassBinding};
-use mrsl_abi::{BINDING_ARGS, Layout, SampleType};
+use mrsl_abi::{BINDING_ARGS, Channel, ChannelAccess, Layout, SampleType};
 
 pub(crate) fn resources_layout(device: &wgpu::Device, l: &Layout) -> wgpu::BindGroupLayout {
     let uniform = |binding| wgpu::BindGroupLayoutEntry {
@@ -54,21 +54,33 @@ pub(crate) fn gbuffer_layout(device: &wgpu::Device, l: &Layout) -> wgpu::BindGro
         .map(|c| wgpu::BindGroupLayoutEntry {
             binding: c.binding,
             visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Texture {
-                sample_type: match c.sample_type {
-                    SampleType::Uint => wgpu::TextureSampleType::Uint,
-                    SampleType::Sint => wgpu::TextureSampleType::Sint,
-                    SampleType::UnfilterableFloat => wgpu::TextureSampleType::Float { filterable: false },
-                    SampleType::Depth => wgpu::TextureSampleType::Depth,
-                },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
+            ty: channel_binding_type(c),
             count: None,
         })
         .collect();
     device
         .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("mrsl g-buffer"), entries: &entries })
+}
+
+/// How the kernels bind a channel: sampled, or read-only storage of exactly its format.
+fn channel_binding_type(c: &Channel) -> wgpu::BindingType {
+    match c.access {
+        ChannelAccess::Storage => wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::ReadOnly,
+            format: wgpu_format(c.format),
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        ChannelAccess::Sampled => wgpu::BindingType::Texture {
+            sample_type: match c.sample_type {
+                SampleType::Uint => wgpu::TextureSampleType::Uint,
+                SampleType::Sint => wgpu::TextureSampleType::Sint,
+                SampleType::UnfilterableFloat => wgpu::TextureSampleType::Float { filterable: false },
+                SampleType::Depth => wgpu::TextureSampleType::Depth,
+            },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+    }
 }
 
 /// The stage group of a kernel, from the bindings a pass of the plan lists.
@@ -183,7 +195,9 @@ pub(crate) fn gbuffer_group(
             } else {
                 wgpu::TextureAspect::All
             };
-            let view = wgpu::TextureViewDescriptor { aspect, ..Default::default() };
+            // A storage binding takes one mip level: the kernels read level 0.
+            let mip_level_count = (c.access == ChannelAccess::Storage).then_some(1);
+            let view = wgpu::TextureViewDescriptor { aspect, mip_level_count, ..Default::default() };
             (c.binding, bindings.channels[&c.name].create_view(&view))
         })
         .collect();

@@ -7,7 +7,7 @@ use crate::gpu::{layout_format, wgpu_format};
 use crate::shader::Bindings;
 use mrsl_abi::geometry::MAX_SIDE;
 use mrsl_abi::plan::{MAX_WORKGROUPS_PER_DIMENSION, ModePlan, TooLarge, Workgroups};
-use mrsl_abi::{Channel, Decode, Layout, Output, Plan, ResourceId, SampleType, TextureFormat};
+use mrsl_abi::{Channel, ChannelAccess, Decode, Layout, Output, Plan, ResourceId, SampleType, TextureFormat};
 
 /// The image size: not empty, within [`MAX_SIDE`], and within the limits of
 /// every resource the mode makes and every indirect dispatch it records.
@@ -67,9 +67,11 @@ pub(crate) fn bindings(layout: &Layout, mode: &ModePlan, bindings: &Bindings, ra
 }
 
 /// A G-buffer channel's texture: a depth format exactly when the channel is
-/// rebuilt from depth, else a format of the channel's sample type with
-/// enough components (of what its encoding stores), `TEXTURE_BINDING`, a
-/// single-sample 2D texture of one layer.
+/// rebuilt from depth; else, read sampled, a format of the channel's sample
+/// type with enough components (of what its encoding stores) and
+/// `TEXTURE_BINDING`, or read through a storage binding, exactly the
+/// layout's format and `STORAGE_BINDING`; a single-sample 2D texture of one
+/// layer.
 fn channel(ch: &Channel, t: &wgpu::Texture) -> Result<(), Error> {
     let (found, expected) = (t.format(), wgpu_format(ch.format));
     let from_depth = matches!(ch.decode, Some(Decode::Depth { .. }));
@@ -84,6 +86,12 @@ fn channel(ch: &Channel, t: &wgpu::Texture) -> Result<(), Error> {
     if from_depth {
         if !found.has_depth_aspect() {
             return Err(Error::ChannelNotDepth { channel: ch.name.clone(), found });
+        }
+        return usage_and_shape(ch, t);
+    }
+    if ch.access == ChannelAccess::Storage {
+        if found != expected {
+            return Err(Error::ChannelStorageFormat { channel: ch.name.clone(), expected, found });
         }
         return usage_and_shape(ch, t);
     }
@@ -106,10 +114,16 @@ fn channel(ch: &Channel, t: &wgpu::Texture) -> Result<(), Error> {
     usage_and_shape(ch, t)
 }
 
-/// A channel's texture has `TEXTURE_BINDING` and is a single-sample 2D texture of one layer.
+/// A channel's texture has the usage its binding needs (`TEXTURE_BINDING`,
+/// or `STORAGE_BINDING` for a storage channel) and is a single-sample 2D
+/// texture of one layer.
 fn usage_and_shape(ch: &Channel, t: &wgpu::Texture) -> Result<(), Error> {
-    if !t.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING) {
-        return Err(Error::ChannelUsage { channel: ch.name.clone(), missing: "TEXTURE_BINDING" });
+    let (usage, missing) = match ch.access {
+        ChannelAccess::Sampled => (wgpu::TextureUsages::TEXTURE_BINDING, "TEXTURE_BINDING"),
+        ChannelAccess::Storage => (wgpu::TextureUsages::STORAGE_BINDING, "STORAGE_BINDING"),
+    };
+    if !t.usage().contains(usage) {
+        return Err(Error::ChannelUsage { channel: ch.name.clone(), missing });
     }
     match shape(t, false) {
         Some(found) => Err(Error::TextureShape { what: "G-buffer channel", name: ch.name.clone(), found }),
@@ -265,6 +279,7 @@ mod tests {
             key: None,
             background: None,
             decode: None,
+            access: Default::default(),
         }
     }
 

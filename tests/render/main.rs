@@ -19,6 +19,7 @@ mod rate_image;
 mod rate_source;
 mod second_driver;
 mod sponza;
+mod storage_channels;
 mod suite_scenes;
 mod textures;
 
@@ -57,6 +58,14 @@ const GPU_TESTS: &[GpuTest] = &[
         engine_formats::decoded_channels_take_their_engine_formats,
     ),
     ("errors::binding_mismatches_are_typed_errors", errors::binding_mismatches_are_typed_errors),
+    (
+        "storage_channels::storage_channels_render_what_sampled_channels_render",
+        storage_channels::storage_channels_render_what_sampled_channels_render,
+    ),
+    (
+        "storage_channels::storage_channels_check_their_format_and_usage",
+        storage_channels::storage_channels_check_their_format_and_usage,
+    ),
     ("errors::engine_textures_are_checked_before_recording", errors::engine_textures_are_checked_before_recording),
     (
         "frames::velocity_is_the_projection_difference_of_a_camera_move",

@@ -483,7 +483,7 @@ pub fn bad_inputs_are_typed_errors(gpu: &Gpu) {
         Err(Error::BadRateOption { name: "sensitivity", .. })
     ));
     // A target that cannot be written.
-    let readonly = gpu.texture_with_data("read-only", (5, 3), F::R32Uint, &[0u8; 60]);
+    let readonly = gpu.texture_2d("read-only", (5, 3), F::R32Uint, wgpu::TextureUsages::TEXTURE_BINDING);
     assert_eq!(
         encode(&RateInputs::new(&color), &options, &readonly),
         Err(Error::RateUsage { what: "the rate image (target)", missing: "STORAGE_BINDING" })

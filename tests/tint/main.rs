@@ -26,8 +26,9 @@ fn main() {
     let out = std::env::temp_dir().join(format!("mrsl-tint-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     let programs = programs();
-    for (stem, source) in &programs {
-        let options = mrsl::Options { file_name: format!("{stem}.mrsl"), ..mrsl::Options::default() };
+    for (stem, source, storage_channels) in &programs {
+        let storage_channels = *storage_channels;
+        let options = mrsl::Options { file_name: format!("{stem}.mrsl"), storage_channels, ..mrsl::Options::default() };
         let program = match mrsl::compile(source, &options) {
             Ok(program) => program,
             Err(d) => panic!("{stem} should compile:\n{}", mrsl::render_all(&d, stem, source)),
@@ -62,9 +63,12 @@ fn ready(here: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// The programs checked: every corpus `ok/` case, every example, and wide
-/// programs at the compiler's limits.
-fn programs() -> Vec<(String, String)> {
+/// The programs checked, and whether with storage channels: every corpus
+/// `ok/` case, every example, and wide programs at the compiler's limits;
+/// and again with storage channels (`Options::storage_channels`) every
+/// example and the corpus case of channels in engine formats, so that each
+/// way the kernels load a channel is read through a storage binding too.
+fn programs() -> Vec<(String, String, bool)> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut programs = vec![];
     for dir in [root.join("compiler/tests/data/ok"), root.join("examples")] {
@@ -76,10 +80,14 @@ fn programs() -> Vec<(String, String)> {
         paths.sort();
         for path in paths {
             let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
-            programs.push((stem, std::fs::read_to_string(&path).expect("a program is readable")));
+            let source = std::fs::read_to_string(&path).expect("a program is readable");
+            if dir.ends_with("examples") || stem.contains("engine_formats") {
+                programs.push((format!("{stem}.storage_channels"), source.clone(), true));
+            }
+            programs.push((stem, source, false));
         }
     }
-    programs.push(("wide_output".into(), wide_output(1000)));
+    programs.push(("wide_output".into(), wide_output(1000), false));
     programs
 }
 

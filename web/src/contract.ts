@@ -94,7 +94,17 @@ export interface Channel {
   format: TextureFormatName;
   sample_type: SampleType;
   decode?: Decode | null;
+  /** How the kernels bind the channel's texture; absent means sampled. */
+  access?: ChannelAccess;
 }
+
+/**
+ * `sampled`: a sampled texture of any format of the channel's sample type
+ * with enough components. `storage`: a read-only storage texture of exactly
+ * the channel's format (`STORAGE_BINDING`), one more storage texture per
+ * shader stage in every kernel's pipeline.
+ */
+export type ChannelAccess = 'sampled' | 'storage';
 
 export interface Output {
   name: string;

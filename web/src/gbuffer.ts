@@ -30,7 +30,23 @@ export interface LoadedGBuffer {
   samplers: Record<string, GPUSampler>;
 }
 
-function upload(device: GPUDevice, label: string, format: GPUTextureFormat, mips: { data: ArrayBuffer; size: [number, number] }[]): GPUTexture {
+/**
+ * The colour formats WebGPU's core can bind as read-only storage textures:
+ * a channel of one of them is made with STORAGE_BINDING too, so that it
+ * binds to kernels compiled with storage channels as well as sampled ones.
+ */
+const STORAGE_READABLE: ReadonlySet<string> = new Set([
+  'rgba8unorm', 'rgba8snorm', 'rgba8uint', 'rgba8sint', 'rgba16uint', 'rgba16sint', 'rgba16float',
+  'r32uint', 'r32sint', 'r32float', 'rg32uint', 'rg32sint', 'rg32float', 'rgba32uint', 'rgba32sint', 'rgba32float',
+]);
+
+function upload(
+  device: GPUDevice,
+  label: string,
+  format: GPUTextureFormat,
+  mips: { data: ArrayBuffer; size: [number, number] }[],
+  storage = false,
+): GPUTexture {
   const info = formatInfo(format);
   if (!info || info.bytes === 0) throw new MrslError('program', `${label}: format ${format} cannot be uploaded as plain texels`);
   const [width, height] = mips[0]!.size;
@@ -39,7 +55,11 @@ function upload(device: GPUDevice, label: string, format: GPUTextureFormat, mips
     size: [width, height],
     format,
     mipLevelCount: mips.length,
-    usage: GPUTextureUsage.TEXTURE_BINDING | GPUTextureUsage.COPY_DST | GPUTextureUsage.COPY_SRC,
+    usage:
+      GPUTextureUsage.TEXTURE_BINDING |
+      GPUTextureUsage.COPY_DST |
+      GPUTextureUsage.COPY_SRC |
+      (storage && STORAGE_READABLE.has(format) ? GPUTextureUsage.STORAGE_BINDING : 0),
   });
   mips.forEach(({ data, size: [w, h] }, level) => {
     const expected = w * h * info.bytes;
@@ -62,7 +82,7 @@ export async function loadGBuffer(device: GPUDevice, manifest: GBufferManifest, 
   const size: Size = [manifest.size[0], manifest.size[1]];
   const channels: Record<string, GPUTexture> = {};
   for (const ch of manifest.channels) {
-    channels[ch.name] = upload(device, `channel ${ch.name}`, ch.format, [{ data: await read(ch.file), size: manifest.size }]);
+    channels[ch.name] = upload(device, `channel ${ch.name}`, ch.format, [{ data: await read(ch.file), size: manifest.size }], true);
   }
   const textures: Record<string, GPUTexture> = {};
   for (const t of manifest.textures) {

@@ -21,11 +21,11 @@ export function resourcesLayout(device: GPUDevice, l: Layout): GPUBindGroupLayou
 }
 
 export function gbufferLayout(device: GPUDevice, l: Layout): GPUBindGroupLayout {
-  const entries: GPUBindGroupLayoutEntry[] = l.channels.map((c) => ({
-    binding: c.binding,
-    visibility: visibility(),
-    texture: { sampleType: c.sample_type, viewDimension: '2d' },
-  }));
+  const entries: GPUBindGroupLayoutEntry[] = l.channels.map((c) =>
+    c.access === 'storage'
+      ? { binding: c.binding, visibility: visibility(), storageTexture: { access: 'read-only', format: c.format, viewDimension: '2d' } }
+      : { binding: c.binding, visibility: visibility(), texture: { sampleType: c.sample_type, viewDimension: '2d' } },
+  );
   return device.createBindGroupLayout({ label: 'mrsl g-buffer', entries });
 }
 

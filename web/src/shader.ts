@@ -259,7 +259,10 @@ export class Shader {
     // A depth-and-stencil texture is bound through its depth aspect.
     const entries = this.program.layout.channels.map((c) => ({
       binding: c.binding,
-      resource: (bindings.channels[c.name] as GPUTexture).createView(c.sample_type === 'depth' ? { aspect: 'depth-only' } : {}),
+      // A depth texture through its depth aspect; a storage binding takes one mip level.
+      resource: (bindings.channels[c.name] as GPUTexture).createView(
+        c.sample_type === 'depth' ? { aspect: 'depth-only' } : c.access === 'storage' ? { mipLevelCount: 1 } : {},
+      ),
     }));
     return this.device.createBindGroup({ label: 'mrsl g-buffer', layout: this.layouts.gbuffer, entries });
   }

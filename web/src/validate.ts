@@ -117,6 +117,16 @@ function checkChannel(ch: Channel, t: GPUTexture): void {
       ch.name,
     );
   }
+  if (ch.access === 'storage') {
+    if (t.format !== ch.format) {
+      throw new MrslError(
+        'channel-format',
+        `G-buffer channel \`${ch.name}\` has format ${t.format}, but the kernels read it through a storage binding of format ${ch.format}, which takes no other: bind a ${ch.format} texture, or compile without storage channels to read it sampled`,
+        ch.name,
+      );
+    }
+    return checkUsageAndShape(ch, t);
+  }
   const need = Math.min(storedComponents(ch), 4);
   const fits = info !== null && info.readAs === wants && info.components >= need && (need !== 3 || info.components === 4);
   if (!fits) {
@@ -130,12 +140,18 @@ function checkChannel(ch: Channel, t: GPUTexture): void {
   checkUsageAndShape(ch, t);
 }
 
-/** A channel's texture has TEXTURE_BINDING and is a single-sample 2D texture of one layer. */
+/**
+ * A channel's texture has the usage its binding needs (TEXTURE_BINDING, or
+ * STORAGE_BINDING for a storage channel) and is a single-sample 2D texture
+ * of one layer.
+ */
 function checkUsageAndShape(ch: Channel, t: GPUTexture): void {
-  if (!(t.usage & GPUTextureUsage.TEXTURE_BINDING)) {
+  const [usage, name] =
+    ch.access === 'storage' ? [GPUTextureUsage.STORAGE_BINDING, 'STORAGE_BINDING'] : [GPUTextureUsage.TEXTURE_BINDING, 'TEXTURE_BINDING'];
+  if (!(t.usage & usage)) {
     throw new MrslError(
       'channel-usage',
-      `G-buffer channel \`${ch.name}\` was not created with GPUTextureUsage.TEXTURE_BINDING, which the kernels need to read it: add it to the texture's usage`,
+      `G-buffer channel \`${ch.name}\` was not created with GPUTextureUsage.${name}, which the kernels need to read it: add it to the texture's usage`,
       ch.name,
     );
   }

@@ -62,6 +62,17 @@ fn no_outputs(w: &str) -> Option<String> {
     })
 }
 
+/// The shading function's test of the pixel's mask, per effect
+/// (`if ((mrsl_word(mrsl_pos, W) & M) != 0u) {`), made true: a listed pixel
+/// evaluates every coarse effect, whichever its classification named.
+fn every_effect_listed(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        (t.starts_with("if ((mrsl_word(mrsl_pos, ") && t.ends_with(") != 0u) {"))
+            .then(|| format!("{}if (true) {{", indent(l)))
+    })
+}
+
 /// Everything: every entry point returns at once, so what is left is the
 /// launches (passes, dispatches, indirect arguments) and their barriers.
 fn launches_only(w: &str) -> Option<String> {
@@ -75,7 +86,7 @@ fn launches_only(w: &str) -> Option<String> {
 /// The variants. "Nothing shaded" is the mode's floor: what it costs where
 /// no pixel past level 0 needs shading; the ones after it take a further
 /// part out of that floor.
-pub(super) const VARIANTS: [Variant; 8] = [
+pub(super) const VARIANTS: [Variant; 9] = [
     Variant {
         name: "no instrumentation",
         removes: "the statistics atomics, their barrier and the refine-mask store (`DispatchOptions::statistics` off)",
@@ -105,6 +116,11 @@ pub(super) const VARIANTS: [Variant; 8] = [
         name: "floor, no classification",
         removes: "also the classification of levels 1-4 and their pixels' outputs (left: level 0 and its outputs)",
         edits: &[nothing_shaded, no_classification],
+    },
+    Variant {
+        name: "every effect at listed pixels (added)",
+        removes: "nothing; adds work: a listed pixel evaluates every coarse effect, whichever its classification named (what a SIMD group whose pixels name different effects pays)",
+        edits: &[every_effect_listed],
     },
     Variant {
         name: "no outputs",

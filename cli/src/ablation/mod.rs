@@ -15,7 +15,7 @@
 //! out and says so. The variants only drop work: their images are wrong by
 //! design and are never compared.
 
-use crate::setup::{Resources, WORKLOAD_PROGRAM, bind_scene, compile_program};
+use crate::setup::{DeviceProgram, Resources, WORKLOAD_PROGRAM, bind_scene, compile_for_device};
 use crate::timing::{median, time_run};
 use anyhow::{Context, Result, anyhow, bail};
 
@@ -137,9 +137,9 @@ type Programs = Vec<(&'static str, &'static str, CompiledProgram)>;
 pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>> {
     let target = Target::of(args.mode)?;
     let modes = [Mode::Reference, args.mode];
-    let (name, program) = compile_program(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &modes)?;
+    let DeviceProgram { name, program, gpu } =
+        compile_for_device(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &modes)?;
     let (programs, skipped) = variants(args, &name, &program, target)?;
-    let gpu = Gpu::new()?;
     let device_name = format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
     eprintln!("ablation: {name}, {} {}, on {device_name}, {}x{}", args.mode, target.what(), args.size.0, args.size.1);
     let mut scene = bind_scene(&gpu, &args.scene, Some(args.size))?;
@@ -196,7 +196,14 @@ fn variants(
             None => WORKLOAD_PROGRAM.to_string(),
         };
         let modes = [Mode::Reference, args.mode];
-        let options = mrsl::Options { compact: true, file_name: name.to_string(), ..mrsl::Options::for_modes(&modes) };
+        // The channels bound as the full kernel binds them.
+        let storage_channels = full.layout.channels.iter().any(|c| c.access == mrsl_abi::ChannelAccess::Storage);
+        let options = mrsl::Options {
+            compact: true,
+            storage_channels,
+            file_name: name.to_string(),
+            ..mrsl::Options::for_modes(&modes)
+        };
         let compacted = mrsl::compile(&source, &options).map_err(|d| anyhow!(mrsl::render_all(&d, name, &source)))?;
         programs.push((
             "compacted (added)",

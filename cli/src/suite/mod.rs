@@ -12,7 +12,7 @@
 mod report;
 
 use crate::ablation::{refining_nothing, shading_nothing};
-use crate::setup::{Resources, WORKLOAD_PROGRAM, bind_scene, compile_program};
+use crate::setup::{DeviceProgram, Resources, WORKLOAD_PROGRAM, bind_scene, compile_for_device};
 use crate::timing::{Clock, median, paired, time_run, warm_up};
 use anyhow::{Context, Result, anyhow, bail};
 use mrsl_abi::CompiledProgram;
@@ -126,9 +126,8 @@ pub fn suite(args: &SuiteArgs) -> Result<Vec<PathBuf>> {
         }
     }
     let start = Instant::now();
-    let (name, program) =
-        compile_program(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &Mode::ALL)?;
-    let gpu = Gpu::new()?;
+    let DeviceProgram { name, program, gpu } =
+        compile_for_device(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &Mode::ALL)?;
     let device = Device::of(&gpu.adapter_info);
     let adapters: Vec<Device> = mrsl_lab::gpu::adapters().iter().map(Device::of).collect();
     let clock = crate::timing::clock(&gpu).describe();

@@ -14,7 +14,7 @@ use crate::check::{Background, EffectId, InputId, KeyCompare, Symbol};
 use crate::syntax::ast::*;
 use crate::syntax::{visit_expr, visit_stmt_exprs};
 use crate::types::Scalar;
-use mrsl_abi::{BevyField, CONTROL_FIELDS, Decode, KernelKind, SampleType};
+use mrsl_abi::{BevyField, CONTROL_FIELDS, ChannelAccess, Decode, KernelKind, SampleType};
 use std::collections::{BTreeSet, HashMap, HashSet};
 
 /// The most parameters a WGSL function may declare (the specification's
@@ -204,9 +204,10 @@ impl<'b> Writer<'_, '_, 'b> {
         }
         self.template(0, channels, &[]);
         for ch in &l.channels {
-            let texture = match ch.sample_type {
-                SampleType::Depth => "texture_depth_2d".to_string(),
-                _ => format!("texture_2d<{}>", ch.format.scalar().wgsl()),
+            let texture = match (ch.access, ch.sample_type) {
+                (ChannelAccess::Storage, _) => format!("texture_storage_2d<{}, read>", ch.format),
+                (ChannelAccess::Sampled, SampleType::Depth) => "texture_depth_2d".to_string(),
+                (ChannelAccess::Sampled, _) => format!("texture_2d<{}>", ch.format.scalar().wgsl()),
             };
             let (group, binding, name) = (ch.group, ch.binding, Name::GBuffer.of(&ch.name));
             self.line(0, format!("@group({group}) @binding({binding}) var {name}: {texture}; // {}", ch.format));
@@ -283,7 +284,12 @@ impl<'b> Writer<'_, '_, 'b> {
         if inputs.iter().any(|i| i.decode == bevy(BevyField::Emissive)) {
             self.template(0, include_str!("templates/rgb9e5.wgsl"), &[]);
         }
-        for input in inputs {
+        for (input, channel) in inputs.iter().zip(&self.i.layout.channels) {
+            // A storage texture has no mip level to name.
+            let level = match channel.access {
+                ChannelAccess::Sampled => ", 0",
+                ChannelAccess::Storage => "",
+            };
             let swizzle = match input.ty.components() {
                 1 => ".x",
                 2 => ".xy",
@@ -295,14 +301,14 @@ impl<'b> Writer<'_, '_, 'b> {
                 None => self.template(
                     0,
                     include_str!("templates/load.wgsl"),
-                    &[("NAME", name), ("TYPE", &input.ty.wgsl()), ("SWIZZLE", &swizzle)],
+                    &[("NAME", name), ("TYPE", &input.ty.wgsl()), ("SWIZZLE", &swizzle), ("LEVEL", &level)],
                 ),
                 Some(Decode::Unorm) => {
                     let swizzle = format!("{swizzle} * 2.0 - 1.0");
                     self.template(
                         0,
                         include_str!("templates/load.wgsl"),
-                        &[("NAME", name), ("TYPE", &input.ty.wgsl()), ("SWIZZLE", &swizzle)],
+                        &[("NAME", name), ("TYPE", &input.ty.wgsl()), ("SWIZZLE", &swizzle), ("LEVEL", &level)],
                     )
                 }
                 Some(Decode::Depth { inverse_view_projection }) => self.template(
@@ -313,8 +319,13 @@ impl<'b> Writer<'_, '_, 'b> {
                 Some(Decode::BevyDeferred { field }) => {
                     let what = BevyField::ALL.iter().find(|(f, ..)| f == field).map_or("", |(_, n, _)| n);
                     let value = bevy_field(*field);
-                    let values: [(&str, &dyn std::fmt::Display); 4] =
-                        [("NAME", name), ("FIELD", &what), ("TYPE", &input.ty.wgsl()), ("VALUE", &value)];
+                    let values: [(&str, &dyn std::fmt::Display); 5] = [
+                        ("NAME", name),
+                        ("FIELD", &what),
+                        ("TYPE", &input.ty.wgsl()),
+                        ("VALUE", &value),
+                        ("LEVEL", &level),
+                    ];
                     self.template(0, include_str!("templates/load_packed.wgsl"), &values)
                 }
                 Some(octahedral) => {
@@ -322,7 +333,7 @@ impl<'b> Writer<'_, '_, 'b> {
                     self.template(
                         0,
                         include_str!("templates/load_octahedral.wgsl"),
-                        &[("NAME", name), ("UNORM", &unorm)],
+                        &[("NAME", name), ("UNORM", &unorm), ("LEVEL", &level)],
                     )
                 }
             }

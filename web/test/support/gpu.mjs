@@ -43,3 +43,11 @@ async function open() {
   console.log(`web tests: Dawn on ${description}`);
   return { device, adapter, description };
 }
+
+/**
+ * Another adapter of the same instance, for a device with limits of its own
+ * (a WebGPU adapter makes one device); call after `testDevice`.
+ */
+export async function freshAdapter() {
+  return instance.requestAdapter();
+}

@@ -1,4 +1,4 @@
 fn mrsl_load_{{NAME}}(pos: vec2<i32>) -> {{TYPE}} {
-    return textureLoad(mrsl_gb_{{NAME}}, mrsl_pixel(pos), 0){{SWIZZLE}};
+    return textureLoad(mrsl_gb_{{NAME}}, mrsl_pixel(pos){{LEVEL}}){{SWIZZLE}};
 }
 
