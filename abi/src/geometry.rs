@@ -146,6 +146,64 @@ pub fn indirect_args_offset(level: u32) -> u64 {
     u64::from(level * QUEUE_WORDS_PER_LEVEL * 4)
 }
 
+/// Pixels per side of the hierarchical mode's tiles, in a program with a
+/// background rule: what one workgroup of level 0 covers. A tile whose
+/// every pixel is background is left out of every level's dispatches and
+/// shaded by `hier_background` alone.
+pub const HIERARCHICAL_TILE: u32 = HIERARCHICAL_LEVEL0.step * COARSE_WORKGROUP;
+
+/// The hierarchical tiles along x and y of a `size` image.
+pub fn hierarchical_tile_grid(size: (u32, u32)) -> (u32, u32) {
+    (size.0.div_ceil(HIERARCHICAL_TILE), size.1.div_ceil(HIERARCHICAL_TILE))
+}
+
+/// Words of the hierarchical queue buffer that count the surface tiles (list
+/// 0) and the background tiles (list 1): level 0's words, which count no
+/// pixels (level 0 has no work list).
+pub const HIERARCHICAL_TILE_COUNTS: [u32; 2] = [0, 1];
+
+/// Words of the hierarchical indirect-argument buffer: per level 1 to 4 the
+/// dispatch over its work list (at word `4 L`), per level 0 to 4 the
+/// dispatch over the surface tiles (at `4 (5 + L)`), and the dispatch over
+/// the background tiles (at 40).
+pub const HIERARCHICAL_ARGUMENT_WORDS: u32 = (2 * HIERARCHICAL_LEVEL_COUNT + 1) * QUEUE_WORDS_PER_LEVEL;
+
+/// Byte offset of the arguments of level `level`'s (0 to 4) dispatch over the surface tiles.
+pub fn level_tile_args_offset(level: u32) -> u64 {
+    u64::from((HIERARCHICAL_LEVEL_COUNT + level) * QUEUE_WORDS_PER_LEVEL * 4)
+}
+
+/// Byte offset of the arguments of the dispatch over the background tiles.
+pub fn background_tile_args_offset() -> u64 {
+    u64::from(2 * HIERARCHICAL_LEVEL_COUNT * QUEUE_WORDS_PER_LEVEL * 4)
+}
+
+/// Workgroups of [`COARSE_WORKGROUP`]² lanes per background tile: one lane per pixel.
+pub const BACKGROUND_TILE_WORKGROUPS: (u32, u32) =
+    (HIERARCHICAL_TILE / COARSE_WORKGROUP, HIERARCHICAL_TILE / COARSE_WORKGROUP);
+
+/// Word of the work lists where the tile list starts: the back of level 4's
+/// list, which it never reaches. Level 4 lists at most the pixels with an
+/// odd coordinate sum, half its lattice's words rounded down, and the tiles
+/// are never more than the other half (a test checks it), so the surface
+/// tiles (from the front) and the background tiles (from the back) of the
+/// tile list and level 4's pixels never share a word.
+pub fn tile_list_offset(size: (u32, u32)) -> u64 {
+    let (tx, ty) = hierarchical_tile_grid(size);
+    work_list_words(size) - u64::from(tx) * u64::from(ty)
+}
+
+impl Lattice {
+    /// Workgroups per hierarchical tile along x and y for a lattice whose
+    /// step divides [`HIERARCHICAL_TILE`]: its points in a tile (half of
+    /// them along x with `odd_only`) in workgroups of [`COARSE_WORKGROUP`]².
+    pub fn workgroups_per_tile(self) -> (u32, u32) {
+        let points = HIERARCHICAL_TILE / self.step;
+        let x = if self.odd_only { points / 2 } else { points };
+        (x / COARSE_WORKGROUP, points / COARSE_WORKGROUP)
+    }
+}
+
 /// The block and dynamic fine kernels' tile lists: list 0 holds the surface
 /// tiles, list 1 the background tiles. Their counters are a word each; their
 /// indirect arguments (x, y, z, unused) lie [`QUEUE_WORDS_PER_LEVEL`] words
@@ -226,6 +284,29 @@ mod tests {
                 }
             }
             assert!(shaded.iter().all(|&n| n == 1), "{size:?}: {shaded:?}");
+        }
+    }
+
+    /// The tile list fits the back of level 4's work list beside the most
+    /// pixels level 4 can list, and a level's tile workgroups cover its
+    /// points in a tile exactly.
+    #[test]
+    fn the_tile_list_fits_behind_level_four() {
+        for w in 1..70 {
+            for h in [1, 2, 3, 31, 32, 33, 65, 1080] {
+                let level4 = HIERARCHICAL_LEVELS[3];
+                let listed = level4.points((w, h)) / 2;
+                let (tx, ty) = hierarchical_tile_grid((w, h));
+                let start = tile_list_offset((w, h)) - (work_list_words((w, h)) - level4.points((w, h)));
+                assert!(listed <= start, "{w}x{h}: level 4 lists up to {listed}, tiles start at {start}");
+                assert!(u64::from(tx * ty) <= level4.points((w, h)));
+            }
+        }
+        for level in std::iter::once(HIERARCHICAL_LEVEL0).chain(HIERARCHICAL_LEVELS) {
+            let (x, y) = level.workgroups_per_tile();
+            let points = u64::from(HIERARCHICAL_TILE / level.step).pow(2);
+            let lanes = u64::from(x * y * COARSE_WORKGROUP * COARSE_WORKGROUP);
+            assert_eq!(lanes, if level.odd_only { points / 2 } else { points }, "{level:?}");
         }
     }
 

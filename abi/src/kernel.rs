@@ -26,6 +26,16 @@ pub mod entry {
     /// Shade the background tiles (indirect): every coarse effect reads as
     /// zero there, so no coarse sample is read and nothing is refined.
     pub const FINE_BACKGROUND: &str = "fine_background";
+    /// Hierarchical, with a background rule: list each 32x32 tile as a
+    /// surface tile or a background tile (`geometry::HIERARCHICAL_TILE`).
+    pub const HIER_TILES: &str = "hier_tiles";
+    /// Hierarchical: turn the tile lists' lengths into the indirect arguments
+    /// of every level's dispatch over the surface tiles and of
+    /// `hier_background` (binds [`crate::GROUP_ARGS`]).
+    pub const HIER_TILE_ARGS: &str = "hier_tile_args";
+    /// Hierarchical: the outputs of the background tiles' pixels, whose coarse
+    /// effects read as zero (indirect dispatch).
+    pub const HIER_BACKGROUND: &str = "hier_background";
     /// Hierarchical level 0: every 4th pixel, always shaded.
     pub const HIER_LEVEL0: &str = "hier_level0";
     /// Hierarchical levels 1 to 4: classify the level's pixels into its work list.
@@ -58,10 +68,14 @@ pub mod entry {
     pub const RESERVED_PREFIXES: [&str; 3] = ["hier_", "cb_", "rate_"];
 }
 
-/// The hierarchical kernel's entry points in dispatch order: level 0, then per
-/// level 1 to 4 classify, args and (indirect) shade. There is no final pass:
-/// each pixel's outputs are written where its record is complete.
-const HIERARCHICAL_ENTRY_POINTS: [&str; 13] = [
+/// The hierarchical kernel's entry points in dispatch order: the tile lists
+/// (empty and not dispatched without a background rule), level 0, then per
+/// level 1 to 4 classify, args and (indirect) shade, then the background
+/// tiles. There is no final pass: each pixel's outputs are written where its
+/// record is complete.
+const HIERARCHICAL_ENTRY_POINTS: [&str; 16] = [
+    entry::HIER_TILES,
+    entry::HIER_TILE_ARGS,
     entry::HIER_LEVEL0,
     entry::HIER_CLASSIFY[0],
     entry::HIER_ARGS[0],
@@ -75,6 +89,7 @@ const HIERARCHICAL_ENTRY_POINTS: [&str; 13] = [
     entry::HIER_CLASSIFY[3],
     entry::HIER_ARGS[3],
     entry::HIER_SHADE[3],
+    entry::HIER_BACKGROUND,
 ];
 
 /// Which kernel: each is one WGSL module with the entry points [`KernelKind::entry_points`] lists.

@@ -165,15 +165,31 @@ fn multi_rate_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
 }
 
 /// DACS: level 0, then per level classify into the work list, turn its
-/// count into indirect arguments and shade the list.
+/// count into indirect arguments and shade the list. With a background rule,
+/// first list the tiles: level 0 and the classifications are dispatched over
+/// the surface tiles only, and the background tiles have a pass of their own.
 fn hierarchical_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
     let kernel = KernelRef::new(KernelKind::Hierarchical, None);
-    let level0 = HIERARCHICAL_LEVEL0;
-    let lattice = |l: geometry::Lattice| Workgroups::Lattice { start: l.start, step: l.step, odd_only: l.odd_only };
-    let mut levels = vec![dispatch(entry::HIER_LEVEL0, lattice(level0))];
+    let tiled = layout.has_background();
+    let lattice = |level: u32, l: geometry::Lattice| match tiled {
+        false => Workgroups::Lattice { start: l.start, step: l.step, odd_only: l.odd_only },
+        true => tile_list(geometry::level_tile_args_offset(level)),
+    };
+    let mut levels = vec![];
+    if tiled {
+        let level0 = HIERARCHICAL_LEVEL0;
+        let grid = Workgroups::Lattice { start: level0.start, step: level0.step, odd_only: level0.odd_only };
+        levels.push(dispatch(entry::HIER_TILES, grid));
+        levels.push(Dispatch {
+            entry: entry::HIER_TILE_ARGS.into(),
+            arguments: Some(ResourceId::LevelArguments),
+            workgroups: Workgroups::One,
+        });
+    }
+    levels.push(dispatch(entry::HIER_LEVEL0, lattice(0, HIERARCHICAL_LEVEL0)));
     for (index, level) in HIERARCHICAL_LEVELS.iter().enumerate() {
         let (start, step, odd_only) = (level.start, level.step, level.odd_only);
-        levels.push(dispatch(entry::HIER_CLASSIFY[index], lattice(*level)));
+        levels.push(dispatch(entry::HIER_CLASSIFY[index], lattice(index as u32 + 1, *level)));
         levels.push(Dispatch {
             entry: entry::HIER_ARGS[index].into(),
             arguments: Some(ResourceId::LevelArguments),
@@ -188,6 +204,9 @@ fn hierarchical_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
                 per_workgroup: WORK_LIST_WORKGROUP,
             },
         ));
+    }
+    if tiled {
+        levels.push(dispatch(entry::HIER_BACKGROUND, tile_list(geometry::background_tile_args_offset())));
     }
     steps.push(Step::Clear { resource: ResourceId::LevelCounts });
     // No final pass: the entry point that completes a pixel's record writes
@@ -204,6 +223,18 @@ fn hierarchical_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
             lanes: WORK_LIST_WORKGROUP,
         }),
         background: None,
+    }
+}
+
+/// An indirect dispatch over a hierarchical tile list, whose arguments are
+/// at byte `offset` of the level arguments.
+fn tile_list(offset: u64) -> Workgroups {
+    Workgroups::Indirect {
+        buffer: ResourceId::LevelArguments,
+        offset,
+        // The arguments lay the workgroups out in rows of as many tiles as the image has across.
+        at_most: None,
+        per_workgroup: geometry::COARSE_WORKGROUP * geometry::COARSE_WORKGROUP,
     }
 }
 
@@ -403,7 +434,10 @@ fn resource(layout: &Layout, id: ResourceId) -> ResourceDesc {
         ),
         R::WorkLists => ("the hierarchical work lists", words(Extent::HierarchicalLevels, 1)),
         R::LevelCounts => ("the hierarchical level counts", words(Extent::Fixed { count: counters }, 1)),
-        R::LevelArguments => ("the hierarchical dispatch arguments", words(Extent::Fixed { count: counters }, 1)),
+        R::LevelArguments => {
+            let count = u64::from(geometry::HIERARCHICAL_ARGUMENT_WORDS);
+            ("the hierarchical dispatch arguments", words(Extent::Fixed { count }, 1))
+        }
         R::RateRecords => ("the rate-image interface", words(Extent::Pixels, stride.max(1))),
         R::SampleList => ("the rate-image sample list", words(Extent::Pixels, 1)),
         R::SampleCount => ("the rate-image sample count", words(Extent::Fixed { count: rate_words() }, 1)),

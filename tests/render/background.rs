@@ -29,6 +29,11 @@ fine out float4 color = material == 255u
     : float4(tint + float3(diffuse) + 0.1 * direction, 1.0);
 ";
 
+/// The size of the background test: odd, so that blocks and tiles cut the
+/// image, and wide enough for the sky to fill a 32x32 tile.
+const W: usize = 131;
+const H: usize = 83;
+
 fn materials(gbuffer: &GBuffer) -> &[u32] {
     match gbuffer.channels.iter().find(|(n, _)| n == "material") {
         Some((_, ChannelData::Uint(ids))) => ids,
@@ -36,33 +41,42 @@ fn materials(gbuffer: &GBuffer) -> &[u32] {
     }
 }
 
+/// Pixels in `tile`-pixel tiles of a `w` x `h` image whose every pixel is background.
+fn sky_tiles(background: &[bool], (w, h): (usize, usize), tile: usize) -> usize {
+    (0..h.div_ceil(tile))
+        .flat_map(|ty| (0..w.div_ceil(tile)).map(move |tx| (tx, ty)))
+        .filter(|&(tx, ty)| {
+            let rows = ty * tile..(ty * tile + tile).min(h);
+            rows.flat_map(|y| (tx * tile..(tx * tile + tile).min(w)).map(move |x| y * w + x)).all(|i| background[i])
+        })
+        .count()
+}
+
 /// Forced refinement equals the reference bit for bit, background pixels
 /// included; adaptive (the block and dynamic modes shading wholly-background
-/// tiles from their own list), a background pixel is counted as background and
+/// tiles from their own list, the hierarchical mode its wholly-background
+/// 32x32 tiles), a background pixel is counted as background and
 /// nothing else (the refine mask marks it x 0, y all ones), its output is
 /// the reference's, and no coarse evaluation is spent on a background sample.
 pub fn background_pixels_are_never_shaded_or_refined(gpu: &Gpu) {
     let program = compile(PROGRAM);
     // An odd size: blocks and tiles the image cuts.
-    let gbuffer = Scene::Demo.render(67, 41);
+    let (w, h) = (W, H);
+    let gbuffer = Scene::Demo.render(w as u32, h as u32);
     let background: Vec<bool> = materials(&gbuffer).iter().map(|&m| m == BACKGROUND).collect();
     let count = background.iter().filter(|&&b| b).count() as u64;
     assert!(count > 200 && count < background.len() as u64 / 2, "the demo shows some sky: {count} pixels");
-    // The block and dynamic modes shade these with their background entry point.
-    let tile = mrsl_abi::geometry::TILE as usize;
-    let sky_tiles = (0..41usize.div_ceil(tile))
-        .flat_map(|ty| (0..67usize.div_ceil(tile)).map(move |tx| (tx, ty)))
-        .filter(|&(tx, ty)| {
-            let rows = ty * tile..(ty * tile + tile).min(41);
-            rows.flat_map(|y| (tx * tile..(tx * tile + tile).min(67)).map(move |x| y * 67 + x)).all(|i| background[i])
-        })
-        .count();
-    assert!(sky_tiles >= 3, "the demo has wholly-background tiles: {sky_tiles}");
+    // The block and dynamic modes shade these with their background entry
+    // point, the hierarchical mode its tiles of 32 pixels.
+    let tiles = sky_tiles(&background, (w, h), mrsl_abi::geometry::TILE as usize);
+    assert!(tiles >= 3, "the demo has wholly-background tiles: {tiles}");
+    let tiles = sky_tiles(&background, (w, h), mrsl_abi::geometry::HIERARCHICAL_TILE as usize);
+    assert!(tiles >= 1, "the demo has wholly-background hierarchical tiles: {tiles}");
     let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap().pixels;
     for mode in adaptive_modes() {
         let forced = run(gpu, &program, &gbuffer, mode, true).unwrap();
         assert_eq!(worst_ulps(&forced.pixels, &reference), 0, "{mode}: forced refinement differs from the reference");
-        let rates = mrsl_lab::shading_rate::pattern(mrsl_abi::shading_rate::rate_image_size((67, 41), 8));
+        let rates = mrsl_lab::shading_rate::pattern(mrsl_abi::shading_rate::rate_image_size((W as u32, H as u32), 8));
         let options = DispatchOptions { rate_tile: 8, ..DispatchOptions::new(mode) };
         let [run] = dispatch_in_turn(gpu, &program, &gbuffer, &rates, [options]).unwrap();
         let stats = run.stats.unwrap();

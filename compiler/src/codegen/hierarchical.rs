@@ -11,12 +11,20 @@
 //! level 0 and the shading entry points after shading it, the
 //! classification where it interpolated every effect, and at a background
 //! pixel), from the values that invocation holds, so no pass reads the
-//! records again. The lattices, work-list capacities and queue layout are
-//! the runtime's too: they come from `mrsl_abi::geometry`.
+//! records again. In a program with a background rule, `hier_tiles` first
+//! lists the 32x32 tiles as surface or background tiles: level 0 and the
+//! classifications are dispatched over the surface tiles only, and
+//! `hier_background` writes the background tiles' outputs (on llvmpipe a
+//! lane pays for its whole entry point whatever its branches say, so a sky
+//! pixel is spared the classification only by being left out of its
+//! dispatch). The lattices, tiles, work-list capacities and queue layout
+//! are the runtime's too: they come from `mrsl_abi::geometry`.
 
 use super::Writer;
 use super::effects::Evaluation;
-use super::names::{CONTROL, COUNT, Name, POS, SET_WORD, WORD};
+use super::names::{
+    CONTROL, COUNT, LANE, LOCAL_ID, Name, POS, SET_WORD, TILE_ARGS, TILE_INVOCATION, WORD, WORKGROUP,
+};
 use super::records::{axis_neighbours, diagonal_neighbours, neighbours};
 use super::words::bit;
 use super::writer::cut;
@@ -24,7 +32,8 @@ use crate::check::EffectId;
 use crate::types::{Scalar, Type};
 use mrsl_abi::entry;
 use mrsl_abi::geometry::{
-    COARSE_WORKGROUP, HIERARCHICAL_LEVEL0, HIERARCHICAL_LEVELS, Lattice, QUEUE_WORDS_PER_LEVEL, WORK_LIST_WORKGROUP,
+    self, BACKGROUND_TILE_WORKGROUPS, COARSE_WORKGROUP, HIERARCHICAL_LEVEL0, HIERARCHICAL_LEVELS,
+    HIERARCHICAL_TILE, HIERARCHICAL_TILE_COUNTS, Lattice, QUEUE_WORDS_PER_LEVEL, WORK_LIST_WORKGROUP,
 };
 use std::fmt::Display;
 
@@ -99,6 +108,7 @@ impl Writer<'_, '_, '_> {
         self.pixel_values();
         self.finish_function();
         self.work_lists();
+        self.tile_lists();
         self.shade_function();
         self.level0();
         self.classify_function();
@@ -107,7 +117,10 @@ impl Writer<'_, '_, '_> {
             // indirect arguments (x, y, z).
             let queue = (index as u32 + 1) * QUEUE_WORDS_PER_LEVEL;
             let neighbours = neighbours(level.neighbours);
+            let (params, invocation, valid) = self.level_invocation(*lattice);
             let values: &super::writer::Values = &[
+                ("PARAMS", &params),
+                ("VALID", &valid),
                 ("LEVEL", &(index + 1)),
                 ("WHAT", &level.what),
                 ("CLASSIFY_WORKGROUP", &lattice_workgroup()),
@@ -123,13 +136,117 @@ impl Writer<'_, '_, '_> {
                 ("WORK_GROUP", &WORK_LIST_WORKGROUP),
                 ("SHADE", &entry::HIER_SHADE[index]),
             ];
-            let [classify, shade, end] = cut(include_str!("templates/level.wgsl"), &["FLUSH_CLASSIFY", "FLUSH_SHADE"]);
+            let [head, classify, shade, end] =
+                cut(include_str!("templates/level.wgsl"), &["INVOCATION", "FLUSH_CLASSIFY", "FLUSH_SHADE"]);
+            self.template(0, head, values);
+            if let Some(line) = &invocation {
+                self.line(1, line);
+            }
             self.template(0, classify, values);
             self.flush_finished(COARSE_WORKGROUP * COARSE_WORKGROUP);
             self.template(0, shade, values);
             self.flush_finished(WORK_LIST_WORKGROUP);
             self.template(0, end, values);
         }
+        self.background_tiles();
+    }
+
+    /// Whether level 0 and the classifications run over the surface tiles
+    /// only: in a program with a background rule.
+    fn tiled(&self) -> bool {
+        self.has_background()
+    }
+
+    /// How an entry point over `lattice` finds its invocation: its
+    /// parameters, the line that computes `gid` from the surface tile list
+    /// (tiled), and the test that it has one (a prefix of the image test).
+    fn level_invocation(&self, lattice: Lattice) -> (String, Option<String>, &'static str) {
+        if !self.tiled() {
+            let params = format!("@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) {LANE}: u32");
+            return (params, None, "");
+        }
+        let params = format!(
+            "@builtin(workgroup_id) {WORKGROUP}: vec3<u32>, @builtin(local_invocation_id) {LOCAL_ID}: vec3<u32>, \
+             @builtin(local_invocation_index) {LANE}: u32"
+        );
+        let (x, y) = lattice.workgroups_per_tile();
+        let surface = HIERARCHICAL_TILE_COUNTS[0];
+        let line = format!(
+            "let gid = {TILE_INVOCATION}({WORKGROUP}.xy, {LOCAL_ID}.xy, vec2<u32>({x}u, {y}u), {surface}u);"
+        );
+        (params, Some(line), "gid.x != 0xffffffffu && ")
+    }
+
+    /// The tile lists' helpers and `hier_tiles` and `hier_tile_args`
+    /// (empty, and not dispatched, without a background rule).
+    fn tile_lists(&mut self) {
+        if !self.tiled() {
+            self.line(0, "// No background rule: the plan dispatches every level over its whole lattice and");
+            self.line(0, "// none of these.");
+            for name in [entry::HIER_TILES, entry::HIER_TILE_ARGS] {
+                self.line(0, "@compute @workgroup_size(1, 1, 1)");
+                self.line(0, format!("fn {name}() {{}}"));
+            }
+            self.line(0, "");
+            return;
+        }
+        let last = HIERARCHICAL_LEVELS[HIERARCHICAL_LEVELS.len() - 1];
+        let count = |axis: &str| format!("{COUNT}({}u, {}u, {axis})", last.start, last.step);
+        let last_points = format!("{} * {}", count("w"), count("h"));
+        let [surface, background] = HIERARCHICAL_TILE_COUNTS;
+        let values: &super::writer::Values = &[
+            ("TILE", &HIERARCHICAL_TILE),
+            ("LAST_LEVEL", &HIERARCHICAL_LEVELS.len()),
+            ("LAST_POINTS", &last_points),
+            ("LANES", &COARSE_WORKGROUP),
+            ("STEP", &HIERARCHICAL_LEVEL0.step),
+            ("TILES_ENTRY", &entry::HIER_TILES),
+            ("ARGS_ENTRY", &entry::HIER_TILE_ARGS),
+            ("SURFACE", &surface),
+            ("BACKGROUND", &background),
+        ];
+        let [head, end] = cut(include_str!("templates/hierarchical_tiles.wgsl"), &["DISPATCHES"]);
+        self.template(0, head, values);
+        let word = |offset: u64| offset / 4;
+        for (level, lattice) in std::iter::once(HIERARCHICAL_LEVEL0).chain(HIERARCHICAL_LEVELS).enumerate() {
+            let (x, y) = lattice.workgroups_per_tile();
+            let at = word(geometry::level_tile_args_offset(level as u32));
+            self.line(1, format!("{TILE_ARGS}({at}u, surface, {}u);", x * y));
+        }
+        let (x, y) = BACKGROUND_TILE_WORKGROUPS;
+        let at = word(geometry::background_tile_args_offset());
+        self.line(1, format!("{TILE_ARGS}({at}u, background, {}u);", x * y));
+        self.template(0, end, values);
+    }
+
+    /// `hier_background`: the pixels of the background tiles, one per lane,
+    /// their records cleared and their coarse effects zero (the background
+    /// rule), then their outputs. Without a background rule, empty.
+    fn background_tiles(&mut self) {
+        let lanes = COARSE_WORKGROUP * COARSE_WORKGROUP;
+        if !self.tiled() {
+            self.line(0, "// No background rule: not dispatched.");
+            self.line(0, format!("@compute @workgroup_size({WORK_LIST_WORKGROUP}, 1, 1)"));
+            self.line(0, format!("fn {}() {{}}", entry::HIER_BACKGROUND));
+            self.line(0, "");
+            return;
+        }
+        assert_eq!(lanes, WORK_LIST_WORKGROUP, "a background workgroup is one 8x8 block of a tile");
+        let (x, y) = BACKGROUND_TILE_WORKGROUPS;
+        let values: &super::writer::Values = &[
+            ("WORK_GROUP", &WORK_LIST_WORKGROUP),
+            ("ENTRY", &entry::HIER_BACKGROUND),
+            ("LANES", &COARSE_WORKGROUP),
+            ("PER_X", &x),
+            ("PER_Y", &y),
+            ("LIST", &HIERARCHICAL_TILE_COUNTS[1]),
+        ];
+        let [head, clear, end] = cut(include_str!("templates/hierarchical_background.wgsl"), &["CLEAR", "FLUSH"]);
+        self.template(0, head, values);
+        self.clear_record(2);
+        self.template(0, clear, values);
+        self.flush_finished(lanes);
+        self.template(0, end, values);
     }
 
     /// `var<private> mrsl_pv_<effect>`: the values of the coarse effects at
@@ -194,18 +311,23 @@ impl Writer<'_, '_, '_> {
         if !self.has_background() {
             return;
         }
-        let c = self.checked();
-        let h = &self.i.layout.hierarchical;
         self.line(indent, format!("if ({}) {{", self.background_here("p")));
-        for w in 0..h.record_words {
-            self.line(indent + 1, format!("{SET_WORD}(p, {w}u, 0u);"));
+        self.clear_record(indent + 1);
+        self.line(indent + 1, returns);
+        self.line(indent, "}");
+    }
+
+    /// Background pixel `p`: a record of zeros (no evaluated bit) and every
+    /// coarse effect zero for `mrsl_finish`.
+    fn clear_record(&mut self, indent: usize) {
+        let c = self.checked();
+        for w in 0..self.i.layout.hierarchical.record_words {
+            self.line(indent, format!("{SET_WORD}(p, {w}u, 0u);"));
         }
         for e in self.coarse_live() {
             let info = &c.effects[e.index()];
-            self.line(indent + 1, format!("{} = {}();", Name::PixelValue.of(&info.name), info.ty.wgsl()));
+            self.line(indent, format!("{} = {}();", Name::PixelValue.of(&info.name), info.ty.wgsl()));
         }
-        self.line(indent + 1, returns);
-        self.line(indent, "}");
     }
 
     /// The end of an entry point that finishes pixels: its workgroup's
@@ -268,8 +390,11 @@ impl Writer<'_, '_, '_> {
     /// Level 0: every pixel of its lattice is shaded.
     fn level0(&mut self) {
         let coarse = self.coarse_live().len() as u32;
-        let [head, entry, end] = cut(include_str!("templates/level0.wgsl"), &["MASKS", "FLUSH"]);
+        let [head, entry, body, end] = cut(include_str!("templates/level0.wgsl"), &["MASKS", "INVOCATION", "FLUSH"]);
+        let (params, invocation, valid) = self.level_invocation(HIERARCHICAL_LEVEL0);
         let values: &super::writer::Values = &[
+            ("PARAMS", &params),
+            ("VALID", &valid),
             ("STEP", &HIERARCHICAL_LEVEL0.step),
             ("WORKGROUP", &lattice_workgroup()),
             ("ENTRY", &entry::HIER_LEVEL0),
@@ -284,6 +409,10 @@ impl Writer<'_, '_, '_> {
             self.line(1, format!("{SET_WORD}(p, {}u, {mask}u);", h.flag_words + w));
         }
         self.template(0, entry, values);
+        if let Some(line) = &invocation {
+            self.line(1, line);
+        }
+        self.template(0, body, values);
         self.flush_finished(COARSE_WORKGROUP * COARSE_WORKGROUP);
         self.template(0, end, values);
     }

@@ -274,6 +274,13 @@ pub(super) const WORD: &str = "mrsl_word";
 pub(super) const SET_WORD: &str = "mrsl_set_word";
 /// `mrsl_count(start, step, extent)`: a hierarchical lattice's points along an axis.
 pub(super) const COUNT: &str = "mrsl_count";
+/// `mrsl_tile_invocation(wg, lid, per, list)`: the lattice invocation of a
+/// lane of a dispatch over a hierarchical tile list.
+pub(super) const TILE_INVOCATION: &str = "mrsl_tile_invocation";
+/// The `local_invocation_id` of the hierarchical entry points over tile lists.
+pub(super) const LOCAL_ID: &str = "mrsl_lid";
+/// `mrsl_tile_args(word, tiles, per_tile)`: indirect arguments over a hierarchical tile list.
+pub(super) const TILE_ARGS: &str = "mrsl_tile_args";
 
 /// The words of one record, and the coarse kernels' block size.
 pub(super) const STRIDE: &str = "MRSL_STRIDE";
@@ -330,6 +337,9 @@ pub(super) const FIXED: &[&str] = &[
     WORD,
     SET_WORD,
     COUNT,
+    TILE_INVOCATION,
+    LOCAL_ID,
+    TILE_ARGS,
     STRIDE,
     BLOCK_SIZE,
     BLOCK_STRUCT,
@@ -355,6 +365,9 @@ pub(super) const FIXED: &[&str] = &[
     "mrsl_queue",
     "mrsl_args",
     "mrsl_work_offset",
+    // hierarchical_tiles.wgsl: the tile grid and where the tile list starts
+    "mrsl_htile_grid",
+    "mrsl_tile_list",
     "mrsl_shade",
     "mrsl_classify",
     "mrsl_level0",

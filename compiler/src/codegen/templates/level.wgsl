@@ -1,10 +1,11 @@
 // Level {{LEVEL}}: {{WHAT}}.
 @compute @workgroup_size({{CLASSIFY_WORKGROUP}})
-fn {{CLASSIFY}}(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) mrsl_li: u32) {
+fn {{CLASSIFY}}({{PARAMS}}) {
+{{#INVOCATION}}
     let p = {{PIXEL}};
     // One call of mrsl_finish per entry point: a device that runs every branch
     // with its lanes masked (llvmpipe) would run each call site.
-    if (all(p < vec2<i32>(mrsl_ctl.size))) {
+    if ({{VALID}}all(p < vec2<i32>(mrsl_ctl.size))) {
         if (mrsl_classify(p, {{NEIGHBOURS}}, {{LEVEL}}u)) {
             mrsl_finish(p);
         }
