@@ -181,13 +181,19 @@ pub struct HierarchicalLayout {
     pub mask_words: u32,
     /// Word offset of each live coarse effect's value in a record, in stats-counter order.
     pub value_offsets: Vec<u32>,
-    /// `array<u32>`: pixel indices to shade, level 1 to 4 one after another.
+    /// `array<u32>`: pixel indices to shade, level 1 to 4 one after another;
+    /// with a background rule, the tile list at the back of level 4's
+    /// (`geometry::tile_list_offset`).
     pub work_binding: u32,
-    /// `array<atomic<u32>>` of 4 words per level (index 0..4): the first counts queued pixels.
+    /// `array<atomic<u32>>` of 4 words per level (index 0..4): the first counts queued
+    /// pixels; level 0's first two count the surface and background tiles
+    /// (`geometry::HIERARCHICAL_TILE_COUNTS`).
     pub queue_binding: u32,
-    /// Indirect dispatch arguments (x, y, z, unused) per level (index 0..4), written by
-    /// the `hier_args_*` entry points only: bind group `args_group`, binding 0. It is
-    /// a separate group because a buffer cannot be indirect and writable in one dispatch.
+    /// Indirect dispatch arguments (x, y, z, unused) per level (index 0..4), then of
+    /// the dispatches over the tile lists (`geometry::HIERARCHICAL_ARGUMENT_WORDS`),
+    /// written by the `hier_args_*` and `hier_tile_args` entry points only: bind group
+    /// `args_group`, binding 0. It is a separate group because a buffer cannot be
+    /// indirect and writable in one dispatch.
     pub args_group: u32,
 }
 
