@@ -304,7 +304,7 @@ impl Writer<'_, '_, '_> {
     }
 
     /// Where the background rule makes pixel `p` background (refinement not
-    /// forced): its record holds zeros and no evaluated bit, every coarse
+    /// forced): its record holds no evaluated bit, every coarse
     /// effect's value is zero for `mrsl_finish`, and the function returns
     /// with `returns`; so it is neither shaded nor interpolated.
     fn background_pixel(&mut self, indent: usize, returns: &str) {
@@ -317,11 +317,16 @@ impl Writer<'_, '_, '_> {
         self.line(indent, "}");
     }
 
-    /// Background pixel `p`: a record of zeros (no evaluated bit) and every
-    /// coarse effect zero for `mrsl_finish`.
+    /// Background pixel `p`: no evaluated bit in its record's mask words
+    /// (which `mrsl_finish` counts from) and every coarse effect zero for
+    /// `mrsl_finish`. Its other words are left as they are: a neighbour that
+    /// is not background is across the background channel's key from it, so
+    /// never uses its values or flags, and one that is background reads no
+    /// neighbour.
     fn clear_record(&mut self, indent: usize) {
         let c = self.checked();
-        for w in 0..self.i.layout.hierarchical.record_words {
+        let h = &self.i.layout.hierarchical;
+        for w in h.flag_words..h.flag_words + h.mask_words {
             self.line(indent, format!("{SET_WORD}(p, {w}u, 0u);"));
         }
         for e in self.coarse_live() {
@@ -477,21 +482,25 @@ impl Writer<'_, '_, '_> {
                 need.push(format!("!({spread} <= {CONTROL}.similarity * {scale})"));
                 "mean"
             } else {
-                // Integer, bool and matrix values are copied only when every neighbour agrees.
-                let agree = if matches!(info.ty, Type::Matrix(_)) {
-                    "false".to_string()
+                // Integer and bool values are copied only when every used
+                // neighbour agrees with the first used one (of pair (0, 1) if
+                // it is complete, else of pair (2, 3): an unused neighbour's
+                // record may be another frame's); matrix values never are.
+                if matches!(info.ty, Type::Matrix(_)) {
+                    need.push("true".into());
+                    "v0"
                 } else {
+                    self.line(2, "let first = select(v2, v0, ok[0]);");
                     let eq = |j: usize| {
                         if info.ty.components() == 1 {
-                            format!("(!ok[{j}] || v{j} == v0)")
+                            format!("(!ok[{j}] || v{j} == first)")
                         } else {
-                            format!("(!ok[{j}] || all(v{j} == v0))")
+                            format!("(!ok[{j}] || all(v{j} == first))")
                         }
                     };
-                    format!("{} && {} && {}", eq(1), eq(2), eq(3))
-                };
-                need.push(format!("!({agree})"));
-                "v0"
+                    need.push(format!("!({} && {} && {} && {})", eq(0), eq(1), eq(2), eq(3)));
+                    "first"
+                }
             };
             self.template(
                 0,
