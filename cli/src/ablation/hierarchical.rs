@@ -63,13 +63,12 @@ fn no_outputs(w: &str) -> Option<String> {
 }
 
 /// The shading function's test of the pixel's mask, per effect
-/// (`if ((mrsl_word(mrsl_pos, W) & M) != 0u) {`), made true: a listed pixel
+/// (`if ((mrsl_pmaskW & M) != 0u) {`), made true: a listed pixel
 /// evaluates every coarse effect, whichever its classification named.
 fn every_effect_listed(w: &str) -> Option<String> {
     edit_lines(w, |l| {
         let t = l.trim_start();
-        (t.starts_with("if ((mrsl_word(mrsl_pos, ") && t.ends_with(") != 0u) {"))
-            .then(|| format!("{}if (true) {{", indent(l)))
+        (t.starts_with("if ((mrsl_pmask") && t.ends_with(") != 0u) {")).then(|| format!("{}if (true) {{", indent(l)))
     })
 }
 

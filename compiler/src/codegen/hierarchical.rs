@@ -22,9 +22,7 @@
 
 use super::Writer;
 use super::effects::Evaluation;
-use super::names::{
-    CONTROL, COUNT, LANE, LOCAL_ID, Name, POS, SET_WORD, TILE_ARGS, TILE_INVOCATION, WORD, WORKGROUP,
-};
+use super::names::{CONTROL, COUNT, LANE, LOCAL_ID, Name, POS, SET_WORD, TILE_ARGS, TILE_INVOCATION, WORD, WORKGROUP};
 use super::records::{axis_neighbours, diagonal_neighbours, neighbours};
 use super::words::bit;
 use super::writer::cut;
@@ -32,8 +30,8 @@ use crate::check::EffectId;
 use crate::types::{Scalar, Type};
 use mrsl_abi::entry;
 use mrsl_abi::geometry::{
-    self, BACKGROUND_TILE_WORKGROUPS, COARSE_WORKGROUP, HIERARCHICAL_LEVEL0, HIERARCHICAL_LEVELS,
-    HIERARCHICAL_TILE, HIERARCHICAL_TILE_COUNTS, Lattice, QUEUE_WORDS_PER_LEVEL, WORK_LIST_WORKGROUP,
+    self, BACKGROUND_TILE_WORKGROUPS, COARSE_WORKGROUP, HIERARCHICAL_LEVEL0, HIERARCHICAL_LEVELS, HIERARCHICAL_TILE,
+    HIERARCHICAL_TILE_COUNTS, Lattice, QUEUE_WORDS_PER_LEVEL, WORK_LIST_WORKGROUP,
 };
 use std::fmt::Display;
 
@@ -162,7 +160,8 @@ impl Writer<'_, '_, '_> {
     /// (tiled), and the test that it has one (a prefix of the image test).
     fn level_invocation(&self, lattice: Lattice) -> (String, Option<String>, &'static str) {
         if !self.tiled() {
-            let params = format!("@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) {LANE}: u32");
+            let params =
+                format!("@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) {LANE}: u32");
             return (params, None, "");
         }
         let params = format!(
@@ -171,9 +170,8 @@ impl Writer<'_, '_, '_> {
         );
         let (x, y) = lattice.workgroups_per_tile();
         let surface = HIERARCHICAL_TILE_COUNTS[0];
-        let line = format!(
-            "let gid = {TILE_INVOCATION}({WORKGROUP}.xy, {LOCAL_ID}.xy, vec2<u32>({x}u, {y}u), {surface}u);"
-        );
+        let line =
+            format!("let gid = {TILE_INVOCATION}({WORKGROUP}.xy, {LOCAL_ID}.xy, vec2<u32>({x}u, {y}u), {surface}u);");
         (params, Some(line), "gid.x != 0xffffffffu && ")
     }
 
@@ -270,22 +268,21 @@ impl Writer<'_, '_, '_> {
         let [head, statistics, body] = cut(include_str!("templates/finish.wgsl"), &["STATISTICS", "BODY"]);
         self.template(0, head, &[]);
         if self.counts_stats() {
-            let [open, end] = cut(include_str!("templates/finish_statistics.wgsl"), &["COUNTS"]);
+            let [open, store, end] = cut(include_str!("templates/finish_statistics.wgsl"), &["MASKS", "COUNTS"]);
             let background = self.background_here(POS);
             let mask_y =
                 if self.has_background() { format!("select(0u, 0xffffffffu, {background})") } else { "0u".into() };
-            self.template(
-                0,
-                open,
-                &[
-                    ("FLAG_WORDS", &flag_words),
-                    ("STATISTICS_ON", &super::pixel::statistics_enabled()),
-                    ("MASK_Y", &mask_y),
-                ],
-            );
+            let values: &super::writer::Values =
+                &[("STATISTICS_ON", &super::pixel::statistics_enabled()), ("MASK_Y", &mask_y), ("FIRST_MASK_WORD", &0)];
+            self.template(0, open, values);
+            // The mask words once (a load per count would be a load per count).
+            for w in 0..self.i.layout.hierarchical.mask_words {
+                self.line(2, format!("let {} = {WORD}({POS}, {}u);", Name::PixelMask.of(w), flag_words + w));
+            }
+            self.template(0, store, values);
             for k in 0..coarse {
                 let (word, mask) = bit(k as u32);
-                let evaluated = format!("({WORD}({POS}, {}u) & {mask}u) != 0u", flag_words + word);
+                let evaluated = format!("({} & {mask}u) != 0u", Name::PixelMask.of(word));
                 self.count_refined_at(2, k, &evaluated);
             }
             if self.has_background() {
@@ -370,16 +367,21 @@ impl Writer<'_, '_, '_> {
         let [head, force, end] = cut(include_str!("templates/shade.wgsl"), &["FLAG_WORDS", "EFFECTS"]);
         self.template(0, head, &[]);
         self.declare_flag_words(flag_words);
+        // The mask words once: a load per effect would be a load per effect
+        // on llvmpipe, which does not reuse a storage texel across the
+        // record stores in between.
+        for w in 0..self.i.layout.hierarchical.mask_words {
+            self.line(1, format!("let {} = {WORD}({POS}, {}u);", Name::PixelMask.of(w), flag_words + w));
+        }
         self.template(0, force, &[]);
         let [evaluate, flag, read] = cut(include_str!("templates/shade_effect.wgsl"), &["EVALUATE", "FLAG"]);
         for e in self.coarse_live() {
             let info = &c.effects[e.index()];
-            let (word, mask) = bit(self.coarse_index[&e]);
+            let (mask_word, mask) = bit(self.coarse_index[&e]);
             let var = self.effect_name(e);
             let ty = info.ty.wgsl();
-            let word = flag_words + word;
             let values: [(&str, &dyn Display); 5] =
-                [("VAR", &var), ("TYPE", &ty), ("WORD", &word), ("MASK", &mask), ("NAME", &info.name)];
+                [("VAR", &var), ("TYPE", &ty), ("MASK_WORD", &mask_word), ("MASK", &mask), ("NAME", &info.name)];
             self.template(1, evaluate, &values);
             self.evaluate(e, 2, "", Evaluation::Kernel);
             self.template(1, flag, &values);
@@ -442,6 +444,14 @@ impl Writer<'_, '_, '_> {
         self.template(0, effects, &[]);
         for w in 0..mw {
             self.line(1, format!("var mask{w} = 0u;"));
+        }
+        // The neighbours' flag words once, for every effect's `flagged` test
+        // (as for the mask words in `mrsl_shade`).
+        let flagged_words: std::collections::BTreeSet<u32> =
+            self.coarse_live().iter().filter_map(|e| iface.refine_bit[e.index()].map(|b| bit(b).0)).collect();
+        for w in flagged_words {
+            let loads: Vec<String> = (0..4).map(|j| format!("{WORD}(q[{j}], {w}u)")).collect();
+            self.line(1, format!("var {} = array<u32, 4>({});", Name::NeighbourFlags.of(w), loads.join(", ")));
         }
         let [head_effect, tail_effect] = cut(include_str!("templates/classify_effect.wgsl"), &["TESTS"]);
         for e in self.coarse_live() {

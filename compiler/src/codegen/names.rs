@@ -37,6 +37,10 @@ pub(super) enum Name {
     FlagWord,
     /// `mrsl_w<w>`: word `w` of the block coarse kernel's record, before it is stored.
     RecordWord,
+    /// `mrsl_pmask<w>`: mask word `w` of a hierarchical pixel's record, loaded once.
+    PixelMask,
+    /// `mrsl_qflags<w>`: flag word `w` of a hierarchical pixel's four neighbours, loaded once.
+    NeighbourFlags,
     /// `mrsl_resolve<level>` and a neighbour function's `mrsl_resolve<level>_<effect>`.
     Resolve,
     /// `mrsl_resample<level>_<effect>`: a coarse effect resampled at a level.
@@ -98,7 +102,7 @@ pub(super) enum Name {
 impl Name {
     /// Every family, for the tests that check names against this module.
     #[cfg_attr(not(test), expect(dead_code, reason = "read by the tests"))]
-    pub(super) const ALL: [Name; 34] = [
+    pub(super) const ALL: [Name; 36] = [
         Name::Eval,
         Name::Val,
         Name::At,
@@ -106,6 +110,8 @@ impl Name {
         Name::Refined,
         Name::FlagWord,
         Name::RecordWord,
+        Name::PixelMask,
+        Name::NeighbourFlags,
         Name::Resolve,
         Name::Resample,
         Name::Get,
@@ -145,6 +151,8 @@ impl Name {
             Name::Refined => "mrsl_r",
             Name::FlagWord => "mrsl_flags",
             Name::RecordWord => "mrsl_w",
+            Name::PixelMask => "mrsl_pmask",
+            Name::NeighbourFlags => "mrsl_qflags",
             Name::Resolve => "mrsl_resolve",
             Name::Resample => "mrsl_resample",
             Name::Get => "mrsl_get",
@@ -372,7 +380,6 @@ pub(super) const FIXED: &[&str] = &[
     "mrsl_classify",
     "mrsl_level0",
     "mrsl_finish",
-    "mrsl_mask",
     // tile_lists.wgsl: the lists, their lengths, the workgroup's tile and whether it has surface
     "mrsl_tiles",
     "mrsl_tiles_n",

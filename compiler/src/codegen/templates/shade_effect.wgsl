@@ -1,5 +1,5 @@
 var {{VAR}}: {{TYPE}};
-if ((mrsl_word(mrsl_pos, {{WORD}}u) & {{MASK}}u) != 0u) {
+if ((mrsl_pmask{{MASK_WORD}} & {{MASK}}u) != 0u) {
 {{#EVALUATE}}
     mrsl_hput_{{NAME}}(mrsl_pos, {{VAR}});
 {{#FLAG}}
