@@ -85,7 +85,7 @@ fn launches_only(w: &str) -> Option<String> {
 /// The variants. "Nothing shaded" is the mode's floor: what it costs where
 /// no pixel past level 0 needs shading; the ones after it take a further
 /// part out of that floor.
-pub(super) const VARIANTS: [Variant; 9] = [
+pub(super) const VARIANTS: [Variant; 13] = [
     Variant {
         name: "no instrumentation",
         removes: "the statistics atomics, their barrier and the refine-mask store (`DispatchOptions::statistics` off)",
@@ -130,6 +130,27 @@ pub(super) const VARIANTS: [Variant; 9] = [
         name: "launches only",
         removes: "all the work: every entry point returns at once (left: passes, dispatches, indirect arguments)",
         edits: &[launches_only],
+    },
+    // The same parts as timed runs pay them: statistics off.
+    Variant {
+        name: "no outputs, no instrumentation",
+        removes: "every pixel's outputs, statistics off",
+        edits: &[no_outputs, no_instrumentation],
+    },
+    Variant {
+        name: "floor, no instrumentation",
+        removes: "every shading past level 0, statistics off: the floor as timed runs pay it",
+        edits: &[nothing_shaded, no_instrumentation],
+    },
+    Variant {
+        name: "floor, no level 0, no instrumentation",
+        removes: "also level 0's shading, statistics off",
+        edits: &[nothing_shaded, no_level0_shading, no_instrumentation],
+    },
+    Variant {
+        name: "floor, no classification, no instrumentation",
+        removes: "also the classification of levels 1-4 and their pixels' outputs, statistics off",
+        edits: &[nothing_shaded, no_classification, no_instrumentation],
     },
 ];
 

@@ -113,6 +113,15 @@ impl Target {
             Target::Hierarchical => "hierarchical kernel",
         }
     }
+
+    /// The edited kernel with its mode: "the coarse4x4 fine kernel", "the
+    /// hierarchical kernel" (whose name already says its mode).
+    fn title(self, mode: impl std::fmt::Display) -> String {
+        match self {
+            Target::Block(_) => format!("{mode} {}", self.what()),
+            Target::Hierarchical => self.what().to_string(),
+        }
+    }
 }
 
 /// `program` with its `target` kernel replaced by `wgsl`.
@@ -141,7 +150,7 @@ pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>> {
         compile_for_device(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &modes)?;
     let (programs, skipped) = variants(args, &name, &program, target)?;
     let device_name = format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
-    eprintln!("ablation: {name}, {} {}, on {device_name}, {}x{}", args.mode, target.what(), args.size.0, args.size.1);
+    eprintln!("ablation: {name}, {}, on {device_name}, {}x{}", target.title(&args.mode), args.size.0, args.size.1);
     let mut scene = bind_scene(&gpu, &args.scene, Some(args.size))?;
     let mut shaders = vec![];
     let mut textures = vec![];
@@ -301,11 +310,10 @@ fn markdown(args: &AblationArgs, target: Target, name: &str, device_name: &str, 
     let mut md = String::new();
     let _ = writeln!(
         md,
-        "# Ablation of the {} {}\n\nProgram `{name}`, scene {}, {}x{}, device {device_name}; {rounds} interleaved \
+        "# Ablation of the {}\n\nProgram `{name}`, scene {}, {}x{}, device {device_name}; {rounds} interleaved \
          rounds (the order rotates each round); `x full` is the median over the rounds of the variant's time / the full \
          kernel's time in the same round. Full kernel: {full_ms:.1} ms (median).\n",
-        args.mode,
-        target.what(),
+        target.title(&args.mode),
         args.scene,
         args.size.0,
         args.size.1
