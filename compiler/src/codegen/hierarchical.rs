@@ -445,14 +445,7 @@ impl Writer<'_, '_, '_> {
         for w in 0..mw {
             self.line(1, format!("var mask{w} = 0u;"));
         }
-        // The neighbours' flag words once, for every effect's `flagged` test
-        // (as for the mask words in `mrsl_shade`).
-        let flagged_words: std::collections::BTreeSet<u32> =
-            self.coarse_live().iter().filter_map(|e| iface.refine_bit[e.index()].map(|b| bit(b).0)).collect();
-        for w in flagged_words {
-            let loads: Vec<String> = (0..4).map(|j| format!("{WORD}(q[{j}], {w}u)")).collect();
-            self.line(1, format!("var {} = array<u32, 4>({});", Name::NeighbourFlags.of(w), loads.join(", ")));
-        }
+        self.neighbour_flag_words();
         let [head_effect, tail_effect] = cut(include_str!("templates/classify_effect.wgsl"), &["TESTS"]);
         for e in self.coarse_live() {
             let info = &c.effects[e.index()];
@@ -470,48 +463,7 @@ impl Writer<'_, '_, '_> {
                 self.template(0, include_str!("templates/classify_flagged.wgsl"), &[("WORD", &word), ("MASK", &mask)]);
                 need.push("flagged".into());
             }
-            let interpolable = matches!(info.ty, Type::Scalar(Scalar::Float) | Type::Vector(Scalar::Float, _));
-            let value = if interpolable {
-                let zero = format!("{}(0.0)", info.ty.wgsl());
-                let w = |j: usize| format!("select({zero}, v{j}, ok[{j}])");
-                self.line(2, format!("let mean = ({} + {} + {} + {}) / total;", w(0), w(1), w(2), w(3)));
-                let dev = |j: usize| format!("select({zero}, (v{j} - mean) * (v{j} - mean), ok[{j}])");
-                self.line(2, format!("let variance = ({} + {} + {} + {}) / total;", dev(0), dev(1), dev(2), dev(3)));
-                // The variance relative to the values' size (the largest
-                // square among the neighbours), so one similarity holds for
-                // a distance of hundreds of units and a colour of 0.01.
-                let sq = |j: usize| format!("select({zero}, v{j} * v{j}, ok[{j}])");
-                self.line(2, format!("let scale = max(max({}, {}), max({}, {}));", sq(0), sq(1), sq(2), sq(3)));
-                let spread = |v: &str| match info.ty.components() {
-                    1 => v.to_string(),
-                    2 => format!("max({v}.x, {v}.y)"),
-                    3 => format!("max(max({v}.x, {v}.y), {v}.z)"),
-                    _ => format!("max(max({v}.x, {v}.y), max({v}.z, {v}.w))"),
-                };
-                let (spread, scale) = (spread("variance"), spread("scale"));
-                need.push(format!("!({spread} <= {CONTROL}.similarity * {scale})"));
-                "mean"
-            } else {
-                // Integer and bool values are copied only when every used
-                // neighbour agrees with the first used one (of pair (0, 1) if
-                // it is complete, else of pair (2, 3): an unused neighbour's
-                // record may be another frame's); matrix values never are.
-                if matches!(info.ty, Type::Matrix(_)) {
-                    need.push("true".into());
-                    "v0"
-                } else {
-                    self.line(2, "let first = select(v2, v0, ok[0]);");
-                    let eq = |j: usize| {
-                        if info.ty.components() == 1 {
-                            format!("(!ok[{j}] || v{j} == first)")
-                        } else {
-                            format!("(!ok[{j}] || all(v{j} == first))")
-                        }
-                    };
-                    need.push(format!("!({} && {} && {} && {})", eq(0), eq(1), eq(2), eq(3)));
-                    "first"
-                }
-            };
+            let value = self.value_test(&info.ty, &mut need);
             self.template(
                 0,
                 tail_effect,
@@ -532,5 +484,65 @@ impl Writer<'_, '_, '_> {
         }
         let any: Vec<String> = (0..mw).map(|w| format!("mask{w}")).collect();
         self.template(0, end, &[("ANY_MASK", &any.join(" | ")), ("QUEUE_WORDS", &QUEUE_WORDS_PER_LEVEL)]);
+    }
+
+    /// The classification's test of an effect of type `ty` beyond `disc`
+    /// and `flagged`, pushed onto `need` (its lines written before it), and
+    /// the value the pixel stores where no test holds.
+    fn value_test(&mut self, ty: &Type, need: &mut Vec<String>) -> &'static str {
+        let interpolable = matches!(ty, Type::Scalar(Scalar::Float) | Type::Vector(Scalar::Float, _));
+        if interpolable {
+            let zero = format!("{}(0.0)", ty.wgsl());
+            let w = |j: usize| format!("select({zero}, v{j}, ok[{j}])");
+            self.line(2, format!("let mean = ({} + {} + {} + {}) / total;", w(0), w(1), w(2), w(3)));
+            let dev = |j: usize| format!("select({zero}, (v{j} - mean) * (v{j} - mean), ok[{j}])");
+            self.line(2, format!("let variance = ({} + {} + {} + {}) / total;", dev(0), dev(1), dev(2), dev(3)));
+            // The variance relative to the values' size (the largest
+            // square among the neighbours), so one similarity holds for
+            // a distance of hundreds of units and a colour of 0.01.
+            let sq = |j: usize| format!("select({zero}, v{j} * v{j}, ok[{j}])");
+            self.line(2, format!("let scale = max(max({}, {}), max({}, {}));", sq(0), sq(1), sq(2), sq(3)));
+            let spread = |v: &str| match ty.components() {
+                1 => v.to_string(),
+                2 => format!("max({v}.x, {v}.y)"),
+                3 => format!("max(max({v}.x, {v}.y), {v}.z)"),
+                _ => format!("max(max({v}.x, {v}.y), max({v}.z, {v}.w))"),
+            };
+            let (spread, scale) = (spread("variance"), spread("scale"));
+            need.push(format!("!({spread} <= {CONTROL}.similarity * {scale})"));
+            "mean"
+        } else {
+            // Integer and bool values are copied only when every used
+            // neighbour agrees with the first used one (of pair (0, 1) if
+            // it is complete, else of pair (2, 3): an unused neighbour's
+            // record may be another frame's); matrix values never are.
+            if matches!(ty, Type::Matrix(_)) {
+                need.push("true".into());
+                "v0"
+            } else {
+                self.line(2, "let first = select(v2, v0, ok[0]);");
+                let eq = |j: usize| {
+                    if ty.components() == 1 {
+                        format!("(!ok[{j}] || v{j} == first)")
+                    } else {
+                        format!("(!ok[{j}] || all(v{j} == first))")
+                    }
+                };
+                need.push(format!("!({} && {} && {} && {})", eq(0), eq(1), eq(2), eq(3)));
+                "first"
+            }
+        }
+    }
+
+    /// The neighbours' flag words, loaded once for every effect's `flagged`
+    /// test (as the mask words are in `mrsl_shade`).
+    fn neighbour_flag_words(&mut self) {
+        let refine_bit = &self.i.interface.refine_bit;
+        let words: std::collections::BTreeSet<u32> =
+            self.coarse_live().iter().filter_map(|e| refine_bit[e.index()].map(|b| bit(b).0)).collect();
+        for w in words {
+            let loads: Vec<String> = (0..4).map(|j| format!("{WORD}(q[{j}], {w}u)")).collect();
+            self.line(1, format!("var {} = array<u32, 4>({});", Name::NeighbourFlags.of(w), loads.join(", ")));
+        }
     }
 }
