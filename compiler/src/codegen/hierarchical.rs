@@ -263,7 +263,6 @@ impl Writer<'_, '_, '_> {
     /// bits of the record), then its fine effects and outputs with the
     /// coarse values of `mrsl_pv_*`.
     fn finish_function(&mut self) {
-        let flag_words = self.i.layout.hierarchical.flag_words;
         let coarse = self.coarse_live().len();
         let [head, statistics, body] = cut(include_str!("templates/finish.wgsl"), &["STATISTICS", "BODY"]);
         self.template(0, head, &[]);
@@ -272,13 +271,11 @@ impl Writer<'_, '_, '_> {
             let background = self.background_here(POS);
             let mask_y =
                 if self.has_background() { format!("select(0u, 0xffffffffu, {background})") } else { "0u".into() };
+            let mask_x = Name::PixelMask.of(0);
             let values: &super::writer::Values =
-                &[("STATISTICS_ON", &super::pixel::statistics_enabled()), ("MASK_Y", &mask_y), ("FIRST_MASK_WORD", &0)];
+                &[("STATISTICS_ON", &super::pixel::statistics_enabled()), ("MASK_X", &mask_x), ("MASK_Y", &mask_y)];
             self.template(0, open, values);
-            // The mask words once (a load per count would be a load per count).
-            for w in 0..self.i.layout.hierarchical.mask_words {
-                self.line(2, format!("let {} = {WORD}({POS}, {}u);", Name::PixelMask.of(w), flag_words + w));
-            }
+            self.load_pixel_masks(2);
             self.template(0, store, values);
             for k in 0..coarse {
                 let (word, mask) = bit(k as u32);
@@ -367,12 +364,7 @@ impl Writer<'_, '_, '_> {
         let [head, force, end] = cut(include_str!("templates/shade.wgsl"), &["FLAG_WORDS", "EFFECTS"]);
         self.template(0, head, &[]);
         self.declare_flag_words(flag_words);
-        // The mask words once: a load per effect would be a load per effect
-        // on llvmpipe, which does not reuse a storage texel across the
-        // record stores in between.
-        for w in 0..self.i.layout.hierarchical.mask_words {
-            self.line(1, format!("let {} = {WORD}({POS}, {}u);", Name::PixelMask.of(w), flag_words + w));
-        }
+        self.load_pixel_masks(1);
         self.template(0, force, &[]);
         let [evaluate, flag, read] = cut(include_str!("templates/shade_effect.wgsl"), &["EVALUATE", "FLAG"]);
         for e in self.coarse_live() {
@@ -531,6 +523,17 @@ impl Writer<'_, '_, '_> {
                 need.push(format!("!({} && {} && {} && {})", eq(0), eq(1), eq(2), eq(3)));
                 "first"
             }
+        }
+    }
+
+    /// The pixel's mask words (`mrsl_pmask<w>`), loaded once for every
+    /// effect's test: llvmpipe loads a read-write storage texel again after
+    /// each store to the texture in between, so a load per effect costs one.
+    fn load_pixel_masks(&mut self, indent: usize) {
+        let h = &self.i.layout.hierarchical;
+        let (flag_words, mask_words) = (h.flag_words, h.mask_words);
+        for w in 0..mask_words {
+            self.line(indent, format!("let {} = {WORD}({POS}, {}u);", Name::PixelMask.of(w), flag_words + w));
         }
     }
 

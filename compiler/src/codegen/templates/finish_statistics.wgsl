@@ -1,5 +1,5 @@
     if ({{STATISTICS_ON}}) {
 {{#MASKS}}
-        textureStore(mrsl_refine_mask, mrsl_pos, vec4<u32>(mrsl_pmask{{FIRST_MASK_WORD}}, {{MASK_Y}}, 0u, 1u));
+        textureStore(mrsl_refine_mask, mrsl_pos, vec4<u32>({{MASK_X}}, {{MASK_Y}}, 0u, 1u));
 {{#COUNTS}}
     }
