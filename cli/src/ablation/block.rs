@@ -86,6 +86,68 @@ fn no_key_tests(w: &str) -> Option<String> {
     })
 }
 
+/// The surface keys' test in squared form, without its square root and
+/// the two normalisations: `dot(d, n)^2 > t^2 dot(d, d) dot(n, n)` for each
+/// normal, the same test up to rounding. What the roots cost.
+fn surface_tests_without_roots(w: &str) -> Option<String> {
+    replace_surface_edge_body(w, |t| {
+        format!(
+            "let d = b.p - a.p;\n    let bound = {t} * {t} * dot(d, d);\n    let da = dot(d, a.n);\n    \
+             let db = dot(d, b.n);\n    return da * da > bound * dot(a.n, a.n) || db * db > bound * dot(b.n, b.n);"
+        )
+    })
+}
+
+/// The key comparisons without their arithmetic, the loads kept: a surface
+/// key's test and a threshold key's distance become exact comparisons of
+/// the values loaded. What the tests cost beyond their loads.
+fn key_comparisons_without_arithmetic(w: &str) -> Option<String> {
+    let surface = replace_surface_edge_body(w, |_| "return any(a.p != b.p) || any(a.n != b.n);".to_string());
+    let w = surface.as_deref().unwrap_or(w);
+    let threshold = edit_lines(w, |l| {
+        let t = l.trim_start();
+        if !t.starts_with("let side_") || !t.contains("distance(") {
+            return None;
+        }
+        // `distance(a, b) <= t` of plain names, as `effects.rs` writes it.
+        let mut out = String::new();
+        let mut rest = l;
+        while let Some(at) = rest.find("distance(") {
+            out.push_str(&rest[..at]);
+            let args = &rest[at + "distance(".len()..];
+            let (pair, after) = args.split_once(") <= ")?;
+            let (a, b) = pair.split_once(", ")?;
+            let end = after.find(|c: char| c == ',' || c == ')').unwrap_or(after.len());
+            out.push_str(&format!("all({a} == {b})"));
+            rest = &after[end..];
+        }
+        out.push_str(rest);
+        Some(out)
+    });
+    threshold.or(surface)
+}
+
+/// Replaces the body of each surface key's edge test (`fn mrsl_surface_edge_`)
+/// with `body(threshold)`, the threshold read from its `bound` line.
+fn replace_surface_edge_body(w: &str, body: impl Fn(&str) -> String) -> Option<String> {
+    let mut out = String::with_capacity(w.len());
+    let mut changed = false;
+    let mut lines = w.lines();
+    while let Some(l) = lines.next() {
+        out.push_str(l);
+        out.push('\n');
+        if !(l.starts_with("fn mrsl_surface_edge_") && l.ends_with("-> bool {")) {
+            continue;
+        }
+        let body_lines: Vec<&str> = lines.by_ref().take_while(|l| *l != "}").collect();
+        let bound = body_lines.iter().find_map(|l| l.trim_start().strip_prefix("let bound = "))?;
+        let threshold = bound.split(" * ").next()?;
+        out.push_str(&format!("    {}\n}}\n", body(threshold)));
+        changed = true;
+    }
+    changed.then_some(out)
+}
+
 /// The corners' refine-flag words of the resolve (read as zero).
 fn no_flag_reads(w: &str) -> Option<String> {
     edit_lines(w, |l| {
@@ -159,7 +221,7 @@ fn as_background(w: &str) -> Option<String> {
 /// The variants. Removing the key tests or the flag reads from the full
 /// kernel would also change what is refined, so those parts are measured
 /// within the fixed cost (nothing refined), where they decide nothing.
-pub(super) const VARIANTS: [Variant; 11] = [
+pub(super) const VARIANTS: [Variant; 14] = [
     Variant {
         name: "no instrumentation",
         removes: "the statistics atomics, their barrier and the refine-mask store (`DispatchOptions::statistics` off)",
@@ -199,6 +261,21 @@ pub(super) const VARIANTS: [Variant; 11] = [
         name: "fixed cost, no instrumentation",
         removes: "the fixed cost as timed runs pay it: nothing refined, statistics off",
         edits: &[nothing_refined, no_instrumentation],
+    },
+    Variant {
+        name: "fixed cost, no instrumentation, no key tests",
+        removes: "the key loads and comparisons from the fixed cost as timed runs pay it (with statistics on, a pixel the keys tear also counts itself with an atomic add, which would be counted as the keys' cost)",
+        edits: &[nothing_refined, no_instrumentation, no_key_tests],
+    },
+    Variant {
+        name: "fixed cost, no instrumentation, surface tests without roots",
+        removes: "the square root and normalisations of the surface keys' test (the same test squared), statistics off",
+        edits: &[nothing_refined, no_instrumentation, surface_tests_without_roots],
+    },
+    Variant {
+        name: "fixed cost, no instrumentation, key comparisons without arithmetic",
+        removes: "the arithmetic of the key tests, their loads kept (exact comparisons of the values), statistics off",
+        edits: &[nothing_refined, no_instrumentation, key_comparisons_without_arithmetic],
     },
     Variant {
         name: "fixed cost, no refinement loops",
