@@ -623,8 +623,8 @@ pub fn sponza_lights_workload_matches_its_reference(gpu: &Gpu) {
         assert!(forced.pixels == reference.pixels, "{mode}: forced refinement differs from the reference");
     }
     // Adaptive quality at the program's defaults, measured on lavapipe
-    // (Mesa 22.3) at 192x108: coarse4x4 42.2 dB at shaded fraction 0.789,
-    // hierarchical 43.7 dB at 0.734 (the fractions count the sun's cosine,
+    // (Mesa 22.3) at 192x108: coarse4x4 42.1 dB at shaded fraction 0.763,
+    // hierarchical 43.6 dB at 0.715 (the fractions count the sun's cosine,
     // a fine effect, as shaded at every pixel). At this size almost every 4x4 block
     // holds a silhouette or a crease, and a block spans metres of wall: a
     // pixel resampled from the corners on its side of an edge extrapolates
@@ -635,7 +635,7 @@ pub fn sponza_lights_workload_matches_its_reference(gpu: &Gpu) {
     // (docs/evaluation.md). The bars are 3 dB below, as in the test above:
     // threshold comparisons may flip a few blocks on another driver.
     // (20,427 of 20,504 visible points agreed with the shadow map.)
-    for (mode, bar) in [(Mode::Coarse4x4, 39.2), (Mode::Hierarchical, 40.6)] {
+    for (mode, bar) in [(Mode::Coarse4x4, 39.1), (Mode::Hierarchical, 40.6)] {
         let out = run(mode, false);
         let db = psnr(&out.pixels, &reference.pixels);
         eprintln!("sponza_lights 192x108 {mode}: PSNR {db:.2} dB, shaded fraction {:.4}", out.stats.shaded_fraction);

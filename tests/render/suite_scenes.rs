@@ -90,8 +90,9 @@ fn every_mode_matches_the_reference(gpu: &Gpu, scene: Scene, lit: f32, bars: (f6
 /// The generated city: the same mesh on every call, kilometres wide, seen
 /// with a third of the frame sky; the workload in every mode with forced
 /// refinement bit-identical to the reference, and its adaptive modes close.
-/// (Measured on lavapipe, Mesa 22.3, at 192x108: coarse4x4 56.0 dB at
-/// shaded fraction 0.495, hierarchical 50.0 dB at 0.429.)
+/// (Measured on lavapipe, Mesa 22.3, at 192x108: coarse4x4 56.5 dB at
+/// shaded fraction 0.649, hierarchical 50.0 dB at 0.577; the fractions
+/// count the sun's cosine, a fine effect, as shaded at every pixel.)
 pub fn generated_scene_workload_matches_its_reference(gpu: &Gpu) {
     let mesh = mrsl_lab::procedural::city();
     assert!(mesh == mrsl_lab::procedural::city(), "the city differs between two calls");
@@ -102,7 +103,7 @@ pub fn generated_scene_workload_matches_its_reference(gpu: &Gpu) {
     let scene = Scene::Generated.mesh_scene(gpu).unwrap().unwrap();
     let sky = sky_fraction(gpu, &scene, SIZE);
     assert!(sky > 0.3 && sky < 0.7, "sky fraction {sky}");
-    every_mode_matches_the_reference(gpu, Scene::Generated, 0.05, (53.0, 47.0));
+    every_mode_matches_the_reference(gpu, Scene::Generated, 0.05, (53.5, 47.0));
 }
 
 /// The rigs of the new scenes give the reference point of their layout the
@@ -309,8 +310,8 @@ pub fn bad_ac3d_files_are_typed_errors() {
 /// TORCS's forza track: its triangles, materials and alpha-tested trees,
 /// 2.5 km wide; from the default camera more than 30% of the frame is sky,
 /// and the workload is lit in every mode, forced refinement bit-identical
-/// to the reference. (Measured on lavapipe at 192x108: coarse4x4 52.9 dB at
-/// shaded fraction 0.572, hierarchical 59.0 dB at 0.520.)
+/// to the reference. (Measured on lavapipe at 192x108: coarse4x4 57.1 dB at
+/// shaded fraction 0.714, hierarchical 64.3 dB at 0.641.)
 pub fn outdoor_scene_has_a_large_sky_and_matches_its_reference(gpu: &Gpu) {
     let mesh = mrsl_lab::fixtures::outdoor_shared().unwrap();
     mesh.validate().unwrap();
@@ -322,15 +323,20 @@ pub fn outdoor_scene_has_a_large_sky_and_matches_its_reference(gpu: &Gpu) {
     let scene = Scene::Outdoor.mesh_scene(gpu).unwrap().unwrap();
     let sky = sky_fraction(gpu, &scene, SIZE);
     assert!(sky > 0.3, "sky fraction {sky}");
-    every_mode_matches_the_reference(gpu, Scene::Outdoor, 0.05, (49.8, 55.9));
+    every_mode_matches_the_reference(gpu, Scene::Outdoor, 0.05, (54.1, 61.3));
 }
 
 /// The Franka Panda's link 6 at its native scale (18 cm): its triangles and
 /// materials; from the default camera it fills about half the frame's
 /// height against the background, and the workload is lit in every mode,
 /// forced refinement bit-identical to the reference. (Measured on lavapipe
-/// at 192x108: coarse4x4 35.4 dB at shaded fraction 0.400, hierarchical
-/// 48.4 dB at 0.390.)
+/// at 192x108: coarse4x4 46.2 dB at shaded fraction 0.554, hierarchical
+/// 43.3 dB at 0.532. With the workload's surface key at 0.05 rather than
+/// 0.25, 43.5 dB and 49.4 dB: at this size the part is 50 pixels tall, a
+/// pixel spans millimetres of its curved surface, and the hierarchical
+/// mode interpolates across a level's spacing what its predicates measure
+/// at a pixel's, which the tighter key had refined as torn; at 1920x1080
+/// it measures 47.8 dB with either key, MSSIM 0.9972, docs/evaluation.md.)
 pub fn small_scene_fills_half_the_frame_and_matches_its_reference(gpu: &Gpu) {
     let mesh = mrsl_lab::fixtures::small_shared().unwrap();
     mesh.validate().unwrap();
@@ -346,7 +352,7 @@ pub fn small_scene_fills_half_the_frame_and_matches_its_reference(gpu: &Gpu) {
     assert!((0.4..0.75).contains(&height), "the object spans {height} of the frame's height");
     let (normal, _) = floats(&g, "normal");
     assert!(normal.iter().all(|v| v.is_finite()));
-    every_mode_matches_the_reference(gpu, Scene::Small, 0.05, (32.4, 45.4));
+    every_mode_matches_the_reference(gpu, Scene::Small, 0.05, (43.2, 40.3));
 }
 
 /// A GPU test over a fetched model.
