@@ -332,11 +332,10 @@ pub fn outdoor_scene_has_a_large_sky_and_matches_its_reference(gpu: &Gpu) {
 /// forced refinement bit-identical to the reference. (Measured on lavapipe
 /// at 192x108: coarse4x4 46.2 dB at shaded fraction 0.554, hierarchical
 /// 43.3 dB at 0.532. With the workload's surface key at 0.05 rather than
-/// 0.25, 43.5 dB and 49.4 dB: at this size the part is 50 pixels tall, a
-/// pixel spans millimetres of its curved surface, and the hierarchical
-/// mode interpolates across a level's spacing what its predicates measure
-/// at a pixel's, which the tighter key had refined as torn; at 1920x1080
-/// it measures 47.8 dB with either key, MSSIM 0.9972, docs/evaluation.md.)
+/// 0.25, 43.5 dB and 49.4 dB: at this size the part is 50 pixels tall and
+/// a pixel spans millimetres of its curved surface, where the tighter key
+/// shaded more pixels as torn; at 1920x1080 the hierarchical mode measures
+/// 47.8 dB with either key, MSSIM 0.9972, docs/evaluation.md.)
 pub fn small_scene_fills_half_the_frame_and_matches_its_reference(gpu: &Gpu) {
     let mesh = mrsl_lab::fixtures::small_shared().unwrap();
     mesh.validate().unwrap();
