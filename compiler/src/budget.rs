@@ -404,7 +404,7 @@ impl Counter<'_, '_> {
                     Some(Callee::Builtin(b)) if b.is_derivative() => {
                         // The operand is evaluated at the neighbours, the other arguments here.
                         let operand = b.derivative_operand();
-                        let evaluations = match b {
+                        let evaluations = match b.plain_derivative() {
                             Builtin::Ddx | Builtin::Ddy => 2,
                             _ => 4,
                         };

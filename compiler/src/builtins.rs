@@ -86,6 +86,9 @@ builtins! {
     Ddx = "ddx",
     Ddy = "ddy",
     Fwidth = "fwidth",
+    DdxSurface = "ddx_surface",
+    DdySurface = "ddy_surface",
+    FwidthSurface = "fwidth_surface",
     Sample = "sample",
     SampleLevel = "sample_level",
     SampleGrad = "sample_grad",
@@ -197,7 +200,7 @@ impl Builtin {
         match self {
             Sin | Cos | Tan | Asin | Acos | Atan | Sinh | Cosh | Tanh | Exp | Exp2 | Log | Log2 | Sqrt
             | InverseSqrt | Floor | Ceil | Fract | Round | Trunc | Saturate | Radians | Degrees | Ddx | Ddy
-            | Fwidth => unary(Accept::Float, Returns::Arg),
+            | Fwidth | DdxSurface | DdySurface | FwidthSurface => unary(Accept::Float, Returns::Arg),
             Abs => unary(Accept::Number, Returns::Arg),
             Sign => unary(Accept::Signed, Returns::Arg),
             Pow | Atan2 => generic(2, Accept::Float, &[], Returns::Arg),
@@ -241,7 +244,12 @@ impl Builtin {
     /// evaluation of this argument at the neighbouring sample.
     pub fn derivative_operand(self) -> Option<usize> {
         match self {
-            Builtin::Ddx | Builtin::Ddy | Builtin::Fwidth => Some(0),
+            Builtin::Ddx
+            | Builtin::Ddy
+            | Builtin::Fwidth
+            | Builtin::DdxSurface
+            | Builtin::DdySurface
+            | Builtin::FwidthSurface => Some(0),
             Builtin::Sample => Some(2),
             _ => None,
         }
@@ -250,6 +258,25 @@ impl Builtin {
     /// Whether the builtin is a derivative (see [`Builtin::derivative_operand`]).
     pub fn is_derivative(self) -> bool {
         self.derivative_operand().is_some()
+    }
+
+    /// Whether the derivative stays on the effect's surface: its difference
+    /// never spans one of the effect's discontinuity keys at coarse rate
+    /// where the sample on the other side does not (docs/language.md,
+    /// section 9).
+    pub fn on_surface(self) -> bool {
+        matches!(self, Builtin::DdxSurface | Builtin::DdySurface | Builtin::FwidthSurface)
+    }
+
+    /// The derivative without [`Builtin::on_surface`]'s rule: `ddx` for
+    /// `ddx_surface`; itself for the others.
+    pub fn plain_derivative(self) -> Builtin {
+        match self {
+            Builtin::DdxSurface => Builtin::Ddx,
+            Builtin::DdySurface => Builtin::Ddy,
+            Builtin::FwidthSurface => Builtin::Fwidth,
+            other => other,
+        }
     }
 
     /// Where the builtin is defined on constant arguments, as WGSL's constant

@@ -37,6 +37,8 @@ pub struct DerivSite<'a> {
     pub params: Vec<LocalId>,
     /// Effects the operand reads (directly or through inlined locals): needed at the neighbour.
     pub effects: Vec<EffectId>,
+    /// `ddx_surface`, `ddy_surface` or `fwidth_surface` ([`crate::builtins::Builtin::on_surface`]).
+    pub on_surface: bool,
 }
 
 /// Per-program derivative information.
@@ -121,6 +123,7 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
                 operand,
                 params: params.into_iter().collect(),
                 effects: effects.into_iter().collect(),
+                on_surface: builtin.on_surface(),
             });
         }
     }

@@ -304,7 +304,7 @@ fn reach<'e>(
                 // `mrsl_ddx_<k>(mrsl_pos, ...)`: the operand is in `mrsl_d<k>`.
                 // Past the depth limit, which this root already breaks, a
                 // chain of derivatives is not followed further.
-                Some(Builtin::Ddx | Builtin::Ddy | Builtin::Fwidth) => {
+                Some(b) if matches!(b.plain_derivative(), Builtin::Ddx | Builtin::Ddy | Builtin::Fwidth) => {
                     if depth <= MAX_EXPR_DEPTH {
                         args.iter().for_each(|a| operand(a, depth));
                     }
@@ -336,7 +336,7 @@ fn argument_cost(builtin: Builtin, k: usize) -> u32 {
 /// What a derivative call adds below itself, beyond its arguments.
 fn call_extra(e: &Expr) -> u32 {
     let ExprKind::Call { callee, .. } = &e.kind else { return 0 };
-    match Builtin::from_name(&callee.name) {
+    match Builtin::from_name(&callee.name).map(Builtin::plain_derivative) {
         // `mrsl_ddx_<k>(mrsl_pos, ...)`
         Some(Builtin::Ddx | Builtin::Ddy) => 1,
         // `(abs(mrsl_ddx_<k>(mrsl_pos, ...)) + abs(mrsl_ddy_<k>(...)))`

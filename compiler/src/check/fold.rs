@@ -593,6 +593,9 @@ impl Checker<'_> {
                 | Ddx
                 | Ddy
                 | Fwidth
+                | DdxSurface
+                | DdySurface
+                | FwidthSurface
                 | Sample
                 | SampleLevel
                 | SampleGrad

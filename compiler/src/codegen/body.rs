@@ -388,7 +388,7 @@ impl Writer<'_, '_, '_> {
                 let call_args = call_args.join(", ");
                 let dx = format!("{}({call_args})", Name::Ddx.of(site_index));
                 let dy = format!("{}({call_args})", Name::Ddy.of(site_index));
-                match builtin {
+                match builtin.plain_derivative() {
                     Builtin::Ddx => dx,
                     Builtin::Ddy => dy,
                     Builtin::Fwidth => format!("(abs({dx}) + abs({dy}))"),

@@ -589,9 +589,35 @@ impl<'b> Writer<'_, '_, 'b> {
     /// `mrsl_d<k>` (the operand of derivative site k at a position) and its
     /// differences across the position's quad, `mrsl_ddx_<k>` and `mrsl_ddy_<k>`.
     pub(super) fn derivative_helpers(&mut self) {
-        for k in self.live_sites() {
+        let sites = self.live_sites();
+        if self.derivatives() == Derivatives::HereOnSurface {
+            let mut effects: Vec<EffectId> =
+                sites.iter().map(|&k| &self.i.deriv.sites[k]).filter(|s| s.on_surface).map(|s| s.effect).collect();
+            effects.sort();
+            effects.dedup();
+            for e in effects {
+                self.apart_function(e);
+            }
+        }
+        for k in sites {
             self.cached(super::Piece::Derivative(k, self.derivatives()), |w| w.derivative_helper(k));
         }
+    }
+
+    /// `mrsl_apart_<effect>(a, b)`: whether positions `a` and `b` lie across
+    /// one of the keys `effect` reads (none: never), as the resolve compares
+    /// a pixel with a corner.
+    fn apart_function(&mut self, effect: EffectId) {
+        let keys = self.keys_of(&[effect]);
+        if keys.is_empty() {
+            return;
+        }
+        let tests: Vec<String> = keys.iter().map(|key| key.differs(&key.load("a"), &key.load("b"))).collect();
+        let name = Name::Apart.of(&self.checked().effects[effect.index()].name);
+        self.line(0, format!("fn {name}(a: vec2<i32>, b: vec2<i32>) -> bool {{"));
+        self.line(1, format!("return {};", tests.join(" || ")));
+        self.line(0, "}");
+        self.line(0, "");
     }
 
     fn derivative_helper(&mut self, k: usize) {
@@ -623,7 +649,15 @@ impl<'b> Writer<'_, '_, 'b> {
             ];
             let [operand_helper, differences] = cut(include_str!("templates/derivative.wgsl"), &["DIFFERENCES"]);
             self.template(0, operand_helper, values);
-            if self.reuses_operand_here(k) {
+            let effect = site.effect;
+            let on_surface = site.on_surface
+                && self.derivatives() == Derivatives::HereOnSurface
+                && !self.keys_of(&[effect]).is_empty();
+            if on_surface {
+                let apart = Name::Apart.of(&c.effects[effect.index()].name);
+                let values = &[values, &[("APART", &apart as &dyn std::fmt::Display)][..]].concat();
+                self.template(0, include_str!("templates/derivative_on_surface.wgsl"), values);
+            } else if self.reuses_operand_here(k) {
                 self.template(0, differences, values);
             } else {
                 self.template(0, include_str!("templates/derivative_both.wgsl"), values);
@@ -645,13 +679,17 @@ impl<'b> Writer<'_, '_, 'b> {
     /// under forced refinement the value is the evaluated one.
     pub(super) fn reuses_operand_here(&self, k: usize) -> bool {
         match self.derivatives() {
-            Derivatives::Here => true,
+            Derivatives::Here | Derivatives::HereOnSurface => true,
             Derivatives::HereWithoutEffects => self.i.deriv.sites[k].effects.is_empty(),
         }
     }
 
     pub(super) fn derivatives(&self) -> Derivatives {
-        if matches!(self.kind, KernelKind::Checkerboard) { Derivatives::HereWithoutEffects } else { Derivatives::Here }
+        match self.kind {
+            KernelKind::Checkerboard => Derivatives::HereWithoutEffects,
+            kind if kind.is_coarse() => Derivatives::HereOnSurface,
+            _ => Derivatives::Here,
+        }
     }
 
     /// Effects this kernel needs at other positions (for derivatives).

@@ -150,6 +150,11 @@ enum Piece {
 enum Derivatives {
     /// From the caller, always.
     Here,
+    /// From the caller, always; and the differences of `ddx_surface`,
+    /// `ddy_surface` and `fwidth_surface` never span one of the effect's
+    /// discontinuity keys where the sample on the other side does not (the
+    /// kernels over coarse samples, docs/language.md section 9).
+    HereOnSurface,
     /// From the caller where the operand reads no effect (the checkerboard kernel).
     HereWithoutEffects,
 }

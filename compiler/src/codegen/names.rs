@@ -97,12 +97,14 @@ pub(super) enum Name {
     SurfaceKey,
     /// `mrsl_surface_edge_<channel>`: whether two surface key values lie on different surfaces.
     SurfaceEdge,
+    /// `mrsl_apart_<effect>`: whether two positions lie across one of an effect's keys.
+    Apart,
 }
 
 impl Name {
     /// Every family, for the tests that check names against this module.
     #[cfg_attr(not(test), expect(dead_code, reason = "read by the tests"))]
-    pub(super) const ALL: [Name; 36] = [
+    pub(super) const ALL: [Name; 37] = [
         Name::Eval,
         Name::Val,
         Name::At,
@@ -139,6 +141,7 @@ impl Name {
         Name::SurfaceStruct,
         Name::SurfaceKey,
         Name::SurfaceEdge,
+        Name::Apart,
     ];
 
     /// What every member's name starts with.
@@ -180,6 +183,7 @@ impl Name {
             Name::SurfaceStruct => "MrslSurface_",
             Name::SurfaceKey => "mrsl_surface_key_",
             Name::SurfaceEdge => "mrsl_surface_edge_",
+            Name::Apart => "mrsl_apart_",
         }
     }
 
@@ -364,6 +368,11 @@ pub(super) const FIXED: &[&str] = &[
     "mrsl_there",
     "mrsl_second",
     "mrsl_difference",
+    // derivative_on_surface.wgsl
+    "mrsl_other",
+    "mrsl_mirror",
+    "mrsl_flip",
+    "mrsl_taken",
     // dynamic_gate.wgsl, parent_refined.wgsl, any_refined.wgsl, resolve_inner.wgsl
     "mrsl_parent_refined",
     "mrsl_any_refined",

@@ -694,7 +694,7 @@ impl<'c> Gen<'c> {
         }
         let text = &self.out[start..];
         let reads = names_in(text);
-        if ["ddx(", "ddy(", "fwidth("].iter().any(|d| text.contains(d))
+        if ["ddx(", "ddy(", "fwidth(", "ddx_surface(", "ddy_surface(", "fwidth_surface("].iter().any(|d| text.contains(d))
             || reads.iter().any(|r| self.differentiating.contains(*r))
         {
             self.differentiating.insert(name.clone());
@@ -707,7 +707,7 @@ impl<'c> Gen<'c> {
         let own_ok =
             ctx.scopes[0].iter().any(|v| v.name == own && v.kind == Kind::Own { mutable: false, deriv_ok: true });
         let threshold = if self.chance(1, 2) { "gain".to_string() } else { self.pick(&["0.05", "0.1", "0.01"]).into() };
-        let f = self.pick(&["fwidth", "ddx", "ddy"]);
+        let f = self.pick(&["fwidth", "ddx", "ddy", "fwidth_surface"]);
         self.feat("refine");
         match self.below(4) {
             0 if own_ok && ty.scalar() == Some(S::F) && !matches!(ty, M(_)) => {
@@ -1947,7 +1947,7 @@ impl<'c> Gen<'c> {
         if !matches!(ctx.body, Body::Effect(_)) || ctx.deriv {
             return None;
         }
-        let f = self.pick(&["ddx", "ddy", "fwidth"]);
+        let f = self.pick(&["ddx", "ddy", "fwidth", "ddx_surface", "ddy_surface", "fwidth_surface"]);
         self.feat(f);
         let inner = Ctx {
             body: ctx.body,
