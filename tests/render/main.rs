@@ -90,6 +90,7 @@ const GPU_TESTS: &[GpuTest] = &[
     ),
     ("modes::derivative_chains_render_in_every_mode", modes::derivative_chains_render_in_every_mode),
     ("modes::steps_keep_their_edges", modes::steps_keep_their_edges),
+    ("modes::surface_derivatives_do_not_refine_at_keys", modes::surface_derivatives_do_not_refine_at_keys),
     (
         "modes::statistics_off_changes_nothing_but_the_instrumentation",
         modes::statistics_off_changes_nothing_but_the_instrumentation,

@@ -97,6 +97,47 @@ pub fn steps_keep_their_edges(gpu: &Gpu) {
     }
 }
 
+/// A predicate on the normal's change across the block over nine flat steps
+/// whose normals turn by about 0.27 between neighbours, with the normal a
+/// key at 0.2: `SURFACE_PREDICATE` is the plain derivative or the surface one.
+const SURFACE_STEPS: &str = "
+@key(0.2) in float3 normal;
+coarse effect float light {
+    light = saturate(dot(normalize(normal), normalize(float3(0.3, 0.4, 0.85))));
+    if (length(SURFACE_PREDICATE(normal)) > 0.1) refine;
+}
+fine out float4 color = float4(light, 0.0, 0.0, 1.0);
+";
+
+/// `fwidth_surface` does not measure the step to the next surface, which the
+/// key already keeps the resampling from blending across: over flat steps
+/// (each over four coarse samples wide) the surface form refines no pixel
+/// in the block modes and the dynamic mode, where `fwidth` refines the
+/// blocks around every step (the normal is constant on a step, so the only
+/// change a derivative can see is the step's). Both images equal the
+/// reference up to the resampling's rounding, and forced refinement equals
+/// it bit for bit.
+pub fn surface_derivatives_do_not_refine_at_keys(gpu: &Gpu) {
+    let plain = compile(&SURFACE_STEPS.replace("SURFACE_PREDICATE", "fwidth"));
+    let surface = compile(&SURFACE_STEPS.replace("SURFACE_PREDICATE", "fwidth_surface"));
+    let (w, h) = (160, 48);
+    let gbuffer = Scene::Steps { count: 9 }.render(w, h);
+    let reference = run(gpu, &surface, &gbuffer, Mode::Reference, false).unwrap();
+    for mode in [Mode::Coarse2x2, Mode::Coarse4x4, Mode::Dynamic] {
+        let refined = |program| {
+            let out = run(gpu, program, &gbuffer, mode, false).unwrap();
+            let err = max_abs_diff(&out.pixels, &reference.pixels);
+            assert!(err <= 2e-7, "{mode}: a step was blended (error {err})");
+            out.stats.effects[0].pixel_evaluations
+        };
+        let (at_steps, on_surface) = (refined(&plain), refined(&surface));
+        assert!(at_steps >= 8 * h as u64, "{mode}: fwidth refines around the eight steps: {at_steps} pixels");
+        assert_eq!(on_surface, 0, "{mode}: fwidth_surface refined {on_surface} pixels");
+        let forced = run(gpu, &surface, &gbuffer, mode, true).unwrap();
+        assert!(forced.pixels == reference.pixels, "{mode}: forced refinement differs from the reference");
+    }
+}
+
 const KEYED: &str = "
 @key(0.1) in float3 normal;
 @key in uint material;
