@@ -39,6 +39,9 @@ pub struct DerivSite<'a> {
     pub effects: Vec<EffectId>,
     /// `ddx_surface`, `ddy_surface` or `fwidth_surface` ([`crate::builtins::Builtin::on_surface`]).
     pub on_surface: bool,
+    /// The derivative call and its builtin.
+    pub call: Span,
+    pub builtin: crate::builtins::Builtin,
 }
 
 /// Per-program derivative information.
@@ -124,10 +127,39 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
                 params: params.into_iter().collect(),
                 effects: effects.into_iter().collect(),
                 on_surface: builtin.on_surface(),
+                call: call.span,
+                builtin: *builtin,
             });
         }
     }
     (info, diagnostics)
+}
+
+/// W0003 for each surface derivative (`fwidth_surface`, ...) that can only
+/// be its plain form: in a fine effect or output, which is evaluated per
+/// pixel, or in a coarse effect that reads no discontinuity key.
+pub fn plain_surface_derivatives(checked: &Checked, graph: &crate::graph::EffectGraph, deriv: &DerivInfo) -> Vec<Diagnostic> {
+    let mut out = vec![];
+    for site in deriv.sites.iter().filter(|s| s.on_surface) {
+        let effect = &checked.effects[site.effect.index()];
+        let why = if effect.rate != Rate::Coarse {
+            format!("`{}` is evaluated per pixel, where the surface derivatives are the plain ones", effect.name)
+        } else if graph.keys[site.effect.index()].is_empty() {
+            format!("`{}` reads no discontinuity key, so no difference is taken across one", effect.name)
+        } else {
+            continue;
+        };
+        let (name, plain) = (site.builtin.name(), site.builtin.plain_derivative().name());
+        out.push(
+            Diagnostic::warning("W0003", format!("`{name}` here is `{plain}`"))
+                .with_label(Label::primary(site.call, why))
+                .with_note(
+                    "a surface derivative differs from the plain one only at coarse rate, where the quad pair's \
+                     other sample lies across one of the effect's discontinuity keys (docs/language.md, section 9)",
+                ),
+        );
+    }
+    out
 }
 
 fn collect_derivative_calls<'a>(e: &'a Expr, checked: &Checked, out: &mut dyn FnMut(&'a Expr)) {

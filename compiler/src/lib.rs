@@ -297,6 +297,7 @@ fn front_end<R>(
     diagnostics.extend(graph_diagnostics);
     let (deriv, deriv_diagnostics) = deriv::analyse(&checked);
     diagnostics.extend(deriv_diagnostics);
+    diagnostics.extend(deriv::plain_surface_derivatives(&checked, &graph, &deriv));
     if !diagnostics.iter().any(|d| d.is_error()) {
         diagnostics.extend(limits::derivatives(&checked, &deriv));
     }
