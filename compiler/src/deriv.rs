@@ -138,7 +138,11 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
 /// W0003 for each surface derivative (`fwidth_surface`, ...) that can only
 /// be its plain form: in a fine effect or output, which is evaluated per
 /// pixel, or in a coarse effect that reads no discontinuity key.
-pub fn plain_surface_derivatives(checked: &Checked, graph: &crate::graph::EffectGraph, deriv: &DerivInfo) -> Vec<Diagnostic> {
+pub fn plain_surface_derivatives(
+    checked: &Checked,
+    graph: &crate::graph::EffectGraph,
+    deriv: &DerivInfo,
+) -> Vec<Diagnostic> {
     let mut out = vec![];
     for site in deriv.sites.iter().filter(|s| s.on_surface) {
         let effect = &checked.effects[site.effect.index()];

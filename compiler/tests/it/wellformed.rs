@@ -694,7 +694,9 @@ impl<'c> Gen<'c> {
         }
         let text = &self.out[start..];
         let reads = names_in(text);
-        if ["ddx(", "ddy(", "fwidth(", "ddx_surface(", "ddy_surface(", "fwidth_surface("].iter().any(|d| text.contains(d))
+        if ["ddx(", "ddy(", "fwidth(", "ddx_surface(", "ddy_surface(", "fwidth_surface("]
+            .iter()
+            .any(|d| text.contains(d))
             || reads.iter().any(|r| self.differentiating.contains(*r))
         {
             self.differentiating.insert(name.clone());
