@@ -37,9 +37,8 @@ pub struct DerivSite<'a> {
     pub params: Vec<LocalId>,
     /// Effects the operand reads (directly or through inlined locals): needed at the neighbour.
     pub effects: Vec<EffectId>,
-    /// `ddx_surface`, `ddy_surface` or `fwidth_surface` ([`crate::builtins::Builtin::on_surface`]).
-    pub on_surface: bool,
-    /// The derivative call and its builtin.
+    /// The derivative call and its builtin (`ddx_surface` and its kin:
+    /// [`crate::builtins::Builtin::on_surface`]).
     pub call: Span,
     pub builtin: crate::builtins::Builtin,
 }
@@ -126,7 +125,6 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
                 operand,
                 params: params.into_iter().collect(),
                 effects: effects.into_iter().collect(),
-                on_surface: builtin.on_surface(),
                 call: call.span,
                 builtin: *builtin,
             });
@@ -144,7 +142,7 @@ pub fn plain_surface_derivatives(
     deriv: &DerivInfo,
 ) -> Vec<Diagnostic> {
     let mut out = vec![];
-    for site in deriv.sites.iter().filter(|s| s.on_surface) {
+    for site in deriv.sites.iter().filter(|s| s.builtin.on_surface()) {
         let effect = &checked.effects[site.effect.index()];
         let why = if effect.rate != Rate::Coarse {
             format!("`{}` is evaluated per pixel, where the surface derivatives are the plain ones", effect.name)

@@ -300,11 +300,11 @@ fn reach<'e>(
                 child(base, 0);
                 child(index, 1);
             }
-            ExprKind::Call { callee, args } => match Builtin::from_name(&callee.name) {
+            ExprKind::Call { callee, args } => match Builtin::from_name(&callee.name).map(Builtin::plain_derivative) {
                 // `mrsl_ddx_<k>(mrsl_pos, ...)`: the operand is in `mrsl_d<k>`.
                 // Past the depth limit, which this root already breaks, a
                 // chain of derivatives is not followed further.
-                Some(b) if matches!(b.plain_derivative(), Builtin::Ddx | Builtin::Ddy | Builtin::Fwidth) => {
+                Some(Builtin::Ddx | Builtin::Ddy | Builtin::Fwidth) => {
                     if depth <= MAX_EXPR_DEPTH {
                         args.iter().for_each(|a| operand(a, depth));
                     }

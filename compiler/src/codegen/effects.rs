@@ -6,7 +6,9 @@
 //! entry points of every family use.
 
 use super::body::{Mode, float_literal, local_name, wgsl_ident};
-use super::names::{BACKGROUND, BLOCK_SIZE, CONTROL, FORCE, NEIGHBOURS, Name, OCTAHEDRAL, POS, REFINE, RGB9E5};
+use super::names::{
+    BACKGROUND, BLOCK_SIZE, CONTROL, FORCE, NEIGHBOURS, Name, OCTAHEDRAL, PAIR_X, PAIR_Y, POS, REFINE, RGB9E5,
+};
 use super::words::{bit, unpack_with};
 use super::writer::cut;
 use super::{Derivatives, Writer};
@@ -590,28 +592,33 @@ impl<'b> Writer<'_, '_, 'b> {
     /// differences across the position's quad, `mrsl_ddx_<k>` and `mrsl_ddy_<k>`.
     pub(super) fn derivative_helpers(&mut self) {
         let sites = self.live_sites();
-        if self.derivatives() == Derivatives::HereOnSurface {
-            let mut effects: Vec<EffectId> =
-                sites.iter().map(|&k| &self.i.deriv.sites[k]).filter(|s| s.on_surface).map(|s| s.effect).collect();
-            effects.sort();
-            effects.dedup();
-            for e in effects {
-                self.apart_function(e);
-            }
+        let mut apart: Vec<EffectId> =
+            sites.iter().filter(|&&k| self.stays_on_surface(k)).map(|&k| self.i.deriv.sites[k].effect).collect();
+        apart.sort();
+        apart.dedup();
+        for e in apart {
+            self.apart_function(e);
         }
         for k in sites {
             self.cached(super::Piece::Derivative(k, self.derivatives()), |w| w.derivative_helper(k));
         }
     }
 
+    /// Whether derivative site `k` takes its differences on the effect's
+    /// surface in this kernel: a surface derivative, in a kernel over coarse
+    /// samples, in an effect that reads a discontinuity key.
+    fn stays_on_surface(&self, k: usize) -> bool {
+        let site = &self.i.deriv.sites[k];
+        site.builtin.on_surface()
+            && self.derivatives() == Derivatives::HereOnSurface
+            && !self.keys_of(&[site.effect]).is_empty()
+    }
+
     /// `mrsl_apart_<effect>(a, b)`: whether positions `a` and `b` lie across
-    /// one of the keys `effect` reads (none: never), as the resolve compares
-    /// a pixel with a corner.
+    /// one of the keys `effect` reads, as the resolve compares a pixel with a
+    /// corner.
     fn apart_function(&mut self, effect: EffectId) {
         let keys = self.keys_of(&[effect]);
-        if keys.is_empty() {
-            return;
-        }
         let tests: Vec<String> = keys.iter().map(|key| key.differs(&key.load("a"), &key.load("b"))).collect();
         let name = Name::Apart.of(&self.checked().effects[effect.index()].name);
         self.line(0, format!("fn {name}(a: vec2<i32>, b: vec2<i32>) -> bool {{"));
@@ -649,14 +656,15 @@ impl<'b> Writer<'_, '_, 'b> {
             ];
             let [operand_helper, differences] = cut(include_str!("templates/derivative.wgsl"), &["DIFFERENCES"]);
             self.template(0, operand_helper, values);
-            let effect = site.effect;
-            let on_surface = site.on_surface
-                && self.derivatives() == Derivatives::HereOnSurface
-                && !self.keys_of(&[effect]).is_empty();
-            if on_surface {
-                let apart = Name::Apart.of(&c.effects[effect.index()].name);
-                let values = &[values, &[("APART", &apart as &dyn std::fmt::Display)][..]].concat();
-                self.template(0, include_str!("templates/derivative_on_surface.wgsl"), values);
+            if self.stays_on_surface(k) {
+                let apart = Name::Apart.of(&c.effects[site.effect.index()].name);
+                let [note, difference] = cut(include_str!("templates/derivative_on_surface.wgsl"), &["AXIS"]);
+                self.template(0, note, &[]);
+                for (axis, difference_name, pair) in [("x", Name::Ddx.of(k), PAIR_X), ("y", Name::Ddy.of(k), PAIR_Y)] {
+                    let extra: &super::writer::Values =
+                        &[("APART", &apart), ("AXIS", &axis), ("DIFFERENCE", &difference_name), ("PAIR", &pair)];
+                    self.template(0, difference, &[values, extra].concat());
+                }
             } else if self.reuses_operand_here(k) {
                 self.template(0, differences, values);
             } else {

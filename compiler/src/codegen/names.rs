@@ -211,6 +211,9 @@ pub(super) const FIRST: &str = "mrsl_first";
 pub(super) const IN: &str = "mrsl_in";
 /// `mrsl_grid()`: the positions of the kernel.
 pub(super) const GRID: &str = "mrsl_grid";
+/// The quad pairs of a position along x and along y (positions.wgsl, rate_positions.wgsl).
+pub(super) const PAIR_X: &str = "mrsl_pair_x";
+pub(super) const PAIR_Y: &str = "mrsl_pair_y";
 /// `mrsl_tile_pixel(wg, li)`: the pixel of a lane of a tile.
 pub(super) const TILE_PIXEL: &str = "mrsl_tile_pixel";
 /// With tile lists: the tile a fine workgroup shades, and
@@ -361,8 +364,8 @@ pub(super) const FIXED: &[&str] = &[
     // resources.wgsl, uniforms.wgsl, stats.wgsl, positions.wgsl: bindings and position helpers
     "MrslControl",
     "MrslUniforms",
-    "mrsl_pair_x",
-    "mrsl_pair_y",
+    PAIR_X,
+    PAIR_Y,
     // derivative.wgsl, derivative_both.wgsl: the operand here, at the pair's other position
     "mrsl_here",
     "mrsl_there",
