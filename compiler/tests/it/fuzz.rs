@@ -182,9 +182,9 @@ fn assert_well_formed(source: &str, options: &Options) {
     // that is its plain form) are the diagnostics allowed: the generator
     // draws `@key` attributes and surface derivatives independently of what
     // its effects read and of their rates.
-    let idle_key = |d: &mrsl::Diagnostic| d.code == "W0002" || d.code == "W0003";
+    let allowed_warning = |d: &mrsl::Diagnostic| d.code == "W0002" || d.code == "W0003";
     let mut diagnostics = mrsl::check(source);
-    diagnostics.retain(|d| !idle_key(d));
+    diagnostics.retain(|d| !allowed_warning(d));
     assert!(
         diagnostics.is_empty(),
         "a generated program has diagnostics:\n{source}\n{}",
@@ -192,7 +192,7 @@ fn assert_well_formed(source: &str, options: &Options) {
     );
     match mrsl::compile(source, options) {
         Ok(program) => {
-            assert!(program.warnings.iter().all(idle_key), "a generated program warns:\n{source}")
+            assert!(program.warnings.iter().all(allowed_warning), "a generated program warns:\n{source}")
         }
         Err(diagnostics) => panic!(
             "a generated program does not compile:\n{source}\n{}",
