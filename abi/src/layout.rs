@@ -169,7 +169,9 @@ impl Layout {
 /// word k of pixel (x, y)'s record is texel (x, y) of layer k. (A texture
 /// rather than a storage buffer for the reason [`InterfaceLayout`] gives:
 /// llvmpipe reads and writes it for all lanes at once, a buffer word lane
-/// by lane.)
+/// by lane.) With `packed`, the hierarchical kernel's records are an
+/// `rgba32uint` array instead, four words per texel: word k is component
+/// k % 4 of layer k / 4 (the checkerboard kernel's stay as above).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct HierarchicalLayout {
     /// Per pixel: `flag_words` refine flags, `mask_words` "evaluated here" bits
@@ -181,6 +183,12 @@ pub struct HierarchicalLayout {
     pub mask_words: u32,
     /// Word offset of each live coarse effect's value in a record, in stats-counter order.
     pub value_offsets: Vec<u32>,
+    /// Whether the hierarchical kernel packs its records four words to a
+    /// texel (`ResourceId::PackedPixelRecords`, bound as a
+    /// `BindingType::PackedWordTexture`), which needs read-write storage
+    /// access to `rgba32uint` on the device. Left out of the JSON when false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub packed: bool,
     /// `array<u32>`: pixel indices to shade, level 1 to 4 one after another;
     /// with a background rule, the tile list at the back of level 4's
     /// (`geometry::tile_list_offset`).

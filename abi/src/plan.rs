@@ -237,6 +237,9 @@ pub enum ResourceId {
     TaggedRecords { block: u32 },
     /// The hierarchical and checkerboard modes' record per pixel.
     PixelRecords,
+    /// The hierarchical mode's record per pixel packed four words to a
+    /// texel ([`crate::HierarchicalLayout::packed`]).
+    PackedPixelRecords,
     /// The hierarchical work lists, levels 1 to 4 one after another.
     WorkLists,
     /// The hierarchical per-level counters (the first word of each level's four).
@@ -301,6 +304,12 @@ pub enum BindingType {
     /// A `texture_storage_2d_array<r32uint, read_write>` with a layer per
     /// word: the per-pixel records and the neighbour values.
     WordTexture,
+    /// A `texture_storage_2d_array<rgba32uint, read_write>`, four words per
+    /// texel: the hierarchical mode's packed records. Not in core WebGPU:
+    /// the device needs read-write storage access to `rgba32uint` (wgpu's
+    /// `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES` where the adapter has it,
+    /// WebGPU's `texture-formats-tier2`).
+    PackedWordTexture,
 }
 
 impl BindingType {
@@ -308,7 +317,10 @@ impl BindingType {
     pub fn is_storage_texture(self) -> bool {
         matches!(
             self,
-            BindingType::StorageTexture { .. } | BindingType::RecordStorageTexture | BindingType::WordTexture
+            BindingType::StorageTexture { .. }
+                | BindingType::RecordStorageTexture
+                | BindingType::WordTexture
+                | BindingType::PackedWordTexture
         )
     }
 }

@@ -79,6 +79,12 @@ enum Command {
         /// stage (one more per channel), past WebGPU's default 4 (docs/runtime.md).
         #[arg(long)]
         storage_channels: bool,
+        /// Pack the hierarchical kernel's per-pixel records four words to a texel of an
+        /// rgba32uint read-write storage texture (faster on lavapipe): not in core WebGPU,
+        /// the device needs read-write storage access to rgba32uint (wgpu's
+        /// TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES where the adapter has it).
+        #[arg(long)]
+        packed_records: bool,
     },
     /// Render a program over a scene with the wgpu runtime (lavapipe works).
     ///
@@ -332,8 +338,13 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         Command::Check { file } => check(cli.color, file),
         Command::Render(r) => Ok(written(render::render(&r.args()))),
         Command::Bench(b) => bench(b),
-        Command::Compile { file, out_dir, emit, mode, block, storage_channels } => {
-            compile(cli.color, file, out_dir, *emit, mode, block, *storage_channels)
+        Command::Compile { file, out_dir, emit, mode, block, storage_channels, packed_records } => {
+            let options = Options {
+                storage_channels: *storage_channels,
+                packed_records: *packed_records,
+                ..Options::for_modes(&mode.0)
+            };
+            compile(cli.color, file, out_dir, *emit, block, options)
         }
         Command::Gbuffer(g) => Ok(written(gbuffer_command(g))),
         Command::Serve { host, port } => serve::serve(host, *port).map(|()| ExitCode::SUCCESS),
@@ -472,12 +483,11 @@ fn compile(
     file: &Path,
     out_dir: &Path,
     emit: Option<Emit>,
-    mode: &args::ModeList,
     block: &str,
-    storage_channels: bool,
+    options: Options,
 ) -> Result<ExitCode> {
     let (name, source) = read(file)?;
-    let options = Options { file_name: name.clone(), storage_channels, ..Options::for_modes(&mode.0) };
+    let options = Options { file_name: name.clone(), ..options };
     let program = match mrsl::compile(&source, &options) {
         Ok(p) => p,
         Err(diagnostics) => {

@@ -28,7 +28,7 @@ pub const WORKLOAD_PROGRAM: &str = include_str!("../../examples/sponza_lights.mr
 /// and the program, or the diagnostics rendered.
 pub fn compile_program(path: Option<&Path>, builtin: (&str, &str), modes: &[Mode]) -> Result<(String, mrsl::Program)> {
     let (name, source) = read_program(path, builtin)?;
-    let program = compile(&name, &source, modes, false)?;
+    let program = compile(&name, &source, modes, KernelOptions { storage_channels: false, packed_records: false })?;
     Ok((name, program))
 }
 
@@ -47,24 +47,45 @@ pub struct DeviceProgram {
 /// adds to every kernel (one per channel) on top of WebGPU's default limit:
 /// so a mode that the default limit refuses with sampled channels is refused
 /// with storage channels too. Where it does not, they read the channels
-/// sampled, and a note says so. The images are the same either way.
+/// sampled, and a note says so. Likewise the hierarchical kernel packs its
+/// records four words to a texel (`Options::packed_records`) where the
+/// adapter allows read-write storage access to `Rgba32Uint`, for which
+/// llvmpipe charges a load per texel rather than per word. The images are
+/// the same either way.
 pub fn compile_for_device(path: Option<&Path>, builtin: (&str, &str), modes: &[Mode]) -> Result<DeviceProgram> {
     let (name, source) = read_program(path, builtin)?;
-    let program = compile(&name, &source, modes, true)?;
+    let program = compile(&name, &source, modes, KernelOptions { storage_channels: true, packed_records: true })?;
     let channels = program.layout.channels.iter().filter(|c| c.access == ChannelAccess::Storage).count() as u32;
     let wanted = wgpu::Limits::default().max_storage_textures_per_shader_stage + channels;
-    let gpu = Gpu::with_storage_textures(wanted)?;
+    let gpu = Gpu::with_packed_records(wanted)?;
     let granted = gpu.device.limits().max_storage_textures_per_shader_stage;
-    if granted >= wanted {
+    let options = KernelOptions { storage_channels: granted >= wanted, packed_records: gpu.packs_records };
+    if !options.storage_channels {
+        eprintln!(
+            "note: {} allows {granted} storage textures per shader stage, fewer than the {wanted} that reading the \
+             G-buffer's {channels} channels through storage bindings takes: the kernels read them sampled",
+            gpu.adapter_info.name
+        );
+    }
+    if !options.packed_records && modes.contains(&Mode::Hierarchical) {
+        eprintln!(
+            "note: {} allows no read-write storage access to Rgba32Uint: the hierarchical kernel keeps a texel per \
+             word of its records",
+            gpu.adapter_info.name
+        );
+    }
+    if options.storage_channels && options.packed_records {
         return Ok(DeviceProgram { name, program, gpu });
     }
-    eprintln!(
-        "note: {} allows {granted} storage textures per shader stage, fewer than the {wanted} that reading the \
-         G-buffer's {channels} channels through storage bindings takes: the kernels read them sampled",
-        gpu.adapter_info.name
-    );
-    let program = compile(&name, &source, modes, false)?;
+    let program = compile(&name, &source, modes, options)?;
     Ok(DeviceProgram { name, program, gpu })
+}
+
+/// The options [`compile_for_device`] chooses by what the device grants.
+#[derive(Clone, Copy)]
+struct KernelOptions {
+    storage_channels: bool,
+    packed_records: bool,
 }
 
 /// The program at `path`, or the built-in `(name, source)`: its name for messages and its source.
@@ -75,8 +96,13 @@ fn read_program(path: Option<&Path>, builtin: (&str, &str)) -> Result<(String, S
     })
 }
 
-fn compile(name: &str, source: &str, modes: &[Mode], storage_channels: bool) -> Result<mrsl::Program> {
-    let options = Options { file_name: name.to_string(), storage_channels, ..Options::for_modes(modes) };
+fn compile(name: &str, source: &str, modes: &[Mode], kernels: KernelOptions) -> Result<mrsl::Program> {
+    let options = Options {
+        file_name: name.to_string(),
+        storage_channels: kernels.storage_channels,
+        packed_records: kernels.packed_records,
+        ..Options::for_modes(modes)
+    };
     mrsl::compile(source, &options).map_err(|d| anyhow!(mrsl::render_all(&d, name, source)))
 }
 

@@ -260,6 +260,8 @@ pub fn build(
                 flag_words: interface.flag_words,
                 mask_words,
                 value_offsets,
+                // Set by `compile` from `Options::packed_records`.
+                packed: false,
                 work_binding: 4 + outputs,
                 queue_binding: 5 + outputs,
                 args_group: GROUP_ARGS,
@@ -274,8 +276,6 @@ pub fn build(
     }
 }
 
-/// The binding of the multi-rate mode's stored values in the stage group,
-/// after the neighbour values'.
 /// Binds every channel whose format a storage binding can read (all but
 /// those rebuilt from depth) as a read-only storage texture
 /// ([`crate::Options::storage_channels`]).
@@ -287,6 +287,8 @@ pub fn read_channels_from_storage(layout: &mut Layout) {
     }
 }
 
+/// The binding of the multi-rate mode's stored values in the stage group,
+/// after the neighbour values'.
 pub fn level_values_binding(checked: &Checked) -> u32 {
     8 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32
 }

@@ -126,6 +126,17 @@ pub struct Options {
     /// the hierarchical mode, which loads the key channels of five pixels
     /// per pixel, gains most (docs/evaluation.md).
     pub storage_channels: bool,
+    /// Pack the hierarchical kernel's per-pixel records four words to a
+    /// texel of an `rgba32uint` read-write storage texture instead of a
+    /// texel per word of an `r32uint` one: the classification loads each
+    /// neighbour's record in a texel or two, not a texel per word, and each
+    /// pixel stores its record once. The images are the same bit for bit.
+    /// Off by default: read-write storage access to `rgba32uint` is not in
+    /// core WebGPU (wgpu grants it with `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES`
+    /// where the adapter has it, as lavapipe does; browsers with
+    /// `texture-formats-tier2`). On lavapipe the hierarchical frame is about
+    /// a tenth faster (docs/evaluation.md).
+    pub packed_records: bool,
 }
 
 impl Default for Options {
@@ -137,7 +148,13 @@ impl Default for Options {
 impl Options {
     /// Options that compile for `modes` alone.
     pub fn for_modes(modes: &[Mode]) -> Options {
-        Options { modes: modes.to_vec(), file_name: "program.mrsl".into(), compact: false, storage_channels: false }
+        Options {
+            modes: modes.to_vec(),
+            file_name: "program.mrsl".into(),
+            compact: false,
+            storage_channels: false,
+            packed_records: false,
+        }
     }
 
     /// The kernels [`compile`] generates with these options: those of the
@@ -205,6 +222,7 @@ fn generate(
     if options.storage_channels {
         layout::read_channels_from_storage(&mut layout);
     }
+    layout.hierarchical.packed = options.packed_records;
     let levels = options.modes.contains(&Mode::MultiRate).then(|| rates::levels(checked, graph));
     if let Some(levels) = &levels {
         layout.levels = Some(levels.layout(checked, layout::level_values_binding(checked)));

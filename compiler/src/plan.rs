@@ -318,7 +318,11 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
         ],
         KernelKind::Reference => vec![],
         KernelKind::Hierarchical => vec![
-            at(h.values_binding, R::PixelRecords, T::WordTexture),
+            if h.packed {
+                at(h.values_binding, R::PackedPixelRecords, T::PackedWordTexture)
+            } else {
+                at(h.values_binding, R::PixelRecords, T::WordTexture)
+            },
             buffer(h.work_binding, R::WorkLists, false),
             buffer(h.queue_binding, R::LevelCounts, false),
         ],
@@ -430,6 +434,14 @@ fn resource(layout: &Layout, id: ResourceId) -> ResourceDesc {
                 texels: Extent::Pixels,
                 layers: layout.hierarchical.record_words,
                 format: TextureFormat::R32Uint,
+            },
+        ),
+        R::PackedPixelRecords => (
+            "the packed per-pixel record texture",
+            Shape::TextureArray {
+                texels: Extent::Pixels,
+                layers: layout.hierarchical.record_words.div_ceil(4),
+                format: TextureFormat::Rgba32Uint,
             },
         ),
         R::WorkLists => ("the hierarchical work lists", words(Extent::HierarchicalLevels, 1)),

@@ -20,6 +20,10 @@ pub struct Gpu {
     pub adapter_info: wgpu::AdapterInfo,
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
+    /// Whether the device runs kernels compiled with packed records
+    /// (`mrsl::Options::packed_records`): made by [`Gpu::with_packed_records`]
+    /// on an adapter whose `Rgba32Uint` allows read-write storage access.
+    pub packs_records: bool,
 }
 
 /// Every adapter the machine offers (what [`Gpu::new`] chooses from: it
@@ -92,6 +96,18 @@ impl Gpu {
     /// kernels that read the G-buffer through storage bindings need
     /// (`mrsl::Options::storage_channels`).
     pub fn with_storage_textures(per_stage: u32) -> Result<Gpu, Error> {
+        Gpu::make(per_stage, false)
+    }
+
+    /// The same, with read-write storage access to `Rgba32Uint` where the
+    /// adapter has it (wgpu's `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES`),
+    /// which kernels compiled with `mrsl::Options::packed_records` need:
+    /// [`Gpu::packs_records`] says whether it has.
+    pub fn with_packed_records(per_stage: u32) -> Result<Gpu, Error> {
+        Gpu::make(per_stage, true)
+    }
+
+    fn make(per_stage: u32, packed_records: bool) -> Result<Gpu, Error> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
@@ -100,7 +116,12 @@ impl Gpu {
             apply_limit_buckets: false,
         }))
         .map_err(|e| Error::NoAdapter(format!("{e} (on a machine without a GPU, install Mesa's lavapipe: apt-get install mesa-vulkan-drivers libvulkan1)")))?;
-        let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        let read_write = wgpu::TextureFormatFeatureFlags::STORAGE_READ_WRITE;
+        let packs_records = packed_records
+            && adapter.features().contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES)
+            && adapter.get_texture_format_features(wgpu::TextureFormat::Rgba32Uint).flags.contains(read_write);
+        let mut wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        wanted.set(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES, packs_records);
         let features = adapter.features() & wanted;
         let (device, queue) = pollster::block_on(
             adapter.request_device(&wgpu::DeviceDescriptor {
@@ -116,7 +137,7 @@ impl Gpu {
             }),
         )
         .map_err(|e| Error::Device(e.to_string()))?;
-        Ok(Gpu { adapter_info: adapter.get_info(), device, queue })
+        Ok(Gpu { adapter_info: adapter.get_info(), device, queue, packs_records })
     }
 
     /// Creates a 2D texture and fills it with `data` (tightly packed rows);

@@ -97,6 +97,20 @@ pub(crate) fn stage_layout(device: &wgpu::Device, label: &str, bindings: &[PassB
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
 }
 
+/// Why `device` cannot create a stage group with `bindings`, where a binding
+/// needs a device feature the device lacks: said before the group is made,
+/// so that the error names the feature rather than a format.
+pub(crate) fn missing_feature(device: &wgpu::Device, bindings: &[PassBinding]) -> Option<String> {
+    let packed = bindings.iter().any(|b| b.ty == BindingType::PackedWordTexture);
+    let granted = device.features().contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
+    (packed && !granted).then(|| {
+        "its records are packed into an Rgba32Uint read-write storage texture (`Options::packed_records`), which \
+         needs the device feature TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES and an adapter whose Rgba32Uint allows \
+         read-write storage access: request the feature, or compile without packed records"
+            .to_string()
+    })
+}
+
 fn binding_type(ty: BindingType) -> wgpu::BindingType {
     let array = wgpu::TextureViewDimension::D2Array;
     match ty {
@@ -128,6 +142,11 @@ fn binding_type(ty: BindingType) -> wgpu::BindingType {
         BindingType::WordTexture => wgpu::BindingType::StorageTexture {
             access: wgpu::StorageTextureAccess::ReadWrite,
             format: wgpu::TextureFormat::R32Uint,
+            view_dimension: array,
+        },
+        BindingType::PackedWordTexture => wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::ReadWrite,
+            format: wgpu::TextureFormat::Rgba32Uint,
             view_dimension: array,
         },
     }

@@ -149,6 +149,10 @@ impl Shader {
             let Some(pass) = plan.modes.iter().flat_map(|m| m.passes()).find(|p| p.kernel == kernel_ref) else {
                 continue;
             };
+            if let Some(reason) = groups::missing_feature(device, &pass.bindings) {
+                unavailable.insert(kernel.kind, reason);
+                continue;
+            }
             let kind_scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
             let stage_layout = groups::stage_layout(device, kernel.kind.name(), &pass.bindings);
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

@@ -15,6 +15,7 @@ mod engine_formats;
 mod errors;
 mod frames;
 mod modes;
+mod packed_records;
 mod rate_image;
 mod rate_source;
 mod second_driver;
@@ -58,6 +59,14 @@ const GPU_TESTS: &[GpuTest] = &[
         engine_formats::decoded_channels_take_their_engine_formats,
     ),
     ("errors::binding_mismatches_are_typed_errors", errors::binding_mismatches_are_typed_errors),
+    (
+        "packed_records::packed_records_render_what_word_records_render",
+        packed_records::packed_records_render_what_word_records_render,
+    ),
+    (
+        "packed_records::packed_records_without_the_feature_are_refused",
+        packed_records::packed_records_without_the_feature_are_refused,
+    ),
     (
         "storage_channels::storage_channels_render_what_sampled_channels_render",
         storage_channels::storage_channels_render_what_sampled_channels_render,

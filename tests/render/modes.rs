@@ -5,7 +5,8 @@ use mrsl_lab::gpu::Gpu;
 use mrsl_lab::scene::{BACKGROUND, ChannelData, GBuffer, Scene};
 use mrsl_runtime::{DispatchOptions, Error, Mode};
 
-fn examples() -> Vec<(String, String)> {
+/// Every example program, by file name, with its source.
+pub(crate) fn examples() -> Vec<(String, String)> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
     let mut out: Vec<(String, String)> = std::fs::read_dir(dir)
         .unwrap()

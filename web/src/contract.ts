@@ -205,6 +205,7 @@ export type ResourceId =
   | { id: 'neighbour_values'; block: number }
   | { id: 'tagged_records'; block: number }
   | { id: 'pixel_records' }
+  | { id: 'packed_pixel_records' }
   | { id: 'work_lists' }
   | { id: 'level_counts' }
   | { id: 'level_arguments' }
@@ -228,7 +229,8 @@ export type BindingType =
   | { kind: 'uint_texture' }
   | { kind: 'record_texture' }
   | { kind: 'record_storage_texture' }
-  | { kind: 'word_texture' };
+  | { kind: 'word_texture' }
+  | { kind: 'packed_word_texture' };
 
 export interface ResourceDesc {
   id: ResourceId;

@@ -44,6 +44,11 @@ function entry(binding: number, ty: BindingType): GPUBindGroupLayoutEntry {
       return { ...base, storageTexture: { access: 'write-only', format: 'rgba32uint', viewDimension: '2d-array' } };
     case 'word_texture':
       return { ...base, storageTexture: { access: 'read-write', format: 'r32uint', viewDimension: '2d-array' } };
+    // Packed records (`Options::packed_records`): read-write rgba32uint needs
+    // the device feature `texture-formats-tier2`; without it the layout is
+    // refused and the mode reported unsupported.
+    case 'packed_word_texture':
+      return { ...base, storageTexture: { access: 'read-write', format: 'rgba32uint', viewDimension: '2d-array' } };
   }
 }
 

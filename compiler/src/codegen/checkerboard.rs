@@ -23,6 +23,7 @@ impl Writer<'_, '_, '_> {
     pub(super) fn checkerboard_bindings(&mut self) {
         self.record_binding(
             "Checkerboard mode: per pixel records of the coarse effects' values (layout `hierarchical`).",
+            false,
         );
     }
 

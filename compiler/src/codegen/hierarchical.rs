@@ -22,8 +22,11 @@
 
 use super::Writer;
 use super::effects::Evaluation;
-use super::names::{CONTROL, COUNT, LANE, LOCAL_ID, Name, POS, SET_WORD, TILE_ARGS, TILE_INVOCATION, WORD, WORKGROUP};
-use super::records::{axis_neighbours, diagonal_neighbours, neighbours};
+use super::names::{
+    CONTROL, COUNT, LANE, LOAD_RECORD, LOCAL_ID, NEIGHBOUR_RECORDS, Name, PIXEL_RECORD, POS, PUT_MASKS, PUT_RECORD,
+    RECORD_TYPE, SET_WORD, TILE_ARGS, TILE_INVOCATION, WORD, WORKGROUP,
+};
+use super::records::{axis_neighbours, diagonal_neighbours, neighbours, record_word};
 use super::words::bit;
 use super::writer::cut;
 use crate::check::EffectId;
@@ -86,7 +89,10 @@ impl Writer<'_, '_, '_> {
     pub(super) fn hierarchical_bindings(&mut self) {
         let l = self.i.layout;
         let h = &l.hierarchical;
-        self.record_binding("Hierarchical mode: per pixel record (flags, evaluated-mask, values), work lists, queues.");
+        self.record_binding(
+            "Hierarchical mode: per pixel record (flags, evaluated-mask, values), work lists, queues.",
+            h.packed,
+        );
         self.template(
             0,
             include_str!("templates/hierarchical_queues.wgsl"),
@@ -102,7 +108,11 @@ impl Writer<'_, '_, '_> {
 
     /// Every entry point, in dispatch order, after the helpers they share.
     pub(super) fn hierarchical_entries(&mut self) {
-        self.record_helpers();
+        if self.packed() {
+            self.packed_record_helpers();
+        } else {
+            self.record_helpers();
+        }
         self.pixel_values();
         self.finish_function();
         self.work_lists();
@@ -147,6 +157,41 @@ impl Writer<'_, '_, '_> {
             self.template(0, end, values);
         }
         self.background_tiles();
+    }
+
+    /// Whether the records are packed four words to a texel
+    /// (`Options::packed_records`): then every invocation loads the records
+    /// it reads whole, once, and stores its pixel's record whole, once.
+    fn packed(&self) -> bool {
+        self.i.layout.hierarchical.packed
+    }
+
+    /// The line that stores pixel `pos`'s record (packed) from `flags` and
+    /// `masks` and its `mrsl_pv_*` values, or its flag and mask words (a
+    /// texel per word; its values were stored one by one).
+    fn store_record(&mut self, pos: &str, flags: &[String], masks: &[String]) {
+        if self.packed() {
+            let words: String = flags.iter().chain(masks).map(|w| format!(", {w}")).collect();
+            self.line(1, format!("{PUT_RECORD}({pos}{words});"));
+        } else {
+            for (w, word) in flags.iter().chain(masks).enumerate() {
+                self.line(1, format!("{SET_WORD}({pos}, {w}u, {word});"));
+            }
+        }
+    }
+
+    /// Lines storing pixel `p`'s mask words `masks` alone (the flag and value
+    /// words of a packed record's texels that hold them become zero).
+    fn store_masks(&mut self, indent: usize, masks: &[String]) {
+        if self.packed() {
+            let words: String = masks.iter().map(|w| format!(", {w}")).collect();
+            self.line(indent, format!("{PUT_MASKS}(p{words});"));
+        } else {
+            let first = self.i.layout.hierarchical.flag_words;
+            for (w, mask) in masks.iter().enumerate() {
+                self.line(indent, format!("{SET_WORD}(p, {}u, {mask});", first + w as u32));
+            }
+        }
     }
 
     /// Whether level 0 and the classifications run over the surface tiles
@@ -319,10 +364,8 @@ impl Writer<'_, '_, '_> {
     /// neighbour.
     fn clear_record(&mut self, indent: usize) {
         let c = self.checked();
-        let h = &self.i.layout.hierarchical;
-        for w in h.flag_words..h.flag_words + h.mask_words {
-            self.line(indent, format!("{SET_WORD}(p, {w}u, 0u);"));
-        }
+        let zeros = vec!["0u".to_string(); self.i.layout.hierarchical.mask_words as usize];
+        self.store_masks(indent, &zeros);
         for e in self.coarse_live() {
             let info = &c.effects[e.index()];
             self.line(indent, format!("{} = {}();", Name::PixelValue.of(&info.name), info.ty.wgsl()));
@@ -364,24 +407,47 @@ impl Writer<'_, '_, '_> {
         let [head, force, end] = cut(include_str!("templates/shade.wgsl"), &["FLAG_WORDS", "EFFECTS"]);
         self.template(0, head, &[]);
         self.declare_flag_words(flag_words);
-        self.load_pixel_masks(1);
+        let own = if self.packed() {
+            self.line(1, format!("let {PIXEL_RECORD} = {LOAD_RECORD}({POS});"));
+            self.load_masks_from(1, PIXEL_RECORD);
+            PIXEL_RECORD
+        } else {
+            self.load_pixel_masks(1);
+            POS
+        };
         self.template(0, force, &[]);
-        let [evaluate, flag, read] = cut(include_str!("templates/shade_effect.wgsl"), &["EVALUATE", "FLAG"]);
+        let [evaluate, put, flag, read] =
+            cut(include_str!("templates/shade_effect.wgsl"), &["EVALUATE", "PUT", "FLAG"]);
         for e in self.coarse_live() {
             let info = &c.effects[e.index()];
             let (mask_word, mask) = bit(self.coarse_index[&e]);
             let var = self.effect_name(e);
             let ty = info.ty.wgsl();
-            let values: [(&str, &dyn Display); 5] =
-                [("VAR", &var), ("TYPE", &ty), ("MASK_WORD", &mask_word), ("MASK", &mask), ("NAME", &info.name)];
+            let values: [(&str, &dyn Display); 6] = [
+                ("VAR", &var),
+                ("TYPE", &ty),
+                ("MASK_WORD", &mask_word),
+                ("MASK", &mask),
+                ("NAME", &info.name),
+                ("OWN", &own),
+            ];
             self.template(1, evaluate, &values);
             self.evaluate(e, 2, "", Evaluation::Kernel);
+            self.template(1, put, &values);
+            if !self.packed() {
+                self.line(2, format!("{}({POS}, {var});", Name::RecordPut.of(&info.name)));
+            }
             self.template(1, flag, &values);
             self.set_refine_flag(e, 2);
             self.template(1, read, &values);
         }
-        for w in 0..flag_words {
-            self.line(1, format!("{SET_WORD}({POS}, {w}u, {});", Name::FlagWord.of(w)));
+        let flags: Vec<String> = (0..flag_words).map(|w| Name::FlagWord.of(w)).collect();
+        if self.packed() {
+            let h = &self.i.layout.hierarchical;
+            let masks: Vec<String> = (0..h.mask_words).map(|w| Name::PixelMask.of(w)).collect();
+            self.store_record(POS, &flags, &masks);
+        } else {
+            self.store_record(POS, &flags, &[]);
         }
         self.template(0, end, &[]);
     }
@@ -401,12 +467,14 @@ impl Writer<'_, '_, '_> {
         ];
         self.template(0, head, values);
         self.background_pixel(1, "return;");
-        let h = &self.i.layout.hierarchical;
-        for w in 0..h.mask_words {
-            let bits = coarse.saturating_sub(w * 32).min(32);
-            let mask = if bits == 32 { u32::MAX } else { (1u32 << bits) - 1 };
-            self.line(1, format!("{SET_WORD}(p, {}u, {mask}u);", h.flag_words + w));
-        }
+        let masks: Vec<String> = (0..self.i.layout.hierarchical.mask_words)
+            .map(|w| {
+                let bits = coarse.saturating_sub(w * 32).min(32);
+                let mask = if bits == 32 { u32::MAX } else { (1u32 << bits) - 1 };
+                format!("{mask}u")
+            })
+            .collect();
+        self.store_masks(1, &masks);
         self.template(0, entry, values);
         if let Some(line) = &invocation {
             self.line(1, line);
@@ -437,8 +505,15 @@ impl Writer<'_, '_, '_> {
         for w in 0..mw {
             self.line(1, format!("var mask{w} = 0u;"));
         }
+        if self.packed() {
+            let loads: Vec<String> = (0..4).map(|j| format!("{LOAD_RECORD}(q[{j}])")).collect();
+            let records = format!("array<{RECORD_TYPE}, 4>({})", loads.join(", "));
+            self.line(1, format!("let {NEIGHBOUR_RECORDS} = {records};"));
+        }
         self.neighbour_flag_words();
-        let [head_effect, tail_effect] = cut(include_str!("templates/classify_effect.wgsl"), &["TESTS"]);
+        let from = if self.packed() { NEIGHBOUR_RECORDS } else { "q" };
+        let [head_effect, tests_effect, tail_effect] =
+            cut(include_str!("templates/classify_effect.wgsl"), &["TESTS", "PUT"]);
         for e in self.coarse_live() {
             let info = &c.effects[e.index()];
             let (word, mask) = bit(self.coarse_index[&e]);
@@ -446,7 +521,7 @@ impl Writer<'_, '_, '_> {
                 .iter()
                 .map(|i| format!(" && !across_{}[k]", c.inputs[i.index()].name))
                 .collect();
-            self.template(0, head_effect, &[("NAME", &info.name), ("ON_SIDE", &on_side)]);
+            self.template(0, head_effect, &[("NAME", &info.name), ("ON_SIDE", &on_side), ("FROM", &from)]);
             // `disc` first: the ablation's edits find the test by it.
             let mut need = vec!["disc".to_string()];
             if let Some(b) = iface.refine_bit[e.index()] {
@@ -456,24 +531,22 @@ impl Writer<'_, '_, '_> {
                 need.push("flagged".into());
             }
             let value = self.value_test(&info.ty, &mut need);
-            self.template(
-                0,
-                tail_effect,
-                &[
-                    ("NEED", &need.join(" || ")),
-                    ("WORD", &word),
-                    ("MASK", &mask),
-                    ("NAME", &info.name),
-                    ("VALUE", &value),
-                ],
-            );
+            let values: &super::writer::Values = &[
+                ("NEED", &need.join(" || ")),
+                ("WORD", &word),
+                ("MASK", &mask),
+                ("NAME", &info.name),
+                ("VALUE", &value),
+            ];
+            self.template(0, tests_effect, values);
+            if !self.packed() {
+                self.line(3, format!("{}(p, {value});", Name::RecordPut.of(&info.name)));
+            }
+            self.template(0, tail_effect, values);
         }
-        for w in 0..fw {
-            self.line(1, format!("{SET_WORD}(p, {w}u, 0u);"));
-        }
-        for w in 0..mw {
-            self.line(1, format!("{SET_WORD}(p, {}u, mask{w});", fw + w));
-        }
+        let flags = vec!["0u".to_string(); fw as usize];
+        let masks: Vec<String> = (0..mw).map(|w| format!("mask{w}")).collect();
+        self.store_record("p", &flags, &masks);
         let any: Vec<String> = (0..mw).map(|w| format!("mask{w}")).collect();
         self.template(0, end, &[("ANY_MASK", &any.join(" | ")), ("QUEUE_WORDS", &QUEUE_WORDS_PER_LEVEL)]);
     }
@@ -537,14 +610,33 @@ impl Writer<'_, '_, '_> {
         }
     }
 
+    /// The pixel's mask words taken from its packed record, held in `record`.
+    fn load_masks_from(&mut self, indent: usize, record: &str) {
+        let h = &self.i.layout.hierarchical;
+        let (flag_words, mask_words) = (h.flag_words, h.mask_words);
+        for w in 0..mask_words {
+            self.line(indent, format!("let {} = {};", Name::PixelMask.of(w), record_word(record, flag_words + w)));
+        }
+    }
+
     /// The neighbours' flag words, loaded once for every effect's `flagged`
-    /// test (as the mask words are in `mrsl_shade`).
+    /// test (as the mask words are in `mrsl_shade`), or taken from their
+    /// packed records.
     fn neighbour_flag_words(&mut self) {
         let refine_bit = &self.i.interface.refine_bit;
         let words: std::collections::BTreeSet<u32> =
             self.coarse_live().iter().filter_map(|e| refine_bit[e.index()].map(|b| bit(b).0)).collect();
+        let packed = self.packed();
         for w in words {
-            let loads: Vec<String> = (0..4).map(|j| format!("{WORD}(q[{j}], {w}u)")).collect();
+            let loads: Vec<String> = (0..4)
+                .map(|j| {
+                    if packed {
+                        record_word(&format!("{NEIGHBOUR_RECORDS}[{j}]"), w)
+                    } else {
+                        format!("{WORD}(q[{j}], {w}u)")
+                    }
+                })
+                .collect();
             self.line(1, format!("var {} = array<u32, 4>({});", Name::NeighbourFlags.of(w), loads.join(", ")));
         }
     }

@@ -287,6 +287,20 @@ pub(super) const LISTED: &str = "mrsl_q";
 /// A per-pixel record's word, read and written (record modes).
 pub(super) const WORD: &str = "mrsl_word";
 pub(super) const SET_WORD: &str = "mrsl_set_word";
+/// Packed per-pixel records (four words to a texel): a record's texels
+/// (`MrslRecord`), loaded whole (`mrsl_record(p)`) and stored whole
+/// (`mrsl_put_record(p, flags.., masks..)`, its values from `mrsl_pv_*`), or
+/// only the texels of its mask words (`mrsl_put_masks(p, masks..)`, the
+/// other words of those texels zero); the hierarchical pixel's own record
+/// and its four neighbours', loaded once.
+pub(super) const RECORD_TYPE: &str = "MrslRecord";
+/// The record texture of the record modes.
+pub(super) const VALUES: &str = "mrsl_values";
+pub(super) const LOAD_RECORD: &str = "mrsl_record";
+pub(super) const PUT_RECORD: &str = "mrsl_put_record";
+pub(super) const PUT_MASKS: &str = "mrsl_put_masks";
+pub(super) const PIXEL_RECORD: &str = "mrsl_prec";
+pub(super) const NEIGHBOUR_RECORDS: &str = "mrsl_qr";
 /// `mrsl_count(start, step, extent)`: a hierarchical lattice's points along an axis.
 pub(super) const COUNT: &str = "mrsl_count";
 /// `mrsl_tile_invocation(wg, lid, per, list)`: the lattice invocation of a
@@ -351,6 +365,13 @@ pub(super) const FIXED: &[&str] = &[
     LISTED,
     WORD,
     SET_WORD,
+    RECORD_TYPE,
+    VALUES,
+    LOAD_RECORD,
+    PUT_RECORD,
+    PUT_MASKS,
+    PIXEL_RECORD,
+    NEIGHBOUR_RECORDS,
     COUNT,
     TILE_INVOCATION,
     LOCAL_ID,
@@ -380,7 +401,6 @@ pub(super) const FIXED: &[&str] = &[
     "mrsl_parent_refined",
     "mrsl_any_refined",
     // records.wgsl, record_binding.wgsl, hierarchical_*.wgsl, level*.wgsl, shade.wgsl, classify.wgsl
-    "mrsl_values",
     "mrsl_work",
     "mrsl_queue",
     "mrsl_args",

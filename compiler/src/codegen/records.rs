@@ -8,7 +8,7 @@
 //! opposite pairs, only complete pairs used) and the final pass's shape.
 
 use super::Writer;
-use super::names::{SET_WORD, WORD};
+use super::names::{Name, PUT_MASKS, PUT_RECORD, SET_WORD, VALUES, WORD};
 use super::pixel::Scope;
 use super::words::{pack_words, unpack_with};
 use super::writer::cut;
@@ -30,15 +30,80 @@ pub(super) fn neighbours(offsets: [(i32, i32); 4]) -> String {
     format!("array<vec2<i32>, 4>({})", points.join(", "))
 }
 
+/// Word `k` of a packed record held in `record` (a `MrslRecord`): a
+/// component of one of its texels.
+pub(super) fn record_word(record: &str, k: u32) -> String {
+    format!("{record}[{}].{}", k / 4, ["x", "y", "z", "w"][k as usize % 4])
+}
+
 impl Writer<'_, '_, '_> {
-    /// The record texture, after a comment on what the mode keeps in it.
-    pub(super) fn record_binding(&mut self, what: &str) {
+    /// The record texture, after a comment on what the mode keeps in it: a
+    /// texel per word, or with `packed` four words per texel.
+    pub(super) fn record_binding(&mut self, what: &str, packed: bool) {
         let l = self.i.layout;
+        let format = if packed { "rgba32uint" } else { "r32uint" };
         self.template(
             0,
             include_str!("templates/record_binding.wgsl"),
-            &[("WHAT", &what), ("GROUP", &l.interface.group), ("BINDING", &l.hierarchical.values_binding)],
+            &[
+                ("WHAT", &what),
+                ("GROUP", &l.interface.group),
+                ("BINDING", &l.hierarchical.values_binding),
+                ("FORMAT", &format),
+            ],
         );
+    }
+
+    /// The packed records' helpers (the hierarchical kernel's, with
+    /// `Options::packed_records`): `mrsl_word`, `MrslRecord` and its loader,
+    /// `mrsl_hget_X(record)` for every live coarse effect, and the stores
+    /// `mrsl_put_record` and `mrsl_put_masks`. A record is stored whole, a
+    /// texel at a time, from the values the invocation holds (`mrsl_pv_*`):
+    /// the invocation that classifies or shades a pixel knows all of it.
+    pub(super) fn packed_record_helpers(&mut self) {
+        let c = self.checked();
+        let h = &self.i.layout.hierarchical;
+        let texels = h.record_words.div_ceil(4);
+        let loads: Vec<String> = (0..texels).map(|t| format!("textureLoad({VALUES}, p, {t})")).collect();
+        self.template(
+            0,
+            include_str!("templates/records_packed.wgsl"),
+            &[("TEXELS", &texels), ("LOADS", &loads.join(", "))],
+        );
+        let mut words: Vec<String> = vec!["0u".into(); (texels * 4) as usize];
+        let flags: Vec<String> = (0..h.flag_words).map(|w| format!("f{w}")).collect();
+        let masks: Vec<String> = (0..h.mask_words).map(|w| format!("m{w}")).collect();
+        for (w, name) in flags.iter().chain(&masks).enumerate() {
+            words[w] = name.clone();
+        }
+        for (k, &e) in self.coarse_live().iter().enumerate() {
+            let info = &c.effects[e.index()];
+            let offset = h.value_offsets[k];
+            let unpack = unpack_with(&info.ty, |j| record_word("r", offset + j));
+            let values =
+                [("NAME", &info.name as &dyn std::fmt::Display), ("TYPE", &info.ty.wgsl()), ("UNPACK", &unpack)];
+            self.template(0, include_str!("templates/record_access_packed.wgsl"), &values);
+            for (j, word) in pack_words(&Name::PixelValue.of(&info.name), &info.ty).into_iter().enumerate() {
+                words[(offset + j as u32) as usize] = word;
+            }
+        }
+        let params = |names: &[String]| names.iter().map(|n| format!(", {n}: u32")).collect::<String>();
+        let all = params(&[flags.clone(), masks.clone()].concat());
+        self.line(0, format!("fn {PUT_RECORD}(p: vec2<i32>{all}) {{"));
+        for (t, texel) in words.chunks(4).enumerate() {
+            self.line(1, format!("textureStore({VALUES}, p, {t}, vec4<u32>({}));", texel.join(", ")));
+        }
+        self.line(0, "}");
+        self.line(0, format!("fn {PUT_MASKS}(p: vec2<i32>{}) {{", params(&masks)));
+        let mask_range = h.flag_words..h.flag_words + h.mask_words;
+        for t in mask_range.start / 4..mask_range.end.div_ceil(4) {
+            let texel: Vec<String> = (t * 4..t * 4 + 4)
+                .map(|w| if mask_range.contains(&w) { masks[(w - h.flag_words) as usize].clone() } else { "0u".into() })
+                .collect();
+            self.line(1, format!("textureStore({VALUES}, p, {t}, vec4<u32>({}));", texel.join(", ")));
+        }
+        self.line(0, "}");
+        self.line(0, "");
     }
 
     /// `mrsl_word` / `mrsl_set_word`, and `mrsl_hget_X` / `mrsl_hput_X` for every live coarse effect.

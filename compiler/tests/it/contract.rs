@@ -83,8 +83,11 @@ fn foreign_or_broken_layouts_are_refused() {
 fn kernels_declare_the_stage_bindings_of_the_contract() {
     use mrsl_abi::{BindingType as StageResource, GROUP_STAGE, KernelRef, TextureFormat};
     let prefix = format!("@group({GROUP_STAGE}) @binding(");
-    for (stem, source) in examples() {
-        let program = mrsl::compile(&source, &Options::default()).unwrap();
+    let packed = Options { packed_records: true, ..Options::default() };
+    for ((stem, source), options) in
+        examples().into_iter().flat_map(|e| [(e.clone(), Options::default()), (e, packed.clone())])
+    {
+        let program = mrsl::compile(&source, &options).unwrap();
         for kernel in &program.kernels {
             let mut declared: Vec<(u32, StageResource)> = kernel
                 .wgsl
@@ -104,6 +107,8 @@ fn kernels_declare_the_stage_bindings_of_the_contract() {
                         StageResource::RecordStorageTexture
                     } else if decl.contains("texture_storage_2d_array<r32uint, read_write>") {
                         StageResource::WordTexture
+                    } else if decl.contains("texture_storage_2d_array<rgba32uint, read_write>") {
+                        StageResource::PackedWordTexture
                     } else {
                         let format = decl.split("texture_storage_2d<").nth(1).unwrap().split(',').next().unwrap();
                         StageResource::StorageTexture { format: format.parse::<TextureFormat>().unwrap() }
@@ -130,8 +135,11 @@ fn kernels_declare_the_stage_bindings_of_the_contract() {
 /// the block fine kernels `FINE_PIXELS_PER_LANE` pixels of one block per lane.
 #[test]
 fn main_entry_points_declare_the_workgroup_size_of_the_contract() {
-    for (stem, source) in examples() {
-        let program = mrsl::compile(&source, &Options::default()).unwrap();
+    let packed = Options { packed_records: true, ..Options::default() };
+    for ((stem, source), options) in
+        examples().into_iter().flat_map(|e| [(e.clone(), Options::default()), (e, packed.clone())])
+    {
+        let program = mrsl::compile(&source, &options).unwrap();
         for kernel in &program.kernels {
             let entry = format!("fn {}(", kernel.kind.main_entry_point());
             let lines: Vec<&str> = kernel.wgsl.lines().collect();

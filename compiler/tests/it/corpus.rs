@@ -68,6 +68,35 @@ fn ok_programs() {
     });
 }
 
+/// The cases whose hierarchical kernel also has a golden file compiled with
+/// packed records (`Options::packed_records`): values of every kind a
+/// record packs (int, uint and bool; matrices; a background rule and a
+/// surface key), as `snapshots/ok/CASE/hierarchical.packed.snap`.
+const PACKED_CASES: [&str; 3] =
+    ["0036_int_uint_bool_coarse", "0054_matrix_select_and_nearest", "0075_background_and_surface_key"];
+
+#[test]
+fn packed_record_kernels() {
+    for case in PACKED_CASES {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/data/ok/{case}.mrsl"));
+        let source = source_of(&path);
+        let options = Options {
+            file_name: file_name(&path),
+            packed_records: true,
+            ..Options::for_modes(&[mrsl_abi::Mode::Hierarchical])
+        };
+        let program = mrsl::compile(&source, &options).unwrap_or_else(|d| panic!("{case}: {d:?}"));
+        assert!(program.layout.hierarchical.packed);
+        let kernel = program.kernel(mrsl_abi::KernelKind::Hierarchical, 1).expect("a hierarchical kernel");
+        let mut settings = insta::Settings::clone_current();
+        settings.set_snapshot_path(format!("snapshots/ok/{case}"));
+        settings.set_prepend_module_to_snapshot(false);
+        settings.remove_snapshot_suffix();
+        settings.set_omit_expression(true);
+        settings.bind(|| insta::assert_snapshot!("hierarchical.packed", kernel.wgsl.trim_end()));
+    }
+}
+
 /// The source, the warnings if any, and the layout without its plan.
 fn layout_snapshot(source: &str, name: &str, program: &mrsl::Program) -> String {
     let mut snapshot = String::new();

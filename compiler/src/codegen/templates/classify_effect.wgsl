@@ -15,15 +15,15 @@
             total += select(0.0, 1.0, ok[k]);
         }
         let disc = force || !(pair_a || pair_b);
-        let v0 = mrsl_hget_{{NAME}}(q[0]);
-        let v1 = mrsl_hget_{{NAME}}(q[1]);
-        let v2 = mrsl_hget_{{NAME}}(q[2]);
-        let v3 = mrsl_hget_{{NAME}}(q[3]);
+        let v0 = mrsl_hget_{{NAME}}({{FROM}}[0]);
+        let v1 = mrsl_hget_{{NAME}}({{FROM}}[1]);
+        let v2 = mrsl_hget_{{NAME}}({{FROM}}[2]);
+        let v3 = mrsl_hget_{{NAME}}({{FROM}}[3]);
 {{#TESTS}}
         if ({{NEED}}) {
             mask{{WORD}} |= {{MASK}}u;
         } else {
-            mrsl_hput_{{NAME}}(p, {{VALUE}});
+{{#PUT}}
             mrsl_pv_{{NAME}} = {{VALUE}};
         }
     }

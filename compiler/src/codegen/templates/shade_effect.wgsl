@@ -1,9 +1,9 @@
 var {{VAR}}: {{TYPE}};
 if ((mrsl_pmask{{MASK_WORD}} & {{MASK}}u) != 0u) {
 {{#EVALUATE}}
-    mrsl_hput_{{NAME}}(mrsl_pos, {{VAR}});
+{{#PUT}}
 {{#FLAG}}
 } else {
-    {{VAR}} = mrsl_hget_{{NAME}}(mrsl_pos);
+    {{VAR}} = mrsl_hget_{{NAME}}({{OWN}});
 }
 mrsl_pv_{{NAME}} = {{VAR}};

@@ -1,0 +1,3 @@
+fn mrsl_hget_{{NAME}}(r: MrslRecord) -> {{TYPE}} {
+    return {{UNPACK}};
+}
