@@ -45,11 +45,24 @@ function entry(binding: number, ty: BindingType): GPUBindGroupLayoutEntry {
     case 'word_texture':
       return { ...base, storageTexture: { access: 'read-write', format: 'r32uint', viewDimension: '2d-array' } };
     // Packed records (`Options::packed_records`): read-write rgba32uint needs
-    // the device feature `texture-formats-tier2`; without it the layout is
-    // refused and the mode reported unsupported.
+    // the device feature `texture-formats-tier2` (`missingFeature`).
     case 'packed_word_texture':
       return { ...base, storageTexture: { access: 'read-write', format: 'rgba32uint', viewDimension: '2d-array' } };
   }
+}
+
+/**
+ * Why `device` cannot make a stage group with `bindings`, where one needs a
+ * device feature the device lacks, or `null`: said before anything is made,
+ * so that the reason names the feature rather than a format.
+ */
+export function missingFeature(device: GPUDevice, bindings: readonly PassBinding[]): string | null {
+  const packed = bindings.some((b) => b.type.kind === 'packed_word_texture');
+  if (!packed || device.features.has('texture-formats-tier2')) return null;
+  return (
+    'its records are packed into an rgba32uint read-write storage texture (compiled with --packed-records), which ' +
+    'needs the device feature `texture-formats-tier2`: request it, or compile without --packed-records'
+  );
 }
 
 /** The stage group of a kernel, from the bindings a pass of the plan lists. */

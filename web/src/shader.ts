@@ -346,6 +346,8 @@ async function makeKernel(
   kernelPasses: Pass[],
   shared: SharedLayouts,
 ): Promise<{ stage: GPUBindGroupLayout; pipelines: Map<string, GPUComputePipeline> } | { refused: string }> {
+  const missing = groups.missingFeature(device, kernelPasses[0]!.bindings);
+  if (missing !== null) return { refused: missing };
   device.pushErrorScope('validation');
   const stage = groups.stageLayout(device, kernel.kind, kernelPasses[0]!.bindings);
   const module = device.createShaderModule({ label: kernel.kind, code: kernel.wgsl });

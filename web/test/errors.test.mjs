@@ -15,6 +15,7 @@ let gpu;
 let dir;
 let shader;
 let referenceOnly;
+let packed;
 
 before(async () => {
   gpu = await testDevice();
@@ -25,6 +26,8 @@ before(async () => {
   const load = (sub) => loadProgram((f) => readFile(join(dir, sub, f), 'utf8'), 'demo');
   shader = await Shader.create(gpu.device, await load('all'));
   referenceOnly = await Shader.create(gpu.device, await load('reference'));
+  mrslc(['compile', 'examples/demo.mrsl', '--packed-records', '-o', join(dir, 'packed')]);
+  packed = await Shader.create(gpu.device, await load('packed'));
 });
 after(() => dir && rmSync(dir, { recursive: true, force: true }));
 
@@ -118,6 +121,17 @@ test('modes: unknown, and not compiled', async (t) => {
   await refused(referenceOnly, bindings(() => ({})), { mode: 'coarse4x4' }, 'unsupported-mode', ['coarse4x4', 'plan']);
   assert.deepEqual(referenceOnly.modes(), ['reference']);
   assert.deepEqual(shader.modes(), MODES);
+});
+
+test('packed records: the hierarchical mode needs texture-formats-tier2, and the other modes run without it', async (t) => {
+  if (skip(t)) return;
+  if (gpu.device.features.has('texture-formats-tier2')) {
+    packed.supports('hierarchical');
+    return;
+  }
+  const words = ['hierarchical', 'texture-formats-tier2', '--packed-records'];
+  await refused(packed, bindings(() => ({})), { mode: 'hierarchical' }, 'unsupported-mode', words);
+  assert.deepEqual(packed.modes(), MODES.filter((m) => m !== 'hierarchical'));
 });
 
 test('the rate-image mode: its image bound, of the right size and format, and a tile size it has', async (t) => {

@@ -171,11 +171,19 @@ mod tests {
     /// edit fails here.
     #[test]
     fn every_variant_edits_the_workload_kernel() {
-        let program = mrsl::compile(WORKLOAD_PROGRAM, &mrsl::Options::default()).unwrap();
-        let kernel = &program.kernels.iter().find(|k| k.kind == KernelKind::Hierarchical).unwrap().wgsl;
+        // Both record layouts: the CLI packs records where the device can.
+        for packed_records in [false, true] {
+            let options = mrsl::Options { packed_records, ..mrsl::Options::default() };
+            let program = mrsl::compile(WORKLOAD_PROGRAM, &options).unwrap();
+            let kernel = &program.kernels.iter().find(|k| k.kind == KernelKind::Hierarchical).unwrap().wgsl;
+            edits_apply(kernel);
+        }
+    }
+
+    fn edits_apply(kernel: &str) {
         for v in &VARIANTS {
             let edited = apply(v, kernel).unwrap_or_else(|| panic!("{}: no line to edit", v.name));
-            assert_ne!(&edited, kernel, "{}", v.name);
+            assert_ne!(edited, kernel, "{}", v.name);
             mrsl::validate_wgsl(&edited).unwrap_or_else(|e| panic!("{}: {e}", v.name));
         }
         // Each edit finds the lines of its own part and no other's: level 0
