@@ -50,7 +50,7 @@ fn no_classification(w: &str) -> Option<String> {
 /// The shading of the work lists (pixels are still queued and counted, and
 /// their outputs written).
 fn no_work_list_shading(w: &str) -> Option<String> {
-    edit_lines(w, |l| (l.trim_start() == "mrsl_shade(listed);").then(String::new))
+    edit_lines(w, |l| matches!(l.trim_start(), "mrsl_shade(listed);" | "mrsl_shade_last(listed);").then(String::new))
 }
 
 /// The pixels' outputs: no call of `mrsl_finish` (their fine effects,
@@ -189,7 +189,8 @@ mod tests {
         // Each edit finds the lines of its own part and no other's: level 0
         // shades at one call, the work lists at one per level.
         assert_eq!(kernel.matches("mrsl_shade(p);").count(), 1);
-        assert_eq!(kernel.matches("mrsl_shade(listed);").count(), 4);
+        assert_eq!(kernel.matches("mrsl_shade(listed);").count(), 3);
+        assert_eq!(kernel.matches("mrsl_shade_last(listed);").count(), 1);
         assert_eq!(kernel.matches("if (mrsl_classify(p, ").count(), 4);
         let floor = nothing_shaded(kernel).unwrap();
         assert!(!floor.contains("if (disc"), "the floor still tests an effect");

@@ -728,7 +728,9 @@ impl<'b> Writer<'_, '_, 'b> {
     pub(super) fn value_only_effects(&self) -> BTreeSet<EffectId> {
         let c = self.checked();
         let mut effects = BTreeSet::new();
-        if !self.keeps_refine_flags() {
+        // The hierarchical kernel's last level evaluates its coarse effects
+        // for their values alone (`mrsl_shade_last`).
+        if !self.keeps_refine_flags() || self.kind == KernelKind::Hierarchical {
             effects.extend(self.kernel_effects().into_iter().filter(|e| c.effects[e.index()].has_refine));
         }
         for e in self.effects_at_neighbours() {

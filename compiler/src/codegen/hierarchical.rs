@@ -24,7 +24,7 @@ use super::Writer;
 use super::effects::Evaluation;
 use super::names::{
     CONTROL, COUNT, LANE, LOAD_RECORD, LOCAL_ID, NEIGHBOUR_RECORDS, Name, PIXEL_RECORD, POS, PUT_MASKS, PUT_RECORD,
-    RECORD_TYPE, SET_WORD, TILE_ARGS, TILE_INVOCATION, WORD, WORKGROUP,
+    RECORD_TYPE, SET_WORD, SHADE, SHADE_LAST, TILE_ARGS, TILE_INVOCATION, WORD, WORKGROUP,
 };
 use super::records::{axis_neighbours, diagonal_neighbours, neighbours, record_word};
 use super::words::bit;
@@ -117,7 +117,8 @@ impl Writer<'_, '_, '_> {
         self.finish_function();
         self.work_lists();
         self.tile_lists();
-        self.shade_function();
+        self.shade_function(false);
+        self.shade_function(true);
         self.level0();
         self.classify_function();
         for (index, (lattice, level)) in HIERARCHICAL_LEVELS.iter().zip(classified_levels()).enumerate() {
@@ -126,7 +127,10 @@ impl Writer<'_, '_, '_> {
             let queue = (index as u32 + 1) * QUEUE_WORDS_PER_LEVEL;
             let neighbours = neighbours(level.neighbours);
             let (params, invocation, valid) = self.level_invocation(*lattice);
+            // The last level's flags are read by no later classification.
+            let shade = if index + 1 == HIERARCHICAL_LEVELS.len() { SHADE_LAST } else { SHADE };
             let values: &super::writer::Values = &[
+                ("SHADE_PIXEL", &shade),
                 ("PARAMS", &params),
                 ("VALID", &valid),
                 ("LEVEL", &(index + 1)),
@@ -400,12 +404,17 @@ impl Writer<'_, '_, '_> {
 
     /// `mrsl_shade(pos)`: evaluates the coarse effects the pixel's mask names
     /// (reading the others from the records) and stores their values and
-    /// refine flags.
-    fn shade_function(&mut self) {
+    /// refine flags. With `last`, `mrsl_shade_last(pos)` for the last level,
+    /// whose flags no classification reads: the effects are evaluated for
+    /// their values alone (`mrsl_val_<effect>`, without what only decides a
+    /// flag, such as a predicate's derivatives), and the flags stored are 0.
+    /// The values are the same computation either way.
+    fn shade_function(&mut self, last: bool) {
         let c = self.checked();
         let flag_words = self.i.layout.hierarchical.flag_words;
         let [head, force, end] = cut(include_str!("templates/shade.wgsl"), &["FLAG_WORDS", "EFFECTS"]);
-        self.template(0, head, &[]);
+        let (name, what) = if last { (SHADE_LAST, " (their refine flags 0)") } else { (SHADE, " and refine flags") };
+        self.template(0, head, &[("NAME", &name), ("WHAT", &what)]);
         self.declare_flag_words(flag_words);
         let own = if self.packed() {
             self.line(1, format!("let {PIXEL_RECORD} = {LOAD_RECORD}({POS});"));
@@ -415,7 +424,9 @@ impl Writer<'_, '_, '_> {
             self.load_pixel_masks(1);
             POS
         };
-        self.template(0, force, &[]);
+        if !last {
+            self.template(0, force, &[]);
+        }
         let [evaluate, put, flag, read] =
             cut(include_str!("templates/shade_effect.wgsl"), &["EVALUATE", "PUT", "FLAG"]);
         for e in self.coarse_live() {
@@ -432,13 +443,15 @@ impl Writer<'_, '_, '_> {
                 ("OWN", &own),
             ];
             self.template(1, evaluate, &values);
-            self.evaluate(e, 2, "", Evaluation::Kernel);
+            self.evaluate(e, 2, "", if last { Evaluation::ValueOnly } else { Evaluation::Kernel });
             self.template(1, put, &values);
             if !self.packed() {
                 self.line(2, format!("{}({POS}, {var});", Name::RecordPut.of(&info.name)));
             }
             self.template(1, flag, &values);
-            self.set_refine_flag(e, 2);
+            if !last {
+                self.set_refine_flag(e, 2);
+            }
             self.template(1, read, &values);
         }
         let flags: Vec<String> = (0..flag_words).map(|w| Name::FlagWord.of(w)).collect();

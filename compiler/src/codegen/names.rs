@@ -301,6 +301,11 @@ pub(super) const PUT_RECORD: &str = "mrsl_put_record";
 pub(super) const PUT_MASKS: &str = "mrsl_put_masks";
 pub(super) const PIXEL_RECORD: &str = "mrsl_prec";
 pub(super) const NEIGHBOUR_RECORDS: &str = "mrsl_qr";
+/// The hierarchical kernel's shading of a pixel: with its refine flags
+/// (levels 0 to 3, whose flags the next level's classification reads), and
+/// for the values alone at level 4, the last, whose flags nothing reads.
+pub(super) const SHADE: &str = "mrsl_shade";
+pub(super) const SHADE_LAST: &str = "mrsl_shade_last";
 /// `mrsl_count(start, step, extent)`: a hierarchical lattice's points along an axis.
 pub(super) const COUNT: &str = "mrsl_count";
 /// `mrsl_tile_invocation(wg, lid, per, list)`: the lattice invocation of a
@@ -409,6 +414,7 @@ pub(super) const FIXED: &[&str] = &[
     "mrsl_htile_grid",
     "mrsl_tile_list",
     "mrsl_shade",
+    "mrsl_shade_last",
     "mrsl_classify",
     "mrsl_level0",
     "mrsl_finish",
