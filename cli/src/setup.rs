@@ -28,7 +28,7 @@ pub const WORKLOAD_PROGRAM: &str = include_str!("../../examples/sponza_lights.mr
 /// and the program, or the diagnostics rendered.
 pub fn compile_program(path: Option<&Path>, builtin: (&str, &str), modes: &[Mode]) -> Result<(String, mrsl::Program)> {
     let (name, source) = read_program(path, builtin)?;
-    let program = compile(&name, &source, modes, KernelOptions { storage_channels: false, packed_records: false })?;
+    let program = compile(&name, &source, Options::for_modes(modes))?;
     Ok((name, program))
 }
 
@@ -54,12 +54,13 @@ pub struct DeviceProgram {
 /// the same either way.
 pub fn compile_for_device(path: Option<&Path>, builtin: (&str, &str), modes: &[Mode]) -> Result<DeviceProgram> {
     let (name, source) = read_program(path, builtin)?;
-    let program = compile(&name, &source, modes, KernelOptions { storage_channels: true, packed_records: true })?;
+    let wished = Options { storage_channels: true, packed_records: true, ..Options::for_modes(modes) };
+    let program = compile(&name, &source, wished.clone())?;
     let channels = program.layout.channels.iter().filter(|c| c.access == ChannelAccess::Storage).count() as u32;
     let wanted = wgpu::Limits::default().max_storage_textures_per_shader_stage + channels;
     let gpu = Gpu::with_packed_records(wanted)?;
     let granted = gpu.device.limits().max_storage_textures_per_shader_stage;
-    let options = KernelOptions { storage_channels: granted >= wanted, packed_records: gpu.packs_records };
+    let options = Options { storage_channels: granted >= wanted, packed_records: gpu.packs_records, ..wished };
     if !options.storage_channels {
         eprintln!(
             "note: {} allows {granted} storage textures per shader stage, fewer than the {wanted} that reading the \
@@ -77,15 +78,8 @@ pub fn compile_for_device(path: Option<&Path>, builtin: (&str, &str), modes: &[M
     if options.storage_channels && options.packed_records {
         return Ok(DeviceProgram { name, program, gpu });
     }
-    let program = compile(&name, &source, modes, options)?;
+    let program = compile(&name, &source, options)?;
     Ok(DeviceProgram { name, program, gpu })
-}
-
-/// The options [`compile_for_device`] chooses by what the device grants.
-#[derive(Clone, Copy)]
-struct KernelOptions {
-    storage_channels: bool,
-    packed_records: bool,
 }
 
 /// The program at `path`, or the built-in `(name, source)`: its name for messages and its source.
@@ -96,13 +90,9 @@ fn read_program(path: Option<&Path>, builtin: (&str, &str)) -> Result<(String, S
     })
 }
 
-fn compile(name: &str, source: &str, modes: &[Mode], kernels: KernelOptions) -> Result<mrsl::Program> {
-    let options = Options {
-        file_name: name.to_string(),
-        storage_channels: kernels.storage_channels,
-        packed_records: kernels.packed_records,
-        ..Options::for_modes(modes)
-    };
+/// `source` compiled with `options`, its diagnostics naming the file `name`.
+fn compile(name: &str, source: &str, options: Options) -> Result<mrsl::Program> {
+    let options = Options { file_name: name.to_string(), ..options };
     mrsl::compile(source, &options).map_err(|d| anyhow!(mrsl::render_all(&d, name, source)))
 }
 

@@ -455,13 +455,10 @@ impl Writer<'_, '_, '_> {
             self.template(1, read, &values);
         }
         let flags: Vec<String> = (0..flag_words).map(|w| Name::FlagWord.of(w)).collect();
-        if self.packed() {
-            let h = &self.i.layout.hierarchical;
-            let masks: Vec<String> = (0..h.mask_words).map(|w| Name::PixelMask.of(w)).collect();
-            self.store_record(POS, &flags, &masks);
-        } else {
-            self.store_record(POS, &flags, &[]);
-        }
+        // Word records keep the mask words the level stored; a packed record is stored whole.
+        let mask_words = if self.packed() { self.i.layout.hierarchical.mask_words } else { 0 };
+        let masks: Vec<String> = (0..mask_words).map(|w| Name::PixelMask.of(w)).collect();
+        self.store_record(POS, &flags, &masks);
         self.template(0, end, &[]);
     }
 

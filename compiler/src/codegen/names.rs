@@ -377,6 +377,8 @@ pub(super) const FIXED: &[&str] = &[
     PUT_MASKS,
     PIXEL_RECORD,
     NEIGHBOUR_RECORDS,
+    SHADE,
+    SHADE_LAST,
     COUNT,
     TILE_INVOCATION,
     LOCAL_ID,
@@ -413,8 +415,6 @@ pub(super) const FIXED: &[&str] = &[
     // hierarchical_tiles.wgsl: the tile grid and where the tile list starts
     "mrsl_htile_grid",
     "mrsl_tile_list",
-    "mrsl_shade",
-    "mrsl_shade_last",
     "mrsl_classify",
     "mrsl_level0",
     "mrsl_finish",
