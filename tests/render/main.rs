@@ -124,6 +124,10 @@ const GPU_TESTS: &[GpuTest] = &[
         "modes::hierarchical_interpolates_a_gradient_from_level_zero",
         modes::hierarchical_interpolates_a_gradient_from_level_zero,
     ),
+    (
+        "modes::hierarchical_predicate_derivatives_from_level_neighbours",
+        modes::hierarchical_predicate_derivatives_from_level_neighbours,
+    ),
     ("modes::hierarchical_work_lists_keep_lanes_full", modes::hierarchical_work_lists_keep_lanes_full),
     (
         "modes::checkerboard_reconstructs_a_gradient_at_half_rate",

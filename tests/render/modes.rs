@@ -393,6 +393,56 @@ pub fn hierarchical_interpolates_a_gradient_from_level_zero(gpu: &Gpu) {
     assert!(queued <= 4 * 256, "{:?}", out.stats.work_lists);
 }
 
+/// At hierarchical levels 1 to 3 a predicate's derivative of a coarse
+/// effect is taken from the level's neighbours (docs/language.md, section
+/// 9, "A level's neighbours"); on a linear ramp it must equal the quad
+/// pair's difference per pixel, along the axis asked for. Each probe refines
+/// where one difference of the ramp exceeds its edge. With the edges at 0.8
+/// of the ramp's differences every shaded pixel flags, so refinement spreads
+/// from level 0 through every level; at 1.25 of them none does, and the
+/// probes are shaded where the ramp is. A difference off by a factor of 2
+/// (a level's span not divided out), or taken along the other axis (the two
+/// differences are 2.1x apart here), fails one of the two.
+pub fn hierarchical_predicate_derivatives_from_level_neighbours(gpu: &Gpu) {
+    let (w, h) = (256u32, 192u32);
+    // uv = (x + 0.5) / w, (y + 0.5) / h (Scene::Gradient), so these are the
+    // ramp's differences per pixel.
+    let (dx, dy) = (0.7 / w as f32, 0.25 / h as f32);
+    let gbuffer = Scene::Gradient.render(w, h);
+    for (factor, everywhere) in [(0.8f32, true), (1.25, false)] {
+        let source = format!(
+            "
+in float2 uv;
+coarse effect float ramp = dot(uv, float2(0.7, 0.25)) + 0.05;
+coarse effect float along_x {{
+    along_x = ramp * 0.5;
+    if (abs(ddx(ramp)) > {:.9})
+        refine;
+}}
+coarse effect float along_y {{
+    along_y = ramp * 0.25;
+    if (abs(ddy(ramp)) > {:.9})
+        refine;
+}}
+fine out float4 color = float4(ramp, along_x, along_y, 1.0);
+",
+            factor * dx,
+            factor * dy
+        );
+        let program = compile(&source);
+        let out = run(gpu, &program, &gbuffer, Mode::Hierarchical, false).unwrap();
+        let effect = |name: &str| out.stats.effects.iter().find(|e| e.name == name).unwrap().clone();
+        let ramp = effect("ramp");
+        for probe in [effect("along_x"), effect("along_y")] {
+            if everywhere {
+                assert!(probe.shaded_fraction >= 0.99, "edge {factor}: {probe:?}");
+            } else {
+                assert!(probe.shaded_fraction <= ramp.shaded_fraction + 0.005, "edge {factor}: {probe:?} / {ramp:?}");
+            }
+        }
+    }
+}
+
 /// Work compaction: on the demo scene every queued pixel is shaded by a
 /// full lane except the last partial group of each level.
 pub fn hierarchical_work_lists_keep_lanes_full(gpu: &Gpu) {

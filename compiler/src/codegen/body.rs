@@ -72,6 +72,9 @@ pub(super) enum Mode<'s> {
     Body,
     /// Rebuilding a derivative operand at another position.
     Neighbour(&'s crate::deriv::DerivSite<'s>),
+    /// The same at a pixel whose record is complete (a hierarchical level's
+    /// neighbour): effects are read from the record, not evaluated.
+    Stored(&'s crate::deriv::DerivSite<'s>),
 }
 
 impl Writer<'_, '_, '_> {
@@ -329,15 +332,17 @@ impl Writer<'_, '_, '_> {
         let c = self.checked();
         match c.symbols.get(&e.id) {
             Some(Symbol::Local(l)) => match mode {
-                Mode::Neighbour(site) if !site.params.contains(l) => match self.i.deriv.definitions.get(l) {
-                    Some(def) => format!("({})", self.expr(def, mode)),
-                    None => local_name(c, *l),
-                },
+                Mode::Neighbour(site) | Mode::Stored(site) if !site.params.contains(l) => {
+                    match self.i.deriv.definitions.get(l) {
+                        Some(def) => format!("({})", self.expr(def, mode)),
+                        None => local_name(c, *l),
+                    }
+                }
                 _ => local_name(c, *l),
             },
             Some(Symbol::Input(i)) => match mode {
                 Mode::Body => wgsl_ident(name),
-                Mode::Neighbour(_) => format!("{}({POS})", Name::Load.of(&c.inputs[i.index()].name)),
+                Mode::Neighbour(_) | Mode::Stored(_) => format!("{}({POS})", Name::Load.of(&c.inputs[i.index()].name)),
             },
             Some(Symbol::Uniform(u)) => {
                 let info = &c.uniforms[u.index()];
@@ -356,6 +361,7 @@ impl Writer<'_, '_, '_> {
             Some(Symbol::Effect(id)) => match mode {
                 Mode::Body => self.effect_name(*id),
                 Mode::Neighbour(_) => format!("{}({POS})", Name::At.of(&c.effects[id.index()].name)),
+                Mode::Stored(_) => format!("{}({POS})", Name::Stored.of(&c.effects[id.index()].name)),
             },
             None => wgsl_ident(name),
         }

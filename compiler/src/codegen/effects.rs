@@ -7,7 +7,8 @@
 
 use super::body::{Mode, float_literal, local_name, wgsl_ident};
 use super::names::{
-    BACKGROUND, BLOCK_SIZE, CONTROL, FORCE, NEIGHBOURS, Name, OCTAHEDRAL, PAIR_X, PAIR_Y, POS, REFINE, RGB9E5,
+    BACKGROUND, BLOCK_SIZE, CONTROL, FORCE, HERE, LEVEL, NEIGHBOURS, Name, OCTAHEDRAL, PAIR_X, PAIR_Y, POS, REFINE,
+    RGB9E5,
 };
 use super::words::{bit, unpack_with};
 use super::writer::cut;
@@ -503,6 +504,14 @@ impl<'b> Writer<'_, '_, 'b> {
         if own.is_empty() {
             return false;
         }
+        let kept = self.value_expressions(e);
+        own.iter().any(|n| kept.contains(n))
+    }
+
+    /// The expressions of `e`'s body that its value needs: all but those in
+    /// the statements that only decide its refine flag (`DerivInfo::value_skips`).
+    fn value_expressions(&self, e: EffectId) -> HashSet<NodeId> {
+        let c = self.checked();
         let mut kept = HashSet::new();
         let mut collect = |x: &Expr| visit_expr(x, &mut |y| _ = kept.insert(y.id));
         match &c.effect_decl(e).body {
@@ -513,7 +522,21 @@ impl<'b> Writer<'_, '_, 'b> {
                 b.stmts.iter().for_each(|s| visit_kept_exprs(s, skipped, &mut collect));
             }
         }
-        own.iter().any(|n| kept.contains(n))
+        kept
+    }
+
+    /// Whether derivative site `k` is taken from the level's neighbours at
+    /// hierarchical levels 1 to 3 ([`Derivatives::HereOrLevelNeighbours`]):
+    /// its operand reads a coarse effect, which the quad pair would evaluate
+    /// at the partner, and it only decides a refine flag (a predicate's
+    /// derivative), so the values, and forced refinement, never depend on it.
+    pub(super) fn takes_level_differences(&self, k: usize) -> bool {
+        let site = &self.i.deriv.sites[k];
+        if self.derivatives() != Derivatives::HereOrLevelNeighbours || site.effects.is_empty() {
+            return false;
+        }
+        let call = self.i.deriv.site_of.iter().find(|&(_, &site)| site == k).map(|(&node, _)| node);
+        call.is_some_and(|node| !self.value_expressions(site.effect).contains(&node))
     }
 
     /// `mrsl_eval_<effect>`: the effect's body at `mrsl_pos`, given its
@@ -578,6 +601,12 @@ impl<'b> Writer<'_, '_, 'b> {
     }
 
     // ---- Derivatives and values at other positions ------------------------------
+
+    /// The live derivative sites taken from the levels' neighbours
+    /// ([`Self::takes_level_differences`]).
+    pub(super) fn level_sites(&self) -> Vec<usize> {
+        self.live_sites().into_iter().filter(|&k| self.takes_level_differences(k)).collect()
+    }
 
     fn live_sites(&self) -> Vec<usize> {
         let mut computed = vec![false; self.checked().effects.len()];
@@ -654,7 +683,8 @@ impl<'b> Writer<'_, '_, 'b> {
                 ("OPERAND", &operand),
                 ("ARGS", &args),
             ];
-            let [operand_helper, differences] = cut(include_str!("templates/derivative.wgsl"), &["DIFFERENCES"]);
+            let [operand_helper, ddx_head, ddx_rest, ddy_rest] =
+                cut(include_str!("templates/derivative.wgsl"), &["DIFFERENCES", "LEVELS_X", "LEVELS_Y"]);
             self.template(0, operand_helper, values);
             if self.stays_on_surface(k) {
                 let apart = Name::Apart.of(&c.effects[site.effect.index()].name);
@@ -666,7 +696,23 @@ impl<'b> Writer<'_, '_, 'b> {
                     self.template(0, difference, &[values, extra].concat());
                 }
             } else if self.reuses_operand_here(k) {
-                self.template(0, differences, values);
+                let levels = self.takes_level_differences(k);
+                if levels {
+                    let stored = self.expr(site.operand, Mode::Stored(site));
+                    let extra: &super::writer::Values = &[("STORED", &stored)];
+                    self.template(0, include_str!("templates/derivative_levels.wgsl"), &[values, extra].concat());
+                }
+                for (axis, rest) in [(0, ddx_head), (1, ddx_rest), (2, ddy_rest)] {
+                    if levels && axis > 0 {
+                        // At levels 1 to 3 the level's neighbours give the difference.
+                        let differences =
+                            format!("{}({POS}{args}, {HERE})[{}]", Name::LevelDifferences.of(k), axis - 1);
+                        self.line(1, format!("if ({LEVEL} != 0u) {{"));
+                        self.line(2, format!("return {differences};"));
+                        self.line(1, "}");
+                    }
+                    self.template(0, rest, values);
+                }
             } else {
                 self.template(0, include_str!("templates/derivative_both.wgsl"), values);
             }
@@ -687,7 +733,7 @@ impl<'b> Writer<'_, '_, 'b> {
     /// under forced refinement the value is the evaluated one.
     pub(super) fn reuses_operand_here(&self, k: usize) -> bool {
         match self.derivatives() {
-            Derivatives::Here | Derivatives::HereOnSurface => true,
+            Derivatives::Here | Derivatives::HereOnSurface | Derivatives::HereOrLevelNeighbours => true,
             Derivatives::HereWithoutEffects => self.i.deriv.sites[k].effects.is_empty(),
         }
     }
@@ -695,6 +741,7 @@ impl<'b> Writer<'_, '_, 'b> {
     pub(super) fn derivatives(&self) -> Derivatives {
         match self.kind {
             KernelKind::Checkerboard => Derivatives::HereWithoutEffects,
+            KernelKind::Hierarchical => Derivatives::HereOrLevelNeighbours,
             kind if kind.is_coarse() => Derivatives::HereOnSurface,
             _ => Derivatives::Here,
         }

@@ -22,9 +22,10 @@
 
 use super::Writer;
 use super::effects::Evaluation;
+use super::level_derivatives::LEVELS_WITH_NEIGHBOUR_DERIVATIVES;
 use super::names::{
-    CONTROL, COUNT, LANE, LOAD_RECORD, LOCAL_ID, NEIGHBOUR_RECORDS, Name, PIXEL_RECORD, POS, PUT_MASKS, PUT_RECORD,
-    RECORD_TYPE, SET_WORD, SHADE, SHADE_LAST, TILE_ARGS, TILE_INVOCATION, WORD, WORKGROUP,
+    CONTROL, COUNT, LANE, LEVEL, LOAD_RECORD, LOCAL_ID, NEIGHBOUR_RECORDS, Name, PIXEL_RECORD, POS, PUT_MASKS,
+    PUT_RECORD, RECORD_TYPE, SET_WORD, SHADE, SHADE_LAST, TILE_ARGS, TILE_INVOCATION, WORD, WORKGROUP,
 };
 use super::records::{axis_neighbours, diagonal_neighbours, neighbours, record_word};
 use super::words::bit;
@@ -58,6 +59,12 @@ fn classified_levels() -> [Classified; 4] {
         Classified { what: "odd pixels, from diagonal neighbours at distance 1", neighbours: diagonal_neighbours(1) },
         Classified { what: "the rest, from axis neighbours at distance 1", neighbours: axis_neighbours(1) },
     ]
+}
+
+/// The neighbours classified level `level` (1 to 4) interpolates from, in
+/// opposite pairs (0, 1) and (2, 3).
+pub(super) fn classified_neighbours(level: usize) -> [(i32, i32); 4] {
+    classified_levels()[level - 1].neighbours
 }
 
 /// The pixel of invocation `gid.xy`, as WGSL: lattice point `gid.xy`, or
@@ -114,6 +121,7 @@ impl Writer<'_, '_, '_> {
             self.record_helpers();
         }
         self.pixel_values();
+        self.level_derivative_helpers();
         self.finish_function();
         self.work_lists();
         self.tile_lists();
@@ -148,8 +156,10 @@ impl Writer<'_, '_, '_> {
                 ("WORK_GROUP", &WORK_LIST_WORKGROUP),
                 ("SHADE", &entry::HIER_SHADE[index]),
             ];
-            let [head, classify, shade, end] =
-                cut(include_str!("templates/level.wgsl"), &["INVOCATION", "FLUSH_CLASSIFY", "FLUSH_SHADE"]);
+            let [head, classify, shade, shade_pixel, end] = cut(
+                include_str!("templates/level.wgsl"),
+                &["INVOCATION", "FLUSH_CLASSIFY", "SET_LEVEL", "FLUSH_SHADE"],
+            );
             self.template(0, head, values);
             if let Some(line) = &invocation {
                 self.line(1, line);
@@ -157,6 +167,10 @@ impl Writer<'_, '_, '_> {
             self.template(0, classify, values);
             self.flush_finished(COARSE_WORKGROUP * COARSE_WORKGROUP);
             self.template(0, shade, values);
+            if self.has_level_derivatives() && LEVELS_WITH_NEIGHBOUR_DERIVATIVES.contains(&(index + 1)) {
+                self.line(2, format!("{LEVEL} = {}u;", index + 1));
+            }
+            self.template(0, shade_pixel, values);
             self.flush_finished(WORK_LIST_WORKGROUP);
             self.template(0, end, values);
         }

@@ -57,6 +57,7 @@ mod dynamic;
 mod effects;
 mod fine;
 mod hierarchical;
+mod level_derivatives;
 mod names;
 mod pixel;
 mod rate;
@@ -157,6 +158,11 @@ enum Derivatives {
     HereOnSurface,
     /// From the caller where the operand reads no effect (the checkerboard kernel).
     HereWithoutEffects,
+    /// From the caller, always; and at levels 1 to 3 a predicate's derivative
+    /// of an operand that reads coarse effects is taken from the level's
+    /// neighbours, their effects read from their records (the hierarchical
+    /// kernel, docs/language.md section 9; [`Writer::takes_level_differences`]).
+    HereOrLevelNeighbours,
 }
 
 impl Cache {

@@ -78,6 +78,14 @@ pub(super) enum Name {
     Out,
     /// `mrsl_d<site>`: the operand of a derivative site at a position.
     Operand,
+    /// `mrsl_dr<site>`: the operand of a derivative site at a pixel whose
+    /// record is complete, its effects read from the record.
+    StoredOperand,
+    /// `mrsl_dl<site>`: a derivative site's differences along x and y from a
+    /// hierarchical level's neighbours.
+    LevelDifferences,
+    /// `mrsl_stored_<effect>`: a coarse effect's value in a complete record (zero at a background pixel).
+    Stored,
     /// `mrsl_ddx_<site>`: a derivative site's difference along x.
     Ddx,
     /// `mrsl_ddy_<site>`: a derivative site's difference along y.
@@ -104,7 +112,7 @@ pub(super) enum Name {
 impl Name {
     /// Every family, for the tests that check names against this module.
     #[cfg_attr(not(test), expect(dead_code, reason = "read by the tests"))]
-    pub(super) const ALL: [Name; 37] = [
+    pub(super) const ALL: [Name; 40] = [
         Name::Eval,
         Name::Val,
         Name::At,
@@ -132,6 +140,9 @@ impl Name {
         Name::GBuffer,
         Name::Out,
         Name::Operand,
+        Name::StoredOperand,
+        Name::LevelDifferences,
+        Name::Stored,
         Name::Ddx,
         Name::Ddy,
         Name::SelectMatrix,
@@ -174,6 +185,9 @@ impl Name {
             Name::GBuffer => "mrsl_gb_",
             Name::Out => "mrsl_out_",
             Name::Operand => "mrsl_d",
+            Name::StoredOperand => "mrsl_dr",
+            Name::LevelDifferences => "mrsl_dl",
+            Name::Stored => "mrsl_stored_",
             Name::Ddx => "mrsl_ddx_",
             Name::Ddy => "mrsl_ddy_",
             Name::SelectMatrix => "mrsl_select_m",
@@ -306,6 +320,17 @@ pub(super) const NEIGHBOUR_RECORDS: &str = "mrsl_qr";
 /// for the values alone at level 4, the last, whose flags nothing reads.
 pub(super) const SHADE: &str = "mrsl_shade";
 pub(super) const SHADE_LAST: &str = "mrsl_shade_last";
+/// The hierarchical level whose work list an invocation shades (1 to 3, else
+/// 0: a private variable the level's entry point sets), the four neighbours
+/// that level interpolates from (`mrsl_level_neighbours(p)`), and the weights
+/// that turn their pairs' differences into differences per pixel
+/// (`mrsl_level_weights()`): a predicate's derivative of coarse effects at
+/// levels 1 to 3 is taken from those neighbours (`Name::LevelDifferences`).
+pub(super) const LEVEL: &str = "mrsl_level";
+pub(super) const LEVEL_NEIGHBOURS: &str = "mrsl_level_neighbours";
+pub(super) const LEVEL_WEIGHTS: &str = "mrsl_level_weights";
+/// A derivative helper's operand at the position itself, which the caller passes.
+pub(super) const HERE: &str = "mrsl_here";
 /// `mrsl_count(start, step, extent)`: a hierarchical lattice's points along an axis.
 pub(super) const COUNT: &str = "mrsl_count";
 /// `mrsl_tile_invocation(wg, lid, per, list)`: the lattice invocation of a
@@ -379,6 +404,9 @@ pub(super) const FIXED: &[&str] = &[
     NEIGHBOUR_RECORDS,
     SHADE,
     SHADE_LAST,
+    LEVEL,
+    LEVEL_NEIGHBOURS,
+    LEVEL_WEIGHTS,
     COUNT,
     TILE_INVOCATION,
     LOCAL_ID,
@@ -395,10 +423,17 @@ pub(super) const FIXED: &[&str] = &[
     PAIR_X,
     PAIR_Y,
     // derivative.wgsl, derivative_both.wgsl: the operand here, at the pair's other position
-    "mrsl_here",
+    HERE,
     "mrsl_there",
     "mrsl_second",
     "mrsl_difference",
+    // derivative_levels.wgsl: a level's neighbours, the operand there, the pairs' differences
+    "mrsl_near",
+    "mrsl_vals",
+    "mrsl_inside",
+    "mrsl_along",
+    "mrsl_across",
+    "mrsl_weights",
     // derivative_on_surface.wgsl
     "mrsl_other",
     "mrsl_mirror",

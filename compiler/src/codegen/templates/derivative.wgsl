@@ -9,6 +9,7 @@ fn mrsl_d{{SITE}}({{PARAMS}}) -> {{TYPE}} {
 // That position is chosen by `select`, not by a branch: lanes on both sides of their
 // pairs would run both sides of a branch on a SIMD machine, evaluating it twice.
 fn mrsl_ddx_{{SITE}}({{PARAMS}}, mrsl_here: {{TYPE}}) -> {{TYPE}} {
+    {{#LEVELS_X}}
     let mrsl_q = mrsl_pair_x(mrsl_pos);
     let mrsl_second = all(mrsl_q.zw == mrsl_pos);
     let mrsl_there = mrsl_d{{SITE}}(select(mrsl_q.zw, mrsl_q.xy, mrsl_second){{ARGS}});
@@ -16,6 +17,7 @@ fn mrsl_ddx_{{SITE}}({{PARAMS}}, mrsl_here: {{TYPE}}) -> {{TYPE}} {
     return select(mrsl_difference, {{TYPE}}(), all(mrsl_q.xy == mrsl_q.zw));
 }
 fn mrsl_ddy_{{SITE}}({{PARAMS}}, mrsl_here: {{TYPE}}) -> {{TYPE}} {
+    {{#LEVELS_Y}}
     let mrsl_q = mrsl_pair_y(mrsl_pos);
     let mrsl_second = all(mrsl_q.zw == mrsl_pos);
     let mrsl_there = mrsl_d{{SITE}}(select(mrsl_q.zw, mrsl_q.xy, mrsl_second){{ARGS}});

@@ -27,6 +27,7 @@ fn {{SHADE}}(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invoc
     if (gid.x < atomicLoad(&mrsl_queue[{{QUEUE}}u])) {
         let index = mrsl_work[mrsl_work_offset({{LEVEL}}u) + gid.x];
         let listed = vec2<i32>(i32(index % mrsl_ctl.size.x), i32(index / mrsl_ctl.size.x));
+        {{#SET_LEVEL}}
         {{SHADE_PIXEL}}(listed);
         mrsl_finish(listed);
     }
