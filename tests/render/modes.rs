@@ -400,7 +400,10 @@ pub fn hierarchical_interpolates_a_gradient_from_level_zero(gpu: &Gpu) {
 /// where one difference of the ramp exceeds its edge. With the edges at 0.8
 /// of the ramp's differences every shaded pixel flags, so refinement spreads
 /// from level 0 through every level; at 1.25 of them none does, and the
-/// probes are shaded where the ramp is. A difference off by a factor of 2
+/// probes are shaded where the ramp is. (At 0.8, 99.3% of the pixels: a
+/// level's neighbour outside the image counts as the pixel itself, which
+/// halves the difference next to the image's edges, so a few pixels there
+/// interpolate; hence 0.99.) A difference off by a factor of 2
 /// (a level's span not divided out), or taken along the other axis (the two
 /// differences are 2.1x apart here), fails one of the two.
 pub fn hierarchical_predicate_derivatives_from_level_neighbours(gpu: &Gpu) {

@@ -2,9 +2,10 @@
 //! functions, and the renaming that keeps source names clear of WGSL's
 //! keywords and of the generated `mrsl_` namespace and entry points.
 //!
-//! The same expression is written in two modes: in its body, where names are
-//! in scope, and rebuilt at another position for a derivative, where inputs
-//! are loaded and effects fetched there instead.
+//! The same expression is written in its body, where names are in scope,
+//! and rebuilt at another position for a derivative, where inputs are
+//! loaded there and effects evaluated there, or read from that pixel's
+//! complete record (the hierarchical levels' neighbours).
 
 use super::Writer;
 use super::names::{Name, POS, REFINE, UNIFORMS};
