@@ -702,17 +702,19 @@ impl<'b> Writer<'_, '_, 'b> {
                     let extra: &super::writer::Values = &[("STORED", &stored)];
                     self.template(0, include_str!("templates/derivative_levels.wgsl"), &[values, extra].concat());
                 }
-                for (axis, rest) in [(0, ddx_head), (1, ddx_rest), (2, ddy_rest)] {
-                    if levels && axis > 0 {
-                        // At levels 1 to 3 the level's neighbours give the difference.
-                        let differences =
-                            format!("{}({POS}{args}, {HERE})[{}]", Name::LevelDifferences.of(k), axis - 1);
-                        self.line(1, format!("if ({LEVEL} != 0u) {{"));
-                        self.line(2, format!("return {differences};"));
-                        self.line(1, "}");
+                // At levels 1 to 3 the level's neighbours give each difference.
+                let level_branch = |w: &mut Self, axis: usize| {
+                    if levels {
+                        w.line(1, format!("if ({LEVEL} != 0u) {{"));
+                        w.line(2, format!("return {}({POS}{args}, {HERE})[{axis}];", Name::LevelDifferences.of(k)));
+                        w.line(1, "}");
                     }
-                    self.template(0, rest, values);
-                }
+                };
+                self.template(0, ddx_head, values);
+                level_branch(self, 0);
+                self.template(0, ddx_rest, values);
+                level_branch(self, 1);
+                self.template(0, ddy_rest, values);
             } else {
                 self.template(0, include_str!("templates/derivative_both.wgsl"), values);
             }

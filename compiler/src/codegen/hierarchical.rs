@@ -129,6 +129,7 @@ impl Writer<'_, '_, '_> {
         self.shade_function(true);
         self.level0();
         self.classify_function();
+        let level_derivatives = self.has_level_derivatives();
         for (index, (lattice, level)) in HIERARCHICAL_LEVELS.iter().zip(classified_levels()).enumerate() {
             // The level's words in the queue (its count first) and in the
             // indirect arguments (x, y, z).
@@ -167,7 +168,7 @@ impl Writer<'_, '_, '_> {
             self.template(0, classify, values);
             self.flush_finished(COARSE_WORKGROUP * COARSE_WORKGROUP);
             self.template(0, shade, values);
-            if self.has_level_derivatives() && LEVELS_WITH_NEIGHBOUR_DERIVATIVES.contains(&(index + 1)) {
+            if level_derivatives && LEVELS_WITH_NEIGHBOUR_DERIVATIVES.contains(&(index + 1)) {
                 self.line(2, format!("{LEVEL} = {}u;", index + 1));
             }
             self.template(0, shade_pixel, values);
@@ -180,7 +181,7 @@ impl Writer<'_, '_, '_> {
     /// Whether the records are packed four words to a texel
     /// (`Options::packed_records`): then every invocation loads the records
     /// it reads whole, once, and stores its pixel's record whole, once.
-    fn packed(&self) -> bool {
+    pub(super) fn packed(&self) -> bool {
         self.i.layout.hierarchical.packed
     }
 

@@ -15,12 +15,14 @@ use super::hierarchical::classified_neighbours;
 use super::names::{LEVEL, LEVEL_NEIGHBOURS, LEVEL_WEIGHTS, LOAD_RECORD, Name, POS};
 use super::records::neighbours;
 use crate::check::EffectId;
+use mrsl_abi::geometry::HIERARCHICAL_LEVELS;
 use std::collections::BTreeSet;
 
 /// The levels whose shading evaluates predicates and reads the level's
-/// neighbours for their derivatives: 1 to 3 (level 4 shades values alone,
-/// level 0's neighbours are shaded in the same dispatch).
-pub(super) const LEVELS_WITH_NEIGHBOUR_DERIVATIVES: std::ops::RangeInclusive<usize> = 1..=3;
+/// neighbours for their derivatives: 1 to 3, every classified level but the
+/// last, which shades values alone (level 0's neighbours are shaded in the
+/// same dispatch).
+pub(super) const LEVELS_WITH_NEIGHBOUR_DERIVATIVES: std::ops::RangeInclusive<usize> = 1..=HIERARCHICAL_LEVELS.len() - 1;
 
 impl Writer<'_, '_, '_> {
     /// Whether some derivative of the kernel is taken from the levels' neighbours.
@@ -82,7 +84,7 @@ impl Writer<'_, '_, '_> {
         let c = self.checked();
         let info = &c.effects[e.index()];
         let ty = info.ty.wgsl();
-        let record = if self.i.layout.hierarchical.packed { format!("{LOAD_RECORD}({POS})") } else { POS.to_string() };
+        let record = if self.packed() { format!("{LOAD_RECORD}({POS})") } else { POS.to_string() };
         self.line(0, format!("// `{}` as a complete record holds it.", info.name));
         self.line(0, format!("fn {}({POS}: vec2<i32>) -> {ty} {{", Name::Stored.of(&info.name)));
         if self.has_background() {
