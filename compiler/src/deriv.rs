@@ -37,8 +37,9 @@ pub struct DerivSite<'a> {
     pub params: Vec<LocalId>,
     /// Effects the operand reads (directly or through inlined locals): needed at the neighbour.
     pub effects: Vec<EffectId>,
-    /// The derivative call and its builtin (`ddx_surface` and its kin:
-    /// [`crate::builtins::Builtin::on_surface`]).
+    /// The derivative call (its node and span) and its builtin
+    /// (`ddx_surface` and its kin: [`crate::builtins::Builtin::on_surface`]).
+    pub node: NodeId,
     pub call: Span,
     pub builtin: crate::builtins::Builtin,
 }
@@ -125,6 +126,7 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
                 operand,
                 params: params.into_iter().collect(),
                 effects: effects.into_iter().collect(),
+                node: call.id,
                 call: call.span,
                 builtin: *builtin,
             });

@@ -535,8 +535,7 @@ impl<'b> Writer<'_, '_, 'b> {
         if self.derivatives() != Derivatives::HereOrLevelNeighbours || site.effects.is_empty() {
             return false;
         }
-        let call = self.i.deriv.site_of.iter().find(|&(_, &site)| site == k).map(|(&node, _)| node);
-        call.is_some_and(|node| !self.value_expressions(site.effect).contains(&node))
+        !self.value_expressions(site.effect).contains(&site.node)
     }
 
     /// `mrsl_eval_<effect>`: the effect's body at `mrsl_pos`, given its
