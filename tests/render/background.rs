@@ -148,3 +148,58 @@ pub fn surface_keys_refine_the_same_pixels_at_any_scale(gpu: &Gpu) {
     println!("world-unit key: {small} refined pixels at scale 0.01, {large} at 100");
     assert!(large > 2 * small, "a world-unit key refines far more of a larger scene: {large} against {small}");
 }
+
+/// Fine effects that read the background channel, at the pixel and at its
+/// quad partner (`fwidth`), for the test below.
+const CHANNEL_PROGRAM: &str = "\
+in float3 normal;
+@background(255) in uint material;
+coarse effect float lit = saturate(normal.y);
+fine effect float id = float(material);
+fine effect float jump = fwidth(float(material));
+fine out float4 color = float4(id / 255.0, jump, lit, 1.0);
+";
+
+/// The entry points over wholly-background tiles evaluate the fine effects
+/// with the background channel's value at the pixel they shade, not a load
+/// (so that what a program computes only for drawn pixels folds away
+/// there). The value is the pixel's own: a quad partner in another tile
+/// still reads its own channel. Here the image is one pixel wider and taller
+/// than a multiple of 8 and 32, so the last column and row lie in tiles of
+/// their own, which the test makes background, with drawn pixels in the
+/// column and row before them: the last pixels' quad partners (the border
+/// rule pairs them with those) lie in surface tiles. Every mode's background
+/// pixels must equal the reference's bit for bit.
+pub fn background_tiles_read_their_own_channel(gpu: &Gpu) {
+    let (w, h) = (129usize, 89usize);
+    let mut gbuffer = Scene::Demo.render(w as u32, h as u32);
+    let Some((_, ChannelData::Uint(ids))) = gbuffer.channels.iter_mut().find(|(n, _)| n == "material") else {
+        panic!("the demo scene has a material channel")
+    };
+    for y in 0..h {
+        for x in 0..w {
+            let id = &mut ids[y * w + x];
+            if x == w - 1 || y == h - 1 {
+                *id = BACKGROUND;
+            } else if (x == w - 2 || y == h - 2) && *id == BACKGROUND {
+                *id = 1;
+            }
+        }
+    }
+    let background: Vec<bool> = materials(&gbuffer).iter().map(|&m| m == BACKGROUND).collect();
+    let program = compile(CHANNEL_PROGRAM);
+    let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap().pixels;
+    // The last column's pixels (but the corner's) differ from their drawn
+    // partners: the test can fail.
+    let jumps = (0..h - 1).filter(|y| reference[y * w + w - 1][1] != 0.0).count();
+    assert_eq!(jumps, h - 1, "the last column's pixels step to their drawn partners");
+    for mode in adaptive_modes() {
+        let pixels = run(gpu, &program, &gbuffer, mode, false).unwrap().pixels;
+        for (i, &bg) in background.iter().enumerate() {
+            if bg {
+                let (x, y) = (i % w, i / w);
+                assert_eq!(pixels[i], reference[i], "{mode}: background pixel ({x}, {y})");
+            }
+        }
+    }
+}

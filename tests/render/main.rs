@@ -36,6 +36,7 @@ const GPU_TESTS: &[GpuTest] = &[
         "background::background_pixels_are_never_shaded_or_refined",
         background::background_pixels_are_never_shaded_or_refined,
     ),
+    ("background::background_tiles_read_their_own_channel", background::background_tiles_read_their_own_channel),
     (
         "background::surface_keys_refine_the_same_pixels_at_any_scale",
         background::surface_keys_refine_the_same_pixels_at_any_scale,

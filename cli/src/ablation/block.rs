@@ -218,10 +218,19 @@ fn as_background(w: &str) -> Option<String> {
     })
 }
 
+/// The background entry points load the background channel at the pixel
+/// they shade instead of taking the rule's value (`mrsl_in_background_tile`
+/// is never set): the kernels as they were before the value was known.
+/// `None` where the kernel does not know it (no background rule, or one
+/// whose value is not one bit pattern).
+pub(super) fn background_channel_loaded(w: &str) -> Option<String> {
+    edit_lines(w, |l| (l.trim_start() == "mrsl_in_background_tile = true;").then(String::new))
+}
+
 /// The variants. Removing the key tests or the flag reads from the full
 /// kernel would also change what is refined, so those parts are measured
 /// within the fixed cost (nothing refined), where they decide nothing.
-pub(super) const VARIANTS: [Variant; 14] = [
+pub(super) const VARIANTS: [Variant; 15] = [
     Variant {
         name: "no instrumentation",
         removes: "the statistics atomics, their barrier and the refine-mask store (`DispatchOptions::statistics` off)",
@@ -288,6 +297,11 @@ pub(super) const VARIANTS: [Variant; 14] = [
         edits: &[as_background, no_refinement_loops, no_instrumentation],
     },
     Variant {
+        name: "background channel loaded (added)",
+        removes: "nothing; adds work: the background tiles' pixels load the background channel instead of taking the rule's value, so what the program computes only where something was drawn no longer folds away there (statistics off, as timed runs)",
+        edits: &[background_channel_loaded, no_instrumentation],
+    },
+    Variant {
         name: "no fine pass work",
         removes: "everything the fine pass does per pixel (left: the coarse pass and the launches)",
         edits: &[no_fine_work],
@@ -338,7 +352,7 @@ mod tests {
     }
 
     /// Without a background rule (no `@background` input) the background
-    /// variant has nothing to edit: it is listed as not applicable, not
+    /// variants have nothing to edit: it is listed as not applicable, not
     /// made into a kernel that does not validate.
     #[test]
     fn the_background_variant_needs_a_background_rule() {
@@ -348,6 +362,7 @@ mod tests {
         let program = mrsl::compile(source, &mrsl::Options::default()).unwrap();
         let fine = &program.kernel(KernelKind::Fine, 4).unwrap().wgsl;
         assert_eq!(as_background(fine), None);
+        assert_eq!(background_channel_loaded(fine), None);
         assert!(nothing_refined(fine).is_some(), "the other variants still apply");
     }
 }

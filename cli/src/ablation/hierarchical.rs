@@ -7,7 +7,7 @@
 //! level entry points' calls of `mrsl_classify` and `mrsl_shade`, the calls
 //! of `mrsl_finish` that write a pixel's outputs.
 
-use super::block::no_instrumentation;
+use super::block::{background_channel_loaded, no_instrumentation};
 use super::{Variant, edit_lines, indent};
 use mrsl_abi::{CompiledProgram, KernelKind};
 
@@ -116,7 +116,7 @@ fn launches_only(w: &str) -> Option<String> {
 /// The variants. "Nothing shaded" is the mode's floor: what it costs where
 /// no pixel past level 0 needs shading; the ones after it take a further
 /// part out of that floor.
-pub(super) const VARIANTS: [Variant; 13] = [
+pub(super) const VARIANTS: [Variant; 14] = [
     Variant {
         name: "no instrumentation",
         removes: "the statistics atomics, their barrier and the refine-mask store (`DispatchOptions::statistics` off)",
@@ -161,6 +161,11 @@ pub(super) const VARIANTS: [Variant; 13] = [
         name: "no outputs",
         removes: "every pixel's outputs: its fine effects, output stores, refine mask and counts (`mrsl_finish`)",
         edits: &[no_outputs],
+    },
+    Variant {
+        name: "background channel loaded (added)",
+        removes: "nothing; adds work: the background tiles' pixels load the background channel instead of taking the rule's value, so what the program computes only where something was drawn no longer folds away there (statistics off, as timed runs)",
+        edits: &[background_channel_loaded, no_instrumentation],
     },
     Variant {
         name: "launches only",

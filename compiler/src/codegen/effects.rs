@@ -7,8 +7,8 @@
 
 use super::body::{Mode, float_literal, local_name, wgsl_ident};
 use super::names::{
-    BACKGROUND, BLOCK_SIZE, CONTROL, FORCE, HERE, LEVEL, NEIGHBOURS, Name, OCTAHEDRAL, PAIR_X, PAIR_Y, POS, REFINE,
-    RGB9E5,
+    BACKGROUND, BACKGROUND_PIXEL, BLOCK_SIZE, CONTROL, FORCE, HERE, IN_BACKGROUND_TILE, LEVEL, NEIGHBOURS, Name,
+    OCTAHEDRAL, PAIR_X, PAIR_Y, POS, REFINE, RGB9E5,
 };
 use super::words::{bit, unpack_with};
 use super::writer::cut;
@@ -115,12 +115,27 @@ impl Key<'_> {
             Background::Equal { value } => ("==", value),
             Background::NotEqual { value } => ("!=", value),
         };
-        let literal = match self.scalar {
+        format!("({value} {op} {})", self.literal(v))
+    }
+
+    /// `v` as a WGSL value of the channel's scalar type.
+    fn literal(&self, v: f64) -> String {
+        match self.scalar {
             Scalar::Uint => format!("{}u", v as u64),
             Scalar::Int => format!("i32({})", v as i64),
             _ => float_literal(v),
-        };
-        format!("({value} {op} {literal})")
+        }
+    }
+
+    /// The channel's value wherever its rule says background, where that is
+    /// one value to the bit: `@background(V)` on an integer channel, or on a
+    /// float one with `V` not zero (`-0.0 == 0.0`, and the two differ in
+    /// what a program can compute from them). `None` for `@foreground`.
+    fn value_where_background(&self) -> Option<String> {
+        match self.background? {
+            Background::Equal { value } if self.scalar != Scalar::Float || value != 0.0 => Some(self.literal(value)),
+            _ => None,
+        }
     }
 }
 
@@ -276,7 +291,18 @@ impl<'b> Writer<'_, '_, 'b> {
     /// decoded where the engine stores it encoded (`@depth`, `@encoded`):
     /// every kernel reads a channel through its loader, so all decode alike.
     pub(super) fn input_loaders(&mut self) {
-        let inputs = &self.checked().inputs;
+        let c = self.checked();
+        let inputs = &c.inputs;
+        let known = self.known_background();
+        if known.is_some() {
+            self.line(0, "// Set by the entry points over background tiles, where the background rule holds at");
+            self.line(0, "// every pixel: the pixel about to be shaded, where the background channel's loader");
+            self.line(0, "// returns the rule's value without a load. Every other entry point leaves the flag");
+            self.line(0, "// false, so the test folds away there.");
+            self.line(0, format!("var<private> {IN_BACKGROUND_TILE}: bool;"));
+            self.line(0, format!("var<private> {BACKGROUND_PIXEL}: vec2<i32>;"));
+            self.line(0, "");
+        }
         let bevy = |f: BevyField| Some(Decode::BevyDeferred { field: f });
         let octahedral = |d: &Option<Decode>| {
             matches!(d, Some(Decode::Octahedral | Decode::OctahedralUnorm)) || *d == bevy(BevyField::Normal)
@@ -300,18 +326,19 @@ impl<'b> Writer<'_, '_, 'b> {
                 _ => "",
             };
             let name = &input.name;
+            let known = known.as_ref().filter(|(i, _)| c.inputs[i.index()].name == *name).map(|(_, v)| v.as_str());
             match &input.decode {
-                None => self.template(
-                    0,
+                None => self.loader(
                     include_str!("templates/load.wgsl"),
                     &[("NAME", name), ("TYPE", &input.ty.wgsl()), ("SWIZZLE", &swizzle), ("LEVEL", &level)],
+                    known,
                 ),
                 Some(Decode::Unorm) => {
                     let swizzle = format!("{swizzle} * 2.0 - 1.0");
-                    self.template(
-                        0,
+                    self.loader(
                         include_str!("templates/load.wgsl"),
                         &[("NAME", name), ("TYPE", &input.ty.wgsl()), ("SWIZZLE", &swizzle), ("LEVEL", &level)],
+                        known,
                     )
                 }
                 Some(Decode::Depth { inverse_view_projection }) => self.template(
@@ -329,7 +356,7 @@ impl<'b> Writer<'_, '_, 'b> {
                         ("VALUE", &value),
                         ("LEVEL", &level),
                     ];
-                    self.template(0, include_str!("templates/load_packed.wgsl"), &values)
+                    self.loader(include_str!("templates/load_packed.wgsl"), &values, known)
                 }
                 Some(octahedral) => {
                     let unorm = if *octahedral == Decode::OctahedralUnorm { " * 2.0 - 1.0" } else { "" };
@@ -340,6 +367,55 @@ impl<'b> Writer<'_, '_, 'b> {
                     )
                 }
             }
+        }
+    }
+
+    /// A loader template with its `KNOWN` hole filled: where `known` is the
+    /// channel's value at every pixel of a background tile, the loader returns
+    /// it at the pixel an entry point over those tiles shades.
+    fn loader(&mut self, template: &str, values: &super::writer::Values, known: Option<&str>) {
+        let [head, tail] = cut(template, &["KNOWN"]);
+        self.template(0, head, values);
+        if let Some(value) = known {
+            let here = format!("{IN_BACKGROUND_TILE} && all(pos == {BACKGROUND_PIXEL})");
+            self.line(1, format!("if ({here}) {{ return {value}; }}"));
+        }
+        self.template(0, tail, values);
+    }
+
+    /// Whether the kernel has an entry point over background tiles (the
+    /// per-pixel passes' `fine_background`, the hierarchical kernel's
+    /// `hier_background`): every pixel it shades is background.
+    fn shades_background_tiles(&self) -> bool {
+        self.has_background() && (self.file.has_tile_lists() || self.file == KernelKind::Hierarchical)
+    }
+
+    /// The background channel and its value (WGSL) at every pixel of a
+    /// background tile, in a kernel with entry points over such tiles: where
+    /// the program's one background rule is `@background(V)` and `V` is one
+    /// value to the bit. Those entry points then evaluate the fine effects and
+    /// outputs with the value, not a load, so that what the program computes
+    /// only for drawn pixels (`material == 255u ? sky : lit`) folds away
+    /// there. With several rules a background pixel does not say which
+    /// channel holds its value.
+    pub(super) fn known_background(&self) -> Option<(InputId, String)> {
+        if !self.shades_background_tiles() {
+            return None;
+        }
+        let c = self.checked();
+        let mut rules = (0..c.inputs.len() as u32).map(InputId).filter(|i| c.inputs[i.index()].background.is_some());
+        match (rules.next(), rules.next()) {
+            (Some(i), None) => self.key(i).value_where_background().map(|v| (i, v)),
+            _ => None,
+        }
+    }
+
+    /// In an entry point over background tiles, before pixel `pos` is
+    /// shaded: the background channel's loader returns its value there.
+    pub(super) fn background_known_at(&mut self, indent: usize, pos: &str) {
+        if self.known_background().is_some() {
+            self.line(indent, format!("{IN_BACKGROUND_TILE} = true;"));
+            self.line(indent, format!("{BACKGROUND_PIXEL} = {pos};"));
         }
     }
 

@@ -306,6 +306,7 @@ impl Writer<'_, '_, '_> {
         let [head, clear, end] = cut(include_str!("templates/hierarchical_background.wgsl"), &["CLEAR", "FLUSH"]);
         self.template(0, head, values);
         self.clear_record(2);
+        self.background_known_at(2, "p");
         self.template(0, clear, values);
         self.flush_finished(lanes);
         self.template(0, end, values);

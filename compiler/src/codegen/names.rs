@@ -219,6 +219,11 @@ impl Name {
 pub(super) const POS: &str = "mrsl_pos";
 /// `mrsl_background(pos)`: whether nothing was drawn at a position (the background rule).
 pub(super) const BACKGROUND: &str = "mrsl_background";
+/// In an entry point over background tiles: that the invocation shades
+/// one, and the pixel it shades, where the background channel's loader
+/// returns the rule's value.
+pub(super) const IN_BACKGROUND_TILE: &str = "mrsl_in_background_tile";
+pub(super) const BACKGROUND_PIXEL: &str = "mrsl_background_pixel";
 /// The first pixel of a fine kernel's lane.
 pub(super) const FIRST: &str = "mrsl_first";
 /// Whether a compacted fine pass's pixel lies inside the image.
@@ -355,6 +360,8 @@ pub(super) const CORNERS_STRUCT: &str = "MrslCorners";
 pub(super) const FIXED: &[&str] = &[
     POS,
     BACKGROUND,
+    IN_BACKGROUND_TILE,
+    BACKGROUND_PIXEL,
     FIRST,
     IN,
     GRID,

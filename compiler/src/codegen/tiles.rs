@@ -116,6 +116,7 @@ impl Writer<'_, '_, '_> {
                     "let {POS} = vec2<i32>({TILE_ORIGIN} * {TILE}u + vec2<u32>({pixel} % {TILE}u, {pixel} / {TILE}u));"
                 ),
             );
+            self.background_known_at(2, POS);
             self.line(2, format!("if (all({POS} < {GRID}())) {{"));
             if counted {
                 let [x, y] = BACKGROUND_MARK;
