@@ -117,7 +117,7 @@ fn key_comparisons_without_arithmetic(w: &str) -> Option<String> {
             let args = &rest[at + "distance(".len()..];
             let (pair, after) = args.split_once(") <= ")?;
             let (a, b) = pair.split_once(", ")?;
-            let end = after.find(|c: char| c == ',' || c == ')').unwrap_or(after.len());
+            let end = after.find([',', ')']).unwrap_or(after.len());
             out.push_str(&format!("all({a} == {b})"));
             rest = &after[end..];
         }

@@ -150,7 +150,7 @@ pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>> {
         compile_for_device(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &modes)?;
     let (programs, skipped) = variants(args, &name, &program, target)?;
     let device_name = format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
-    eprintln!("ablation: {name}, {}, on {device_name}, {}x{}", target.title(&args.mode), args.size.0, args.size.1);
+    eprintln!("ablation: {name}, {}, on {device_name}, {}x{}", target.title(args.mode), args.size.0, args.size.1);
     let mut scene = bind_scene(&gpu, &args.scene, Some(args.size))?;
     let mut shaders = vec![];
     let mut textures = vec![];
@@ -313,7 +313,7 @@ fn markdown(args: &AblationArgs, target: Target, name: &str, device_name: &str, 
         "# Ablation of the {}\n\nProgram `{name}`, scene {}, {}x{}, device {device_name}; {rounds} interleaved \
          rounds (the order rotates each round); `x full` is the median over the rounds of the variant's time / the full \
          kernel's time in the same round. Full kernel: {full_ms:.1} ms (median).\n",
-        target.title(&args.mode),
+        target.title(args.mode),
         args.scene,
         args.size.0,
         args.size.1
