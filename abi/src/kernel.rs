@@ -36,6 +36,11 @@ pub mod entry {
     /// Hierarchical: the outputs of the background tiles' pixels, whose coarse
     /// effects read as zero (indirect dispatch).
     pub const HIER_BACKGROUND: &str = "hier_background";
+    /// Hierarchical, before level 0: the neighbour values (`Layout::neighbours`,
+    /// the coarse effects derivatives read elsewhere) at every level-0 pixel,
+    /// for level 0's predicates to take their derivatives from (empty, and not
+    /// dispatched, without them).
+    pub const HIER_LEVEL0_VALUES: &str = "hier_level0_values";
     /// Hierarchical level 0: every 4th pixel, always shaded.
     pub const HIER_LEVEL0: &str = "hier_level0";
     /// Hierarchical levels 1 to 4: classify the level's pixels into its work list.
@@ -69,13 +74,15 @@ pub mod entry {
 }
 
 /// The hierarchical kernel's entry points in dispatch order: the tile lists
-/// (empty and not dispatched without a background rule), level 0, then per
+/// (empty and not dispatched without a background rule), the neighbour
+/// values at level 0's pixels (empty and not dispatched without them), level 0, then per
 /// level 1 to 4 classify, args and (indirect) shade, then the background
 /// tiles. There is no final pass: each pixel's outputs are written where its
 /// record is complete.
-const HIERARCHICAL_ENTRY_POINTS: [&str; 16] = [
+const HIERARCHICAL_ENTRY_POINTS: [&str; 17] = [
     entry::HIER_TILES,
     entry::HIER_TILE_ARGS,
+    entry::HIER_LEVEL0_VALUES,
     entry::HIER_LEVEL0,
     entry::HIER_CLASSIFY[0],
     entry::HIER_ARGS[0],

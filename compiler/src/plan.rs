@@ -186,6 +186,11 @@ fn hierarchical_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
             workgroups: Workgroups::One,
         });
     }
+    // The effects derivatives read elsewhere, at every level-0 pixel first:
+    // level 0's predicates take their derivatives from them.
+    if layout.neighbours.words > 0 {
+        levels.push(dispatch(entry::HIER_LEVEL0_VALUES, lattice(0, HIERARCHICAL_LEVEL0)));
+    }
     levels.push(dispatch(entry::HIER_LEVEL0, lattice(0, HIERARCHICAL_LEVEL0)));
     for (index, level) in HIERARCHICAL_LEVELS.iter().enumerate() {
         let (start, step, odd_only) = (level.start, level.step, level.odd_only);
@@ -317,15 +322,23 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
             buffer(layout.interface2.binding, R::TaggedRecords { block: DYNAMIC_INNER_BLOCK }, true),
         ],
         KernelKind::Reference => vec![],
-        KernelKind::Hierarchical => vec![
-            if h.packed {
-                at(h.values_binding, R::PackedPixelRecords, T::PackedWordTexture)
-            } else {
-                at(h.values_binding, R::PixelRecords, T::WordTexture)
-            },
-            buffer(h.work_binding, R::WorkLists, false),
-            buffer(h.queue_binding, R::LevelCounts, false),
-        ],
+        KernelKind::Hierarchical => {
+            let mut hierarchical = vec![
+                if h.packed {
+                    at(h.values_binding, R::PackedPixelRecords, T::PackedWordTexture)
+                } else {
+                    at(h.values_binding, R::PixelRecords, T::WordTexture)
+                },
+                buffer(h.work_binding, R::WorkLists, false),
+                buffer(h.queue_binding, R::LevelCounts, false),
+            ];
+            // Level 0's lattice is the 4x4 block modes' sample grid.
+            if layout.neighbours.words > 0 {
+                let block = HIERARCHICAL_LEVEL0.step;
+                hierarchical.push(at(layout.neighbours.binding, R::NeighbourValues { block }, T::WordTexture));
+            }
+            hierarchical
+        }
         KernelKind::Checkerboard => vec![at(h.values_binding, R::PixelRecords, T::WordTexture)],
         KernelKind::RateCoarse => vec![
             buffer(interface, R::RateRecords, false),

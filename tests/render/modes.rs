@@ -393,19 +393,19 @@ pub fn hierarchical_interpolates_a_gradient_from_level_zero(gpu: &Gpu) {
     assert!(queued <= 4 * 256, "{:?}", out.stats.work_lists);
 }
 
-/// At hierarchical levels 1 to 3 a predicate's derivative of a coarse
+/// At hierarchical levels 0 to 3 a predicate's derivative of a coarse
 /// effect is taken from the level's neighbours (docs/language.md, section
 /// 9, "A level's neighbours"); on a linear ramp it must equal the quad
 /// pair's difference per pixel, along the axis asked for. Each probe refines
 /// where one difference of the ramp exceeds its edge. With the edges at 0.8
 /// of the ramp's differences every shaded pixel flags, so refinement spreads
-/// from level 0 through every level; at 1.25 of them none does, and the
-/// probes are shaded where the ramp is. (At 0.8, 99.3% of the pixels: a
-/// level's neighbour outside the image counts as the pixel itself, which
-/// halves the difference next to the image's edges, so a few pixels there
-/// interpolate; hence 0.99.) A difference off by a factor of 2
-/// (a level's span not divided out), or taken along the other axis (the two
-/// differences are 2.1x apart here), fails one of the two.
+/// from level 0 through every level to every pixel (a neighbour outside the
+/// image is its opposite mirrored through the pixel, exact for the ramp, so
+/// the pixels along the edges flag too); at 1.25 of them none does, and the
+/// probes are shaded where the ramp is. A difference off by a factor of 2
+/// (a level's span not divided out, or a neighbour outside the image taken
+/// as the pixel itself), or taken along the other axis (the two differences
+/// are 2.1x apart here), fails one of the two.
 pub fn hierarchical_predicate_derivatives_from_level_neighbours(gpu: &Gpu) {
     let (w, h) = (256u32, 192u32);
     // uv = (x + 0.5) / w, (y + 0.5) / h (Scene::Gradient), so these are the
@@ -437,8 +437,9 @@ fine out float4 color = float4(ramp, along_x, along_y, 1.0);
         let effect = |name: &str| out.stats.effects.iter().find(|e| e.name == name).unwrap().clone();
         let ramp = effect("ramp");
         for probe in [effect("along_x"), effect("along_y")] {
+            println!("edge {factor}: `{}` shaded at {:.2}% of the pixels", probe.name, 100.0 * probe.shaded_fraction);
             if everywhere {
-                assert!(probe.shaded_fraction >= 0.99, "edge {factor}: {probe:?}");
+                assert_eq!(probe.pixel_evaluations, u64::from(w * h), "edge {factor}: {probe:?}");
             } else {
                 assert!(probe.shaded_fraction <= ramp.shaded_fraction + 0.005, "edge {factor}: {probe:?} / {ramp:?}");
             }

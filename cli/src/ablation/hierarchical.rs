@@ -72,37 +72,6 @@ fn every_effect_listed(w: &str) -> Option<String> {
     })
 }
 
-/// The coarse effects a derivative evaluates at the quad partner
-/// (`mrsl_at_<effect>`, which the predicates' `fwidth(blocker)` calls): read
-/// from the partner's record instead, as the previous frame left it. In a
-/// frame rendered again from the same view that is the partner's value as
-/// the kernel last evaluated or interpolated it, so the flags stay close to
-/// the full kernel's while the evaluations go: an estimate of what those
-/// evaluations cost, not a kernel to keep (a moving view would read stale
-/// values).
-fn effects_at_partners_from_records(w: &str) -> Option<String> {
-    let packed = w.contains("alias MrslRecord");
-    let mut out = Vec::new();
-    let mut skipping = false;
-    let mut edited = false;
-    for l in w.lines() {
-        if skipping {
-            if l == "}" {
-                out.push(l.to_string());
-                skipping = false;
-            }
-            continue;
-        }
-        out.push(l.to_string());
-        let Some(name) = l.strip_prefix("fn mrsl_at_").and_then(|r| r.split('(').next()) else { continue };
-        let record = if packed { "mrsl_record(mrsl_pos)" } else { "mrsl_pos" };
-        out.push(format!("    return mrsl_hget_{name}({record});"));
-        skipping = true;
-        edited = true;
-    }
-    edited.then(|| out.join("\n") + "\n")
-}
-
 /// Everything: every entry point returns at once, so what is left is the
 /// launches (passes, dispatches, indirect arguments) and their barriers.
 fn launches_only(w: &str) -> Option<String> {
@@ -116,7 +85,7 @@ fn launches_only(w: &str) -> Option<String> {
 /// The variants. "Nothing shaded" is the mode's floor: what it costs where
 /// no pixel past level 0 needs shading; the ones after it take a further
 /// part out of that floor.
-pub(super) const VARIANTS: [Variant; 14] = [
+pub(super) const VARIANTS: [Variant; 13] = [
     Variant {
         name: "no instrumentation",
         removes: "the statistics atomics, their barrier and the refine-mask store (`DispatchOptions::statistics` off)",
@@ -151,11 +120,6 @@ pub(super) const VARIANTS: [Variant; 14] = [
         name: "every effect at listed pixels (added)",
         removes: "nothing; adds work: a listed pixel evaluates every coarse effect, whichever its classification named (what a SIMD group whose pixels name different effects pays)",
         edits: &[every_effect_listed],
-    },
-    Variant {
-        name: "effects at quad partners from records",
-        removes: "the evaluations of coarse effects at a pixel's quad partner for the predicates' derivatives (`fwidth(blocker)`): the partner's record is read instead, as the frame before left it (an estimate of their cost: the flags are close to, not the same as, the full kernel's)",
-        edits: &[effects_at_partners_from_records],
     },
     Variant {
         name: "no outputs",
@@ -233,8 +197,9 @@ mod tests {
         assert_eq!(kernel.matches("mrsl_shade(listed);").count(), 3);
         assert_eq!(kernel.matches("mrsl_shade_last(listed);").count(), 1);
         assert_eq!(kernel.matches("if (mrsl_classify(p, ").count(), 4);
-        // The predicate's `fwidth_surface(blocker)` evaluates it at the quad partner.
-        assert_eq!(kernel.matches("fn mrsl_at_").count(), 1);
+        // The predicates take every derivative from the levels' neighbours:
+        // no effect is evaluated at a quad partner.
+        assert_eq!(kernel.matches("fn mrsl_at_").count(), 0);
         let floor = nothing_shaded(kernel).unwrap();
         assert!(!floor.contains("if (disc"), "the floor still tests an effect");
     }

@@ -190,21 +190,30 @@ impl Writer<'_, '_, '_> {
             ("ENTRY", &mrsl_abi::entry::COARSE_NEIGHBOURS),
         ];
         self.template(0, head, values);
+        self.store_neighbour_values(1, POS);
+        self.template(0, tail, &[]);
+        self.line(0, "");
+    }
+
+    /// The neighbour values evaluated at `mrsl_pos` (for their values alone,
+    /// as a neighbour evaluation computes them) and stored at texel `texel`
+    /// of `mrsl_neighbours`, a layer per word: the body of `coarse_neighbours`
+    /// and of the hierarchical kernel's `hier_level0_values`.
+    pub(super) fn store_neighbour_values(&mut self, indent: usize, texel: &str) {
         let c = self.checked();
         let stored = self.neighbour_values();
         // The stored effects and what they read, each evaluated once, in dependency order.
         let needed: BTreeSet<EffectId> = stored.iter().flat_map(|&(e, _)| self.i.graph.closure(e, c)).collect();
         let chain: Vec<EffectId> = self.i.graph.order.iter().copied().filter(|e| needed.contains(e)).collect();
-        self.effect_chain(&chain, 1, Evaluation::ValueOnly);
+        self.effect_chain(&chain, indent, Evaluation::ValueOnly);
         for (e, offset) in stored {
             let info = &c.effects[e.index()];
             for (j, word) in pack_words(&self.effect_name(e), &info.ty).iter().enumerate() {
                 let layer = offset + j as u32;
-                self.line(1, format!("textureStore({NEIGHBOURS}, {POS}, {layer}, vec4<u32>({word}, 0u, 0u, 0u));"));
+                let store = format!("textureStore({NEIGHBOURS}, {texel}, {layer}, vec4<u32>({word}, 0u, 0u, 0u));");
+                self.line(indent, store);
             }
         }
-        self.template(0, tail, &[]);
-        self.line(0, "");
     }
 
     /// The entry points of the block modes' coarse kernel and of the dynamic

@@ -614,6 +614,14 @@ impl<'b> Writer<'_, '_, 'b> {
         !self.value_expressions(site.effect).contains(&site.node)
     }
 
+    /// Whether derivative site `k` is taken from the level's neighbours at
+    /// every level that evaluates predicates, level 0 included (where the
+    /// hierarchical kernel stores its neighbours' values first): then no
+    /// quad pair is left, and the operand is never evaluated elsewhere.
+    pub(super) fn only_level_differences(&self, k: usize) -> bool {
+        self.stores_level0_values() && self.takes_level_differences(k)
+    }
+
     /// `mrsl_eval_<effect>`: the effect's body at `mrsl_pos`, given its
     /// dependencies' values (and a refine flag to set, if it can refine).
     /// With `value_only`, `mrsl_val_<effect>` of an effect that can refine:
@@ -760,6 +768,14 @@ impl<'b> Writer<'_, '_, 'b> {
             ];
             let [operand_helper, ddx_head, ddx_rest, ddy_rest] =
                 cut(include_str!("templates/derivative.wgsl"), &["DIFFERENCES", "LEVELS_X", "LEVELS_Y"]);
+            if self.only_level_differences(k) {
+                // Every level that evaluates predicates takes them from its neighbours: no quad pair is left.
+                let stored = self.expr(site.operand, Mode::Stored(site));
+                let extra: &super::writer::Values = &[("STORED", &stored)];
+                self.template(0, include_str!("templates/derivative_levels.wgsl"), &[values, extra].concat());
+                self.template(0, include_str!("templates/derivative_levels_only.wgsl"), values);
+                return;
+            }
             self.template(0, operand_helper, values);
             if self.stays_on_surface(k) {
                 let apart = Name::Apart.of(&c.effects[site.effect.index()].name);
@@ -777,7 +793,7 @@ impl<'b> Writer<'_, '_, 'b> {
                     let extra: &super::writer::Values = &[("STORED", &stored)];
                     self.template(0, include_str!("templates/derivative_levels.wgsl"), &[values, extra].concat());
                 }
-                // At levels 1 to 3 the level's neighbours give each difference.
+                // At levels 1 to 3 the level's neighbours give each difference, at level 0 the quad pair.
                 let level_branch = |w: &mut Self, axis: usize| {
                     if levels {
                         w.line(1, format!("if ({LEVEL} != 0u) {{"));
@@ -827,7 +843,7 @@ impl<'b> Writer<'_, '_, 'b> {
     /// Effects this kernel needs at other positions (for derivatives).
     fn effects_at_neighbours(&self) -> BTreeSet<EffectId> {
         let mut needed: BTreeSet<EffectId> = BTreeSet::new();
-        for k in self.live_sites() {
+        for k in self.live_sites().into_iter().filter(|&k| !self.only_level_differences(k)) {
             let site = &self.i.deriv.sites[k];
             needed.extend(site.effects.iter().copied().filter(|e| self.i.graph.live[e.index()]));
         }

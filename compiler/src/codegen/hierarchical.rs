@@ -22,7 +22,7 @@
 
 use super::Writer;
 use super::effects::Evaluation;
-use super::level_derivatives::LEVELS_WITH_NEIGHBOUR_DERIVATIVES;
+use super::level_derivatives::LEVELS_WITH_PREDICATES;
 use super::names::{
     CONTROL, COUNT, LANE, LEVEL, LOAD_RECORD, LOCAL_ID, NEIGHBOUR_RECORDS, Name, PIXEL_RECORD, POS, PUT_MASKS,
     PUT_RECORD, RECORD_TYPE, SET_WORD, SHADE, SHADE_LAST, TILE_ARGS, TILE_INVOCATION, WORD, WORKGROUP,
@@ -61,10 +61,14 @@ fn classified_levels() -> [Classified; 4] {
     ]
 }
 
-/// The neighbours classified level `level` (1 to 4) interpolates from, in
-/// opposite pairs (0, 1) and (2, 3).
-pub(super) fn classified_neighbours(level: usize) -> [(i32, i32); 4] {
-    classified_levels()[level - 1].neighbours
+/// The neighbours of a pixel of level `level` in opposite pairs (0, 1) and
+/// (2, 3): at level 0 its lattice's neighbours along the axes, at the
+/// classified levels (1 to 4) those it interpolates from.
+pub(super) fn level_neighbours(level: usize) -> [(i32, i32); 4] {
+    match level {
+        0 => axis_neighbours(HIERARCHICAL_LEVEL0.step as i32),
+        _ => classified_levels()[level - 1].neighbours,
+    }
 }
 
 /// The pixel of invocation `gid.xy`, as WGSL: lattice point `gid.xy`, or
@@ -100,6 +104,13 @@ impl Writer<'_, '_, '_> {
             "Hierarchical mode: per pixel record (flags, evaluated-mask, values), work lists, queues.",
             h.packed,
         );
+        if self.stores_level0_values() {
+            self.template(
+                0,
+                include_str!("templates/neighbours_binding.wgsl"),
+                &[("GROUP", &l.interface.group), ("BINDING", &l.neighbours.binding)],
+            );
+        }
         self.template(
             0,
             include_str!("templates/hierarchical_queues.wgsl"),
@@ -127,9 +138,10 @@ impl Writer<'_, '_, '_> {
         self.tile_lists();
         self.shade_function(false);
         self.shade_function(true);
+        self.level0_values_entry();
         self.level0();
         self.classify_function();
-        let level_derivatives = self.has_level_derivatives();
+        let says_level = self.says_level();
         for (index, (lattice, level)) in HIERARCHICAL_LEVELS.iter().zip(classified_levels()).enumerate() {
             // The level's words in the queue (its count first) and in the
             // indirect arguments (x, y, z).
@@ -168,7 +180,7 @@ impl Writer<'_, '_, '_> {
             self.template(0, classify, values);
             self.flush_finished(COARSE_WORKGROUP * COARSE_WORKGROUP);
             self.template(0, shade, values);
-            if level_derivatives && LEVELS_WITH_NEIGHBOUR_DERIVATIVES.contains(&(index + 1)) {
+            if says_level && LEVELS_WITH_PREDICATES.contains(&(index + 1)) {
                 self.line(2, format!("{LEVEL} = {}u;", index + 1));
             }
             self.template(0, shade_pixel, values);
@@ -445,6 +457,15 @@ impl Writer<'_, '_, '_> {
         }
         let [evaluate, put, flag, read] =
             cut(include_str!("templates/shade_effect.wgsl"), &["EVALUATE", "PUT", "FLAG"]);
+        // The stored effects without a refine flag (an effect with one is
+        // evaluated for its flag).
+        let level0_values: Vec<EffectId> = match self.stores_level0_values() {
+            true => {
+                let stored = self.neighbour_values().into_iter().map(|(e, _)| e);
+                stored.filter(|e| !c.effects[e.index()].has_refine).collect()
+            }
+            false => vec![],
+        };
         for e in self.coarse_live() {
             let info = &c.effects[e.index()];
             let (mask_word, mask) = bit(self.coarse_index[&e]);
@@ -459,7 +480,16 @@ impl Writer<'_, '_, '_> {
                 ("OWN", &own),
             ];
             self.template(1, evaluate, &values);
-            self.evaluate(e, 2, "", if last { Evaluation::ValueOnly } else { Evaluation::Kernel });
+            if !last && level0_values.contains(&e) {
+                // Level 0 reads what `hier_level0_values` evaluated here: the same value.
+                self.line(2, format!("if ({LEVEL} == 0u) {{"));
+                self.line(3, format!("{var} = {};", self.level0_value(e)));
+                self.line(2, "} else {");
+                self.evaluate(e, 3, "", Evaluation::Kernel);
+                self.line(2, "}");
+            } else {
+                self.evaluate(e, 2, "", if last { Evaluation::ValueOnly } else { Evaluation::Kernel });
+            }
             self.template(1, put, &values);
             if !self.packed() {
                 self.line(2, format!("{}({POS}, {var});", Name::RecordPut.of(&info.name)));
@@ -476,6 +506,37 @@ impl Writer<'_, '_, '_> {
         let masks: Vec<String> = (0..mask_words).map(|w| Name::PixelMask.of(w)).collect();
         self.store_record(POS, &flags, &masks);
         self.template(0, end, &[]);
+    }
+
+    /// `hier_level0_values`: the layout's neighbour values (the coarse
+    /// effects derivatives read elsewhere) evaluated at every pixel of level
+    /// 0's lattice, for their values alone, and stored a texel per lattice
+    /// point, before level 0 is shaded. Empty, and not dispatched, where the
+    /// program has none.
+    fn level0_values_entry(&mut self) {
+        if !self.stores_level0_values() {
+            self.line(0, "// No neighbour values (layout `neighbours`): the plan does not dispatch this.");
+            self.line(0, "@compute @workgroup_size(1, 1, 1)");
+            self.line(0, format!("fn {}() {{}}", entry::HIER_LEVEL0_VALUES));
+            self.line(0, "");
+            return;
+        }
+        let [head, values_here, end] = cut(include_str!("templates/level0_values.wgsl"), &["INVOCATION", "VALUES"]);
+        let (params, invocation, valid) = self.level_invocation(HIERARCHICAL_LEVEL0);
+        let values: &super::writer::Values = &[
+            ("PARAMS", &params),
+            ("VALID", &valid),
+            ("WORKGROUP", &lattice_workgroup()),
+            ("ENTRY", &entry::HIER_LEVEL0_VALUES),
+            ("PIXEL", &lattice_pixel(HIERARCHICAL_LEVEL0)),
+        ];
+        self.template(0, head, values);
+        if let Some(line) = &invocation {
+            self.line(1, line);
+        }
+        self.template(0, values_here, values);
+        self.store_neighbour_values(2, &format!("{POS} / {}", HIERARCHICAL_LEVEL0.step));
+        self.template(0, end, values);
     }
 
     /// Level 0: every pixel of its lattice is shaded.

@@ -438,6 +438,7 @@ pub(super) const FIXED: &[&str] = &[
     "mrsl_near",
     "mrsl_vals",
     "mrsl_inside",
+    "mrsl_loaded",
     "mrsl_along",
     "mrsl_across",
     "mrsl_weights",
