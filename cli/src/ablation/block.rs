@@ -352,8 +352,8 @@ mod tests {
     }
 
     /// Without a background rule (no `@background` input) the background
-    /// variants have nothing to edit: it is listed as not applicable, not
-    /// made into a kernel that does not validate.
+    /// variants have nothing to edit: they are listed as not applicable, not
+    /// made into kernels that do not validate.
     #[test]
     fn the_background_variant_needs_a_background_rule() {
         let source = "in float3 normal;\n\

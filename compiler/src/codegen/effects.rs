@@ -313,7 +313,7 @@ impl<'b> Writer<'_, '_, 'b> {
         if inputs.iter().any(|i| i.decode == bevy(BevyField::Emissive)) {
             self.template(0, include_str!("templates/rgb9e5.wgsl"), &[]);
         }
-        for (input, channel) in inputs.iter().zip(&self.i.layout.channels) {
+        for (k, (input, channel)) in inputs.iter().zip(&self.i.layout.channels).enumerate() {
             // A storage texture has no mip level to name.
             let level = match channel.access {
                 ChannelAccess::Sampled => ", 0",
@@ -326,7 +326,7 @@ impl<'b> Writer<'_, '_, 'b> {
                 _ => "",
             };
             let name = &input.name;
-            let known = known.as_ref().filter(|(i, _)| c.inputs[i.index()].name == *name).map(|(_, v)| v.as_str());
+            let known = known.as_ref().filter(|(i, _)| i.index() == k).map(|(_, v)| v.as_str());
             match &input.decode {
                 None => self.loader(
                     include_str!("templates/load.wgsl"),

@@ -73,8 +73,9 @@ impl Writer<'_, '_, '_> {
         }
         self.line(
             0,
-            format!("// The four neighbours level `{LEVEL}` interpolates from, in opposite pairs (0, 1) and (2, 3)."),
+            format!("// The four neighbours of a pixel of level `{LEVEL}` in opposite pairs (0, 1) and (2, 3): those"),
         );
+        self.line(0, "// it interpolates from, or at level 0 its lattice's neighbours along the axes.");
         self.line(0, format!("fn {LEVEL_NEIGHBOURS}(p: vec2<i32>) -> array<vec2<i32>, 4> {{"));
         self.level_switch(|level| format!("return {};", neighbours(level_neighbours(level))));
         self.line(0, "}");
@@ -128,9 +129,7 @@ impl Writer<'_, '_, '_> {
         self.line(0, "}");
         self.line(0, "");
     }
-}
 
-impl Writer<'_, '_, '_> {
     /// Effect `e` at level-0 pixel `mrsl_pos`, as `hier_level0_values`
     /// stored it (WGSL): its words in the neighbour values' texel of the pixel.
     pub(super) fn level0_value(&self, e: EffectId) -> String {
