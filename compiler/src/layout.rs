@@ -340,6 +340,24 @@ fn neighbours(checked: &Checked, graph: &EffectGraph, deriv: &DerivInfo, binding
     NeighbourLayout { binding, words, effects }
 }
 
+/// The storage textures WebGPU guarantees a shader stage
+/// (`maxStorageTexturesPerShaderStage`'s default): the hierarchical kernel
+/// adds the neighbour values to its stage group only within it.
+const DEFAULT_STORAGE_TEXTURES_PER_STAGE: u32 = 4;
+
+/// Whether the hierarchical kernel stores the neighbour values at level 0's
+/// pixels (`hier_level0_values`, docs/language.md section 9): where the
+/// program has them, and its stage group's storage textures (the records,
+/// the outputs, the refine mask where there are counters) leave room for
+/// one more within WebGPU's default limit, so that a program whose
+/// hierarchical kernel ran on a default device still does. Otherwise level
+/// 0 keeps the quad pair. The plan and the code generator both ask this.
+pub fn hierarchical_level0_values(layout: &Layout) -> bool {
+    let refine_mask = u32::from(!layout.stats.counters.is_empty());
+    let stage = 1 + layout.outputs.len() as u32 + refine_mask;
+    layout.neighbours.words > 0 && stage < DEFAULT_STORAGE_TEXTURES_PER_STAGE
+}
+
 /// Whether a coarse effect is resampled by the nearest corner: `@nearest`, or
 /// a type that cannot be blended (int, uint, bool).
 pub fn uses_nearest(checked: &Checked, id: crate::check::EffectId) -> bool {

@@ -188,7 +188,7 @@ fn hierarchical_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
     }
     // The effects derivatives read elsewhere, at every level-0 pixel first:
     // level 0's predicates take their derivatives from them.
-    if layout.neighbours.words > 0 {
+    if crate::layout::hierarchical_level0_values(layout) {
         levels.push(dispatch(entry::HIER_LEVEL0_VALUES, lattice(0, HIERARCHICAL_LEVEL0)));
     }
     levels.push(dispatch(entry::HIER_LEVEL0, lattice(0, HIERARCHICAL_LEVEL0)));
@@ -333,7 +333,7 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
                 buffer(h.queue_binding, R::LevelCounts, false),
             ];
             // Level 0's lattice is the 4x4 block modes' sample grid.
-            if layout.neighbours.words > 0 {
+            if crate::layout::hierarchical_level0_values(layout) {
                 let block = HIERARCHICAL_LEVEL0.step;
                 hierarchical.push(at(layout.neighbours.binding, R::NeighbourValues { block }, T::WordTexture));
             }
@@ -519,6 +519,31 @@ mod tests {
         }
         for id in plan.modes.iter().flat_map(|m| m.resources()) {
             assert_eq!(plan.resource(id).is_none(), id.engine_bound(), "{id:?}");
+        }
+    }
+
+    /// The hierarchical kernel stores level 0's neighbour values where its
+    /// stage group has room for them within WebGPU's default of 4 storage
+    /// textures (the records, the refine mask, one output and the neighbour
+    /// values), and keeps the quad pair at level 0 beyond it: a second
+    /// output must not cost a default device the mode.
+    #[test]
+    fn level0_values_only_within_the_default_storage_textures() {
+        let effects = "in float3 normal;\ncoarse effect float d = normal.y;\n\
+                       coarse effect float e {\n    e = d * 2.0;\n    if (fwidth(d) > 0.1) refine;\n}\n\
+                       fine out float4 color = float4(e);\n";
+        let two = format!("{effects}fine out float4 extra = float4(d);\n");
+        for (source, stored) in [(effects.to_string(), true), (two, false)] {
+            let program = crate::compile(&source, &crate::Options::default()).unwrap();
+            let plan = program.layout.plan.mode(Mode::Hierarchical).unwrap();
+            let pass = plan.passes().next().unwrap();
+            let dispatched = pass.dispatches.iter().any(|d| d.entry == entry::HIER_LEVEL0_VALUES);
+            let bound = pass.bindings.iter().any(|b| matches!(b.resource, ResourceId::NeighbourValues { .. }));
+            assert_eq!((dispatched, bound), (stored, stored), "{} outputs", program.layout.outputs.len());
+            let storage = pass.bindings.iter().filter(|b| b.ty.is_storage_texture()).count();
+            assert!(storage <= 4, "{storage} storage textures");
+            let kernel = program.kernel(KernelKind::Hierarchical, 0).unwrap();
+            assert_eq!(kernel.wgsl.contains("var mrsl_neighbours"), stored);
         }
     }
 

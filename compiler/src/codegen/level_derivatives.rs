@@ -35,11 +35,12 @@ impl Writer<'_, '_, '_> {
     }
 
     /// Whether the hierarchical kernel stores the layout's neighbour values
-    /// at level 0's pixels (`hier_level0_values`), where the program has
-    /// them: level 0 then reads its own instead of evaluating them, and its
-    /// predicates take their derivatives from its neighbours'.
+    /// at level 0's pixels (`hier_level0_values`; see
+    /// [`crate::layout::hierarchical_level0_values`]): level 0 then reads its
+    /// own instead of evaluating them, and its predicates take their
+    /// derivatives from its neighbours'.
     pub(super) fn stores_level0_values(&self) -> bool {
-        self.file == KernelKind::Hierarchical && self.i.layout.neighbours.words > 0
+        self.file == KernelKind::Hierarchical && crate::layout::hierarchical_level0_values(self.i.layout)
     }
 
     /// Whether the shading entry points say which level they shade
