@@ -195,6 +195,14 @@ impl Writer<'_, '_, '_> {
         self.line(0, "");
     }
 
+    /// Effect `e` as the neighbour values hold it at texel `texel` (WGSL):
+    /// its words, unpacked, from the layers at its offset.
+    pub(super) fn neighbour_value(&self, e: EffectId, texel: &str) -> String {
+        let (_, offset) = self.neighbour_values().into_iter().find(|&(v, _)| v == e).expect("a stored effect");
+        let ty = &self.checked().effects[e.index()].ty;
+        unpack_with(ty, |j| format!("textureLoad({NEIGHBOURS}, {texel}, {}).x", offset + j))
+    }
+
     /// The neighbour values evaluated at `mrsl_pos` (for their values alone,
     /// as a neighbour evaluation computes them) and stored at texel `texel`
     /// of `mrsl_neighbours`, a layer per word: the body of `coarse_neighbours`

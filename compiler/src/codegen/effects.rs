@@ -7,10 +7,10 @@
 
 use super::body::{Mode, float_literal, local_name, wgsl_ident};
 use super::names::{
-    BACKGROUND, BACKGROUND_PIXEL, BLOCK_SIZE, CONTROL, FORCE, HERE, IN_BACKGROUND_TILE, LEVEL, NEIGHBOURS, Name,
-    OCTAHEDRAL, PAIR_X, PAIR_Y, POS, REFINE, RGB9E5,
+    BACKGROUND, BACKGROUND_PIXEL, BLOCK_SIZE, CONTROL, FORCE, HERE, IN_BACKGROUND_TILE, LEVEL, Name, OCTAHEDRAL,
+    PAIR_X, PAIR_Y, POS, REFINE, RGB9E5,
 };
-use super::words::{bit, unpack_with};
+use super::words::bit;
 use super::writer::cut;
 use super::{Derivatives, Writer};
 use crate::check::{Background, EffectId, InputId, KeyCompare, Symbol};
@@ -387,7 +387,7 @@ impl<'b> Writer<'_, '_, 'b> {
     /// per-pixel passes' `fine_background`, the hierarchical kernel's
     /// `hier_background`): every pixel it shades is background.
     fn shades_background_tiles(&self) -> bool {
-        self.has_background() && (self.file.has_tile_lists() || self.file == KernelKind::Hierarchical)
+        self.lists_tiles() || (self.file == KernelKind::Hierarchical && self.has_background())
     }
 
     /// The background channel and its value (WGSL) at every pixel of a
@@ -768,11 +768,14 @@ impl<'b> Writer<'_, '_, 'b> {
             ];
             let [operand_helper, ddx_head, ddx_rest, ddy_rest] =
                 cut(include_str!("templates/derivative.wgsl"), &["DIFFERENCES", "LEVELS_X", "LEVELS_Y"]);
+            let level_differences = |w: &mut Self| {
+                let stored = w.expr(site.operand, Mode::Stored(site));
+                let extra: &super::writer::Values = &[("STORED", &stored)];
+                w.template(0, include_str!("templates/derivative_levels.wgsl"), &[values, extra].concat());
+            };
             if self.only_level_differences(k) {
                 // Every level that evaluates predicates takes them from its neighbours: no quad pair is left.
-                let stored = self.expr(site.operand, Mode::Stored(site));
-                let extra: &super::writer::Values = &[("STORED", &stored)];
-                self.template(0, include_str!("templates/derivative_levels.wgsl"), &[values, extra].concat());
+                level_differences(self);
                 self.template(0, include_str!("templates/derivative_levels_only.wgsl"), values);
                 return;
             }
@@ -789,9 +792,7 @@ impl<'b> Writer<'_, '_, 'b> {
             } else if self.reuses_operand_here(k) {
                 let levels = self.takes_level_differences(k);
                 if levels {
-                    let stored = self.expr(site.operand, Mode::Stored(site));
-                    let extra: &super::writer::Values = &[("STORED", &stored)];
-                    self.template(0, include_str!("templates/derivative_levels.wgsl"), &[values, extra].concat());
+                    level_differences(self);
                 }
                 // At levels 1 to 3 the level's neighbours give each difference, at level 0 the quad pair.
                 let level_branch = |w: &mut Self, axis: usize| {
@@ -885,12 +886,11 @@ impl<'b> Writer<'_, '_, 'b> {
     pub(super) fn neighbour_functions(&mut self) {
         let c = self.checked();
         if self.stores_neighbours() {
-            for (e, offset) in self.neighbour_values() {
+            for (e, _) in self.neighbour_values() {
                 let info = &c.effects[e.index()];
                 self.line(0, format!("// `{}` at another sample, as `coarse_neighbours` stored it there.", info.name));
                 self.line(0, format!("fn {}({POS}: vec2<i32>) -> {} {{", Name::At.of(&info.name), info.ty.wgsl()));
-                let value = unpack_with(&info.ty, |j| format!("textureLoad({NEIGHBOURS}, {POS}, {}).x", offset + j));
-                self.line(1, format!("return {value};"));
+                self.line(1, format!("return {};", self.neighbour_value(e, POS)));
                 self.line(0, "}");
                 self.line(0, "");
             }

@@ -15,9 +15,8 @@
 
 use super::Writer;
 use super::hierarchical::level_neighbours;
-use super::names::{LEVEL, LEVEL_NEIGHBOURS, LEVEL_WEIGHTS, LOAD_RECORD, NEIGHBOURS, Name, POS};
+use super::names::{LEVEL, LEVEL_NEIGHBOURS, LEVEL_WEIGHTS, LOAD_RECORD, Name, POS};
 use super::records::neighbours;
-use super::words::unpack_with;
 use crate::check::EffectId;
 use mrsl_abi::KernelKind;
 use mrsl_abi::geometry::{HIERARCHICAL_LEVEL0, HIERARCHICAL_LEVELS};
@@ -134,11 +133,7 @@ impl Writer<'_, '_, '_> {
     /// Effect `e` at level-0 pixel `mrsl_pos`, as `hier_level0_values`
     /// stored it (WGSL): its words in the neighbour values' texel of the pixel.
     pub(super) fn level0_value(&self, e: EffectId) -> String {
-        let c = self.checked();
-        let offset = self.neighbour_values().into_iter().find(|&(v, _)| v == e).map(|(_, o)| o);
-        let offset = offset.expect("level 0 stores the effects its derivatives read");
-        let texel = format!("{POS} / {}", HIERARCHICAL_LEVEL0.step);
-        unpack_with(&c.effects[e.index()].ty, |j| format!("textureLoad({NEIGHBOURS}, {texel}, {}).x", offset + j))
+        self.neighbour_value(e, &format!("{POS} / {}", HIERARCHICAL_LEVEL0.step))
     }
 }
 
