@@ -3,7 +3,8 @@
 //! `mrsl::compile` must turn it into kernels that naga accepts.
 //!
 //! It tracks the type of every name and expression while it writes, and
-//! covers inputs (with `@key` and `@key(t)`), value uniforms, uniform arrays,
+//! covers inputs (with `@key`, `@key(t)`, `@surface_key` and background
+//! rules, `@background` and `@foreground`), value uniforms, uniform arrays,
 //! textures and samplers, constants, functions (with texture and sampler
 //! parameters, early returns and calls to earlier functions), coarse effects
 //! (plain, `coarse(4)` reading only `coarse(4)` ones, and `coarse(2)`)
@@ -473,7 +474,7 @@ impl<'c> Gen<'c> {
         };
         let ty = if self.chance(1, 3) { Ty::S(s) } else { V(s, 2 + self.below(3) as u8) };
         let name = self.fresh();
-        let attr = match self.below(6) {
+        let mut attr = match self.below(6) {
             0 => {
                 self.feat("@key");
                 "@key ".to_string()
@@ -482,11 +483,54 @@ impl<'c> Gen<'c> {
                 self.feat("@key(threshold)");
                 format!("@key({}) ", self.pick(&["0.05", "0.0", "1", "0.5"]))
             }
+            2 if ty == V(S::F, 3) => self.surface_key(),
             _ => String::new(),
         };
+        // A background rule, alone or beside a key (a channel may be both).
+        if matches!(ty, Ty::S(_)) && self.chance(1, 3) {
+            attr.push_str(&self.background_rule(s));
+        }
         self.feat("input");
         let _ = writeln!(self.out, "{attr}in {} {name};", ty.name());
         self.globals.push(Var { name, ty, kind: Kind::Input });
+    }
+
+    /// `@surface_key(n, t)` naming an earlier `float3` input as the normal,
+    /// declaring one first where there is none.
+    fn surface_key(&mut self) -> String {
+        let mut normals: Vec<String> = self
+            .globals
+            .iter()
+            .filter(|v| matches!(v.kind, Kind::Input) && v.ty == V(S::F, 3))
+            .map(|v| v.name.clone())
+            .collect();
+        if normals.is_empty() {
+            let name = self.fresh();
+            let _ = writeln!(self.out, "in float3 {name};");
+            self.globals.push(Var { name: name.clone(), ty: V(S::F, 3), kind: Kind::Input });
+            normals.push(name);
+        }
+        self.feat("@surface_key");
+        let normal = self.pick(&normals);
+        format!("@surface_key({normal}, {}) ", self.pick(&["0.25", "0.0", "1", "0.05"]))
+    }
+
+    /// `@background(v)` or `@foreground(v)` with a value of the channel's
+    /// scalar type `s` (for a float channel also zero, whose two bit patterns
+    /// compare equal, and a value no G-buffer holds).
+    fn background_rule(&mut self, s: S) -> String {
+        let value = match s {
+            S::U => self.pick(&["0", "255", "7"]),
+            S::I => self.pick(&["0", "-1", "3"]),
+            _ => self.pick(&["0.0", "1.0", "-0.5", "1000000.0"]),
+        };
+        if self.chance(1, 4) {
+            self.feat("@foreground");
+            format!("@foreground({value}) ")
+        } else {
+            self.feat("@background");
+            format!("@background({value}) ")
+        }
     }
 
     fn uniform(&mut self) {
