@@ -564,7 +564,7 @@ mod tests {
         for (mode, main) in
             [(Mode::Coarse4x4, entry::FINE), (Mode::Coarse2x2, entry::FINE), (Mode::Dynamic, entry::DYNAMIC_FINE)]
         {
-            let listed = vec![entry::FINE_TILES, entry::FINE_TILE_ARGS, entry::FINE_BACKGROUND, main];
+            let listed = [entry::FINE_TILES, entry::FINE_TILE_ARGS, entry::FINE_BACKGROUND, main];
             assert_eq!(fine_entries(&with, mode), (listed.iter().map(|e| e.to_string()).collect(), true), "{mode}");
             assert_eq!(fine_entries(&format!("in float3 normal;\n{body}"), mode), (vec![main.to_string()], false));
         }
