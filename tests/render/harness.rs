@@ -179,31 +179,9 @@ pub fn dispatch_in_turn<const N: usize>(
     let channels = gbuffer.upload(gpu);
     let modes = options.map(|o| o.mode);
     let mut shader = Shader::new(&gpu.device, &restricted_to(program, &modes))?;
-    if let Some(block) = &program.layout.uniforms {
-        for f in &block.fields {
-            if f.default.is_none() {
-                let n = f.ty.components();
-                // Floats in [0.25, 0.75); integers and bools 0 (what those floats were cast to
-                // before set_uniform checked values against their type).
-                let float = f.ty.scalar() == mrsl_abi::Scalar::Float;
-                let value = |i: u32| if float { 0.25 + 0.5 * ((i * 7919) % 13) as f64 / 13.0 } else { 0.0 };
-                let values: Vec<f64> = (0..n).map(value).collect();
-                shader.set_uniform(&f.name, &values)?;
-            }
-        }
-    }
-    let texture = gpu.texture_with_data(
-        "test texture",
-        (4, 4),
-        wgpu::TextureFormat::Rgba8Unorm,
-        &(0..64).map(|i| (i * 37 % 256) as u8).collect::<Vec<u8>>(),
-    );
+    fill_uniforms(&mut shader, program)?;
+    let (texture, sampler) = test_texture_and_sampler(gpu);
     let view = texture.create_view(&Default::default());
-    let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
-        mag_filter: wgpu::FilterMode::Linear,
-        min_filter: wgpu::FilterMode::Linear,
-        ..Default::default()
-    });
     let outputs: Vec<(String, wgpu::Texture)> = program
         .layout
         .outputs
@@ -250,6 +228,38 @@ pub fn dispatch_in_turn<const N: usize>(
         dispatched.push(Dispatched { pixels, stats, refine_masks, refine_masks_y });
     }
     Ok(dispatched.try_into().unwrap_or_else(|_| unreachable!("one result per dispatch")))
+}
+
+/// Sets every uniform without a default to a deterministic value, so that
+/// any program can run: floats in [0.25, 0.75), integers and bools 0 (what
+/// those floats were cast to before `set_uniform` checked values against
+/// their type).
+pub fn fill_uniforms(shader: &mut Shader, program: &CompiledProgram) -> Result<(), Error> {
+    let Some(block) = &program.layout.uniforms else { return Ok(()) };
+    for f in block.fields.iter().filter(|f| f.default.is_none()) {
+        let float = f.ty.scalar() == mrsl_abi::Scalar::Float;
+        let value = |i: u32| if float { 0.25 + 0.5 * ((i * 7919) % 13) as f64 / 13.0 } else { 0.0 };
+        let values: Vec<f64> = (0..f.ty.components()).map(value).collect();
+        shader.set_uniform(&f.name, &values)?;
+    }
+    Ok(())
+}
+
+/// The texture (4x4 `rgba8unorm`, every texel different) and the linear
+/// sampler bound to every texture and sampler uniform of a test program.
+pub fn test_texture_and_sampler(gpu: &Gpu) -> (wgpu::Texture, wgpu::Sampler) {
+    let texture = gpu.texture_with_data(
+        "test texture",
+        (4, 4),
+        wgpu::TextureFormat::Rgba8Unorm,
+        &(0..64).map(|i| (i * 37 % 256) as u8).collect::<Vec<u8>>(),
+    );
+    let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        ..Default::default()
+    });
+    (texture, sampler)
 }
 
 /// Distance in units in the last place between two floats (0 when bit-equal).

@@ -14,6 +14,7 @@ mod binding;
 mod engine_formats;
 mod errors;
 mod frames;
+mod generated;
 mod modes;
 mod packed_records;
 mod rate_image;
@@ -60,6 +61,10 @@ const GPU_TESTS: &[GpuTest] = &[
         engine_formats::decoded_channels_take_their_engine_formats,
     ),
     ("errors::binding_mismatches_are_typed_errors", errors::binding_mismatches_are_typed_errors),
+    (
+        "generated::forced_refinement_equals_reference_for_generated_programs",
+        generated::forced_refinement_equals_reference_for_generated_programs,
+    ),
     (
         "packed_records::packed_records_render_what_word_records_render",
         packed_records::packed_records_render_what_word_records_render,
