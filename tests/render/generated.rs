@@ -28,8 +28,8 @@ use mrsl_runtime::{Bindings, CompiledProgram, DispatchOptions, Error, Mode, Shad
 /// asks for N of each). Each compiles every mode's kernels and builds their
 /// pipelines: about a third of a second on lavapipe in a release build, 2.5
 /// seconds in a debug one. The first 32 with a background rule include seed
-/// 1000246, at which a
-/// deliberate bug in a background tile's known channel failed.
+/// 1000246, at which a deliberate bug in a background tile's known channel
+/// failed.
 const PROGRAMS: u64 = 8;
 const WITH_BACKGROUND: u64 = 32;
 /// Odd sizes, so that the last blocks and tiles are partial; 40 columns of
