@@ -28,9 +28,12 @@ fn floats<'a>(data: Option<&'a ChannelData>, name: &str) -> (usize, &'a [f32]) {
     }
 }
 
+/// A G-buffer's channel textures by name.
+type Channels = Vec<(String, wgpu::Texture)>;
+
 /// The demo G-buffer twice: as the lab stores it, and as an engine does
 /// (depth in a Depth32Float texture, normals as octahedral Rg32Float).
-fn gbuffers(gpu: &Gpu) -> (Vec<(String, wgpu::Texture)>, Vec<(String, wgpu::Texture)>, [f32; 16]) {
+fn gbuffers(gpu: &Gpu) -> (Channels, Channels, [f32; 16]) {
     let gbuffer = Scene::Demo.render(SIZE.0, SIZE.1);
     let float = gbuffer.upload(gpu);
     let (vp, inverse) = engine_formats::view_projection(&Scene::demo_camera(), SIZE).unwrap();
