@@ -1,12 +1,13 @@
 //! Programs from the compiler's well-typed generator, rendered: forced
-//! refinement writes the reference's bytes, in every output and every mode.
+//! refinement writes the reference's outputs in every mode, and so do the
+//! unforced modes at background pixels.
 //!
 //! The compiler's own tests only check that naga accepts what it writes for
 //! these programs; here the runtime runs them over a G-buffer made for each
 //! program's channels, so that a miscompiled path (a background tile that
 //! folds a load it should not, a surface key on a strange channel, a record
-//! word that lands elsewhere) shows as a byte that differs from the
-//! reference. The generator writes background rules (`@background`,
+//! word that lands elsewhere) shows as an output that differs from the
+//! reference's ([`first_difference`] says how closely they must agree). The generator writes background rules (`@background`,
 //! `@foreground`) and surface keys; the G-buffer gives every rule's value
 //! over a band of whole tiles (wholly background 8x8 and 32x32 tiles, and
 //! tiles along its edge) and steps every channel across a row, so that keys
@@ -97,7 +98,8 @@ fn has_background_rule(source: &str) -> bool {
 }
 
 /// Renders `program` in every mode, forced and not, and asserts that every
-/// forced output holds the reference's bytes.
+/// forced output, and every unforced one at background pixels, is the
+/// reference's.
 fn forced_equals_reference(gpu: &Gpu, program: &CompiledProgram, source: &str, seed: u64) {
     let context = |what: String| format!("seed {seed}: {what}\n{source}");
     let mut shader = Shader::new(&gpu.device, program).unwrap_or_else(|e| panic!("{}", context(e.to_string())));
@@ -188,8 +190,8 @@ fn forced_equals_reference(gpu: &Gpu, program: &CompiledProgram, source: &str, s
 /// instruction sequences need not agree on (llvmpipe compiles with
 /// fast-math flags), and which a `unorm` store turns into 0 or 1 with nothing
 /// left to tell; and among the first 200 seeds four programs' float outputs
-/// came out 1 to 8 ulps apart in the reference kernel and in every other,
-/// the same in every mode (seeds 20, 23 and 41, 1 or 2 ulps in `tanh` or
+/// came out 1 to 8 ulps apart in the reference kernel and in the others,
+/// the same in every mode that differs (seeds 20, 23 and 41, 1 or 2 ulps in `tanh` or
 /// `refract` of uniform expressions; seed 55, 8 ulps in a `fwidth` of an
 /// input): the reference kernel, compiled on its own, rounds differently
 /// there (docs/language.md, section 8.3).
