@@ -517,7 +517,7 @@ impl<'c> Gen<'c> {
 
     /// `@background(v)` or `@foreground(v)` with a value of the channel's
     /// scalar type `s` (for a float channel also zero, whose two bit patterns
-    /// compare equal, and a value no G-buffer holds).
+    /// compare equal, and a large one).
     fn background_rule(&mut self, s: S) -> String {
         let value = match s {
             S::U => self.pick(&["0", "255", "7"]),
