@@ -18,11 +18,11 @@
 #[path = "../../compiler/tests/it/wellformed.rs"]
 mod wellformed;
 
-use crate::harness::{fill_uniforms, test_texture_and_sampler};
+use crate::harness::{bind_test_program, fill_uniforms, test_texture_and_sampler};
 use mrsl_abi::{Background, Channel, Scalar, TextureFormat};
 use mrsl_lab::gpu::Gpu;
 use mrsl_runtime::gpu::wgpu_format;
-use mrsl_runtime::{Bindings, CompiledProgram, DispatchOptions, Error, Mode, Shader};
+use mrsl_runtime::{CompiledProgram, DispatchOptions, Error, Mode, Shader};
 
 /// Programs rendered per run: the first [`PROGRAMS`] and the first
 /// [`WITH_BACKGROUND`] with one background rule (`MRSL_GENERATED_PROGRAMS=N`
@@ -116,19 +116,9 @@ fn forced_equals_reference(gpu: &Gpu, program: &CompiledProgram, source: &str, s
         .map(|o| (o.name.clone(), gpu.output_texture(&o.name, SIZE, wgpu_format(o.format)), o.format))
         .collect();
     let shading_rate = mrsl_lab::shading_rate::upload_pattern(gpu, SIZE, 8);
-    let mut bindings = Bindings { size: SIZE, shading_rate: Some(&shading_rate), ..Default::default() };
-    for (name, t) in &channels {
-        bindings.channels.insert(name.clone(), t);
-    }
-    for t in &program.layout.textures {
-        bindings.textures.insert(t.name.clone(), &view);
-    }
-    for s in &program.layout.samplers {
-        bindings.samplers.insert(s.name.clone(), &sampler);
-    }
-    for (name, t, _) in &outputs {
-        bindings.outputs.insert(name.clone(), t);
-    }
+    let named_outputs = outputs.iter().map(|(name, t, _)| (name, t));
+    let mut bindings = bind_test_program(program, SIZE, &channels, &view, &sampler, named_outputs);
+    bindings.shading_rate = Some(&shading_rate);
     let has_background = program.layout.channels.iter().any(|c| c.background.is_some());
     let limit = gpu.device.limits().max_storage_textures_per_shader_stage;
     let mut render = |options: DispatchOptions| -> Option<Vec<Vec<u8>>> {

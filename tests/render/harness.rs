@@ -191,19 +191,8 @@ pub fn dispatch_in_turn<const N: usize>(
             (o.name.clone(), gpu.output_texture(&o.name, size, wgpu::TextureFormat::Rgba32Float))
         })
         .collect();
-    let mut bindings = Bindings { size, ..Default::default() };
-    for (name, t) in &channels {
-        bindings.channels.insert(name.clone(), t);
-    }
-    for t in &program.layout.textures {
-        bindings.textures.insert(t.name.clone(), &view);
-    }
-    for s in &program.layout.samplers {
-        bindings.samplers.insert(s.name.clone(), &sampler);
-    }
-    for (name, t) in &outputs {
-        bindings.outputs.insert(name.clone(), t);
-    }
+    let named_outputs = outputs.iter().map(|(name, t)| (name, t));
+    let mut bindings = bind_test_program(program, size, &channels, &view, &sampler, named_outputs);
     // Only the rate-image mode reads it.
     let shading_rate = mrsl_lab::shading_rate::upload(gpu, size, tile, rates);
     bindings.shading_rate = Some(&shading_rate);
@@ -228,6 +217,33 @@ pub fn dispatch_in_turn<const N: usize>(
         dispatched.push(Dispatched { pixels, stats, refine_masks, refine_masks_y });
     }
     Ok(dispatched.try_into().unwrap_or_else(|_| unreachable!("one result per dispatch")))
+}
+
+/// Bindings of a test program: its channels and outputs by name, and the
+/// test texture and sampler ([`test_texture_and_sampler`]) for every texture
+/// and sampler uniform it declares.
+pub fn bind_test_program<'a>(
+    program: &CompiledProgram,
+    size: (u32, u32),
+    channels: &'a [(String, wgpu::Texture)],
+    view: &'a wgpu::TextureView,
+    sampler: &'a wgpu::Sampler,
+    outputs: impl Iterator<Item = (&'a String, &'a wgpu::Texture)>,
+) -> Bindings<'a> {
+    let mut bindings = Bindings { size, ..Default::default() };
+    for (name, t) in channels {
+        bindings.channels.insert(name.clone(), t);
+    }
+    for t in &program.layout.textures {
+        bindings.textures.insert(t.name.clone(), view);
+    }
+    for s in &program.layout.samplers {
+        bindings.samplers.insert(s.name.clone(), sampler);
+    }
+    for (name, t) in outputs {
+        bindings.outputs.insert(name.clone(), t);
+    }
+    bindings
 }
 
 /// Sets every uniform without a default to a deterministic value, so that
