@@ -136,37 +136,27 @@ fn forced_equals_reference(gpu: &Gpu, program: &CompiledProgram, source: &str, s
         Some(outputs.iter().map(|(_, t, _)| gpu.read_texture(t).unwrap()).collect())
     };
     let reference = render(DispatchOptions::new(Mode::Reference)).expect("the reference runs on any device");
+    // Every output of `images` is the reference's at the pixels `compared` names.
+    let assert_reference = |images: &[Vec<u8>], compared: &dyn Fn(u32, u32) -> bool, what: String| {
+        for ((name, _, format), (a, b)) in outputs.iter().zip(images.iter().zip(&reference)) {
+            if let Some((x, y)) = first_difference(*format, a, b, compared) {
+                let (a, b) = (texel(a, x, y), texel(b, x, y));
+                let found = format!("{what} `{name}` at ({x}, {y}) is {a:02x?}, the reference's {b:02x?}");
+                panic!("{}", context(found));
+            }
+        }
+    };
     for mode in crate::adaptive_modes() {
         // Unforced, at background pixels every coarse effect reads zero and
         // the outputs are the reference's; elsewhere the image is the mode's
         // own (the other render tests bound it).
         let Some(unforced) = render(DispatchOptions::new(mode)) else { continue };
         if has_background {
-            for ((name, _, format), (a, b)) in outputs.iter().zip(unforced.iter().zip(&reference)) {
-                if let Some((x, y)) = first_difference(*format, a, b, |x, _| x < SKY_COLUMNS) {
-                    let (a, b) = (texel(a, x, y), texel(b, x, y));
-                    panic!(
-                        "{}",
-                        context(format!(
-                            "{mode}: output `{name}` at background pixel ({x}, {y}) is {a:02x?}, the reference's {b:02x?}"
-                        ))
-                    );
-                }
-            }
+            assert_reference(&unforced, &|x, _| x < SKY_COLUMNS, format!("{mode}: at a background pixel, output"));
         }
         let forced = render(DispatchOptions { force_refine: true, ..DispatchOptions::new(mode) })
             .unwrap_or_else(|| panic!("{}", context(format!("{mode}: refused forced, not unforced"))));
-        for ((name, _, format), (a, b)) in outputs.iter().zip(forced.iter().zip(&reference)) {
-            if let Some((x, y)) = first_difference(*format, a, b, |_, _| true) {
-                let (a, b) = (texel(a, x, y), texel(b, x, y));
-                panic!(
-                    "{}",
-                    context(format!(
-                        "{mode}: forced output `{name}` at ({x}, {y}) is {a:02x?}, the reference's {b:02x?}"
-                    ))
-                );
-            }
-        }
+        assert_reference(&forced, &|_, _| true, format!("{mode}: forced output"));
     }
 }
 
