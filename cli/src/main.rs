@@ -180,7 +180,8 @@ struct Bench {
     target_fraction: f64,
     /// Instead of the sweep: time the adaptive kernel of the mode given by
     /// --modes (coarse2x2, coarse4x4 or hierarchical; coarse4x4 unless
-    /// given) with one part removed at a time, paired with the full kernel,
+    /// given; for the block modes their coarse pass too) with one part
+    /// removed at a time, paired with the full kernel,
     /// on the first scene (writes ablation.md).
     #[arg(long, conflicts_with = "suite")]
     ablation: bool,

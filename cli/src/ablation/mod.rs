@@ -2,7 +2,8 @@
 //!
 //! The kernel that does a mode's adaptive work (the fine kernel of coarse
 //! 2x2 or 4x4, [`block`]; the hierarchical kernel, [`hierarchical`]) is
-//! rebuilt with one part removed at a time, by editing the generated WGSL
+//! rebuilt with one part removed at a time (for the block modes the coarse
+//! pass too, with the fine pass emptied: [`coarse`]), by editing the generated WGSL
 //! line by line, and
 //! each variant is timed against the full kernel and the reference in
 //! interleaved rounds (the order rotates every round). A variant's figure is
@@ -20,6 +21,7 @@ use crate::timing::{median, time_run};
 use anyhow::{Context, Result, anyhow, bail};
 
 mod block;
+mod coarse;
 mod hierarchical;
 
 pub use block::refining_nothing;
@@ -225,6 +227,19 @@ fn variants(
         match apply(v, &kernel.wgsl) {
             Some(wgsl) => programs.push((v.name, v.removes, with_kernel(full, target.kernel(), &wgsl))),
             None => skipped.push(v.name),
+        }
+    }
+    if let Target::Block(block) = target {
+        // The coarse pass's variants: its kernel edited, the fine pass emptied.
+        let coarse = full.kernel(KernelKind::Coarse, block).context("the program has no coarse kernel")?;
+        for v in &coarse::VARIANTS {
+            match v.apply(&coarse.wgsl, &kernel.wgsl) {
+                Some((c, f)) => {
+                    let p = with_kernel(&with_kernel(full, (KernelKind::Coarse, Some(block)), &c), target.kernel(), &f);
+                    programs.push((v.name, v.removes, p));
+                }
+                None => skipped.push(v.name),
+            }
         }
     }
     Ok((programs, skipped))
