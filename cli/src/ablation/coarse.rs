@@ -32,10 +32,12 @@ fn no_coarse_effects(w: &str) -> Option<String> {
     })
 }
 
+/// The coarse kernel's entry points' test of their sample against the grid.
+const SAMPLE_BOUNDS: &str = "if (mrsl_gid.x >= u32(mrsl_n.x) || mrsl_gid.y >= u32(mrsl_n.y)) { return; }";
+
 /// Nothing at all: each entry point returns at once.
 fn launches_only(w: &str) -> Option<String> {
-    let bounds = "if (mrsl_gid.x >= u32(mrsl_n.x) || mrsl_gid.y >= u32(mrsl_n.y)) { return; }";
-    edit_lines(w, |l| (l.trim_start() == bounds).then(|| format!("{}if (true) {{ return; }}", indent(l))))
+    edit_lines(w, |l| (l.trim_start() == SAMPLE_BOUNDS).then(|| format!("{}if (true) {{ return; }}", indent(l))))
 }
 
 /// (Fine kernel.) The tile classification lists no tile, so that the
@@ -60,10 +62,9 @@ fn classifies_nothing(w: &str) -> Option<String> {
 /// 16x8 pixels rather than 32x4, as the reference's lanes cover whole 2x2
 /// blocks. What the lanes' layout costs in divergence and locality.
 fn lanes_in_4x2_samples(w: &str) -> Option<String> {
-    let bounds = "if (mrsl_gid.x >= u32(mrsl_n.x) || mrsl_gid.y >= u32(mrsl_n.y)) { return; }";
     let changed = edit_lines(w, |l| match l.trim_start() {
         "@compute @workgroup_size(8, 8, 1)" => Some("@compute @workgroup_size(64, 1, 1)".to_string()),
-        t if t == bounds => {
+        SAMPLE_BOUNDS => {
             let i = indent(l);
             Some(format!(
                 "{i}let mrsl_li = mrsl_gid.x % 64u;\n\
