@@ -17,15 +17,15 @@ pub(crate) struct ExtractedMrsl {
     pub(crate) outputs: Vec<(String, AssetId<Image>)>,
 }
 
-pub(crate) fn extract_cameras(
-    mut commands: Commands,
-    cameras: Extract<
-        Query<
-            (Entity, RenderEntity, Option<&MrslCamera>, Option<&MrslUniforms>, Option<&MrslOutputs>),
-            With<bevy::camera::Camera>,
-        >,
-    >,
-) {
+/// The main world's cameras with whatever of the plugin's components each has.
+type CameraQuery<'w, 's> = Query<
+    'w,
+    's,
+    (Entity, RenderEntity, Option<&'static MrslCamera>, Option<&'static MrslUniforms>, Option<&'static MrslOutputs>),
+    With<bevy::camera::Camera>,
+>;
+
+pub(crate) fn extract_cameras(mut commands: Commands, cameras: Extract<CameraQuery>) {
     for (camera, render_entity, settings, uniforms, outputs) in &cameras {
         let mut entity = commands.entity(render_entity);
         match (settings, outputs) {

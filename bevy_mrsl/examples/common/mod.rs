@@ -263,6 +263,9 @@ fn scene_uniforms(
     }
 }
 
+/// What the app hands back when it exits: the captures, or what went wrong.
+type SharedResult = Arc<Mutex<Option<Result<Vec<Captured>, String>>>>;
+
 #[derive(Resource)]
 struct Sequence {
     captures: Vec<Capture>,
@@ -275,11 +278,12 @@ struct Sequence {
     loaded_frames: u32,
     source: Source,
     done: Vec<Captured>,
-    result: Arc<Mutex<Option<Result<Vec<Captured>, String>>>>,
+    result: SharedResult,
 }
 
 /// Sets the camera to the current capture's mode, and starts reading its
 /// output back once the plugin has made the output image.
+#[allow(clippy::too_many_arguments, reason = "a Bevy system takes its parameters as arguments")]
 fn advance(
     mut commands: Commands,
     mut sequence: ResMut<Sequence>,

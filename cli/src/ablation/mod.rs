@@ -378,7 +378,7 @@ mod tests {
         let background = 4 + 2 + 2 + 2 + 1;
         let share = share_in_background_tiles(&texels, (w, h), 2);
         assert_eq!(share, f64::from(background) / f64::from(w * h));
-        assert_eq!(share_in_background_tiles(&vec![[0, 0]; 15], (w, h), 2), 0.0);
-        assert_eq!(share_in_background_tiles(&vec![BACKGROUND_MARK; 15], (w, h), 8), 1.0);
+        assert_eq!(share_in_background_tiles(&[[0, 0]; 15], (w, h), 2), 0.0);
+        assert_eq!(share_in_background_tiles(&[BACKGROUND_MARK; 15], (w, h), 8), 1.0);
     }
 }
