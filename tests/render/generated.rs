@@ -184,9 +184,10 @@ fn forced_equals_reference(gpu: &Gpu, program: &CompiledProgram, source: &str, n
 /// the same in every mode that differs (seeds 20, 23 and 41, 1 or 2 ulps in `tanh` or
 /// `refract` of uniform expressions; seed 55, 8 ulps in a `fwidth` of an
 /// input): the reference kernel, compiled on its own, rounds differently
-/// there (for seed 23, reduced with `MRSL_GENERATED_SOURCE`, because
-/// lavapipe specialises a kernel on a uniform its loop leaves on and folds
-/// the `tanh` on the host: docs/language.md, section 8.3). Deeper runs
+/// there (for seeds 20 and 23, tested with `MRSL_GENERATED_SOURCE`, because
+/// lavapipe specialises the small reference kernel on a uniform its loop
+/// leaves on and folds the expression on the host; for 41 and 55 the cause
+/// is not established: docs/language.md, section 8.3). Deeper runs
 /// (`MRSL_GENERATED_PROGRAMS`) can still fail where a NaN on the way to a
 /// finite output is folded away in one kernel only, or cancellation turns
 /// such an ulp into many (docs/fuzzing.md lists the two seen in 800
