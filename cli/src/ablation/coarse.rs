@@ -133,7 +133,7 @@ pub(super) const VARIANTS: [PassVariant; 7] = [
     },
     PassVariant {
         name: "launches and tile classification",
-        removes: "also the workgroups of the dispatches over the tile lists (no tile is listed)",
+        removes: "also the list writes and the workgroups of the dispatches over the tile lists (no tile is listed)",
         coarse: &[launches_only],
         fine: &[lists_no_tile],
     },
