@@ -17,6 +17,7 @@ const TESTS: &[(&str, fn())] = &[
     ("render_all_skips_only_the_modes_the_device_cannot_run", render_all_skips_only_the_modes_the_device_cannot_run),
     ("heatmaps_mark_background_pixels_grey", heatmaps_mark_background_pixels_grey),
     ("gpu_bench_script_writes_the_suite_report", gpu_bench_script_writes_the_suite_report),
+    ("ablation_times_every_variant_on_the_device", ablation_times_every_variant_on_the_device),
     (
         "gbuffer_exports_the_channels_and_what_the_program_binds",
         gbuffer_exports_the_channels_and_what_the_program_binds,
@@ -186,6 +187,34 @@ fn gpu_bench_script_writes_the_suite_report() {
     let md = std::fs::read_to_string(dir.join("suite.md")).unwrap();
     for heading in ["## 48x27", "### sponza (48x27)", "| geometric mean speedup |", "## Not measured"] {
         assert!(md.contains(heading), "{heading} in:\n{md}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `bench --ablation` at a small size, for the block modes' fine and coarse
+/// passes and for the hierarchical kernel: every variant of the workload's
+/// kernels builds a pipeline on the device and is timed (the unit tests
+/// only check that naga accepts them), and none is left out as not
+/// applicable.
+fn ablation_times_every_variant_on_the_device() {
+    let dir = scratch("ablation");
+    for (mode, at_least) in [("coarse4x4", 24), ("hierarchical", 14)] {
+        let out = dir.join(mode);
+        let args = ["bench", "--ablation", "--modes", mode, "--scene", "sponza", "--size", "48x27", "--runs", "1"];
+        let run = mrslc(&[&args[..], &["-o", out.to_str().unwrap()]].concat());
+        assert!(run.status.success(), "{mode}: {}", stderr(&run));
+        let md = std::fs::read_to_string(out.join("ablation.md")).unwrap();
+        let rows: Vec<&str> = md.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| variant")).collect();
+        assert!(rows.len() >= at_least, "{mode}: {} rows in\n{md}", rows.len());
+        for row in &rows {
+            let ms: f64 = row.split('|').nth(3).unwrap().trim().parse().unwrap_or_else(|_| panic!("{row}"));
+            assert!(ms.is_finite() && ms > 0.0, "{mode}: {row}");
+        }
+        assert!(!md.contains("Not applicable"), "{mode}: every variant applies to the workload:\n{md}");
+    }
+    let coarse = std::fs::read_to_string(dir.join("coarse4x4/ablation.md")).unwrap();
+    for variant in ["| coarse pass, no predicates |", "| launches |"] {
+        assert!(coarse.contains(variant), "{variant} in:\n{coarse}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
