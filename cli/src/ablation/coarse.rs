@@ -4,7 +4,7 @@
 //! the coarse pass is a large share of it.
 
 use super::block::no_fine_work;
-use super::{Edit, edit_lines, indent};
+use super::{Edit, apply_edits, edit_lines, indent};
 
 /// The predicates: every `refine;` statement dropped, so that what only
 /// decides refinement (the `change` sums, the derivatives and their key
@@ -92,8 +92,7 @@ impl PassVariant {
     /// The coarse and fine kernels of the variant, or `None` when one of
     /// its edits has nothing to edit.
     pub fn apply(&self, coarse: &str, fine: &str) -> Option<(String, String)> {
-        let edit = |edits: &[Edit], w: String| edits.iter().try_fold(w, |w, e| e(&w));
-        Some((edit(self.coarse, coarse.to_string())?, edit(self.fine, no_fine_work(fine)?)?))
+        Some((apply_edits(self.coarse, coarse)?, apply_edits(self.fine, &no_fine_work(fine)?)?))
     }
 }
 

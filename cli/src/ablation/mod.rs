@@ -137,7 +137,13 @@ fn with_kernel(program: &CompiledProgram, (kind, block): (KernelKind, Option<u32
 
 /// A variant's kernel, or `None` when one of its edits has nothing to edit.
 fn apply(variant: &Variant, wgsl: &str) -> Option<String> {
-    variant.edits.iter().try_fold(wgsl.to_string(), |w, edit| edit(&w))
+    apply_edits(variant.edits, wgsl)
+}
+
+/// `wgsl` with `edits` applied in turn, or `None` when one of them has
+/// nothing to edit.
+fn apply_edits(edits: &[Edit], wgsl: &str) -> Option<String> {
+    edits.iter().try_fold(wgsl.to_string(), |w, edit| edit(&w))
 }
 
 /// The full kernel, the compacted one (block modes) and the variants that apply, each
