@@ -37,7 +37,7 @@ pub fn adapters() -> Vec<wgpu::AdapterInfo> {
 impl Gpu {
     /// Milliseconds per dispatch of `pipeline` over `workgroups`, averaged
     /// over `dispatches` submissions and the wait for them: the timing of
-    /// the lab's microbenchmarks (`record_loads`, `record_access`, `uniform_branch`).
+    /// the lab's microbenchmarks (`record_loads`, `record_access`, `uniform_branch`, `uniform_loads`).
     pub fn time_dispatches(
         &self,
         pipeline: &wgpu::ComputePipeline,

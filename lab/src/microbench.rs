@@ -1,5 +1,5 @@
 //! The timing the lab's microbenchmarks share (`lab/examples/record_loads.rs`,
-//! `record_access.rs`, `uniform_branch.rs`): kernels timed in interleaved
+//! `record_access.rs`, `uniform_branch.rs`, `uniform_loads.rs`): kernels timed in interleaved
 //! rounds, and medians over the rounds.
 
 /// Times each of `kernels` once to warm up, then `rounds` times in
