@@ -52,6 +52,8 @@ fn decoded_channel_format(decode: &Decode, ty: &Type) -> (TextureFormat, SampleT
     }
 }
 
+/// The layout of a checked program (mode plans and the multi-rate levels are
+/// filled in after it by `plan::build` and `rates::levels_layout`).
 pub fn build(
     checked: &Checked,
     graph: &EffectGraph,
@@ -59,9 +61,72 @@ pub fn build(
     interface: &Interface,
     costs: &Costs,
 ) -> Layout {
-    let operations: HashMap<EffectId, u64> = costs.effects.iter().copied().collect();
-    let value_operations: HashMap<EffectId, u64> = costs.values.iter().copied().collect();
-    let control = ControlBlock {
+    let (uniforms, textures, samplers) = uniform_block_and_resources(checked);
+    let stage_resource = |slot: StageSlot, name: &str, kind: ResourceKind| ResourceBinding {
+        name: name.into(),
+        group: GROUP_STAGE,
+        binding: stage_binding(checked, slot),
+        kind,
+    };
+    Layout {
+        format: LAYOUT_FORMAT.into(),
+        control: control_block(),
+        uniforms,
+        textures,
+        samplers,
+        channels: channels(checked),
+        interface: interface_layout(checked, interface),
+        stats: StatsLayout {
+            group: GROUP_STAGE,
+            binding: stage_binding(checked, StageSlot::Stats),
+            counters: graph
+                .order
+                .iter()
+                .filter(|e| checked.effects[e.index()].rate == Rate::Coarse)
+                .map(|e| checked.effects[e.index()].name.clone())
+                .collect(),
+        },
+        refine_mask: stage_resource(StageSlot::RefineMask, "mrsl_refine_mask", ResourceKind::RefineMask),
+        interface2: stage_resource(StageSlot::Interface2, "mrsl_interface2", ResourceKind::Storage),
+        shading_rate: stage_resource(StageSlot::ShadingRate, "mrsl_shading_rate", ResourceKind::ShadingRate),
+        neighbours: neighbours(checked, graph, deriv, stage_binding(checked, StageSlot::Neighbours)),
+        hierarchical: hierarchical_layout(checked, graph, interface),
+        outputs: outputs(checked),
+        effects: effect_layouts(checked, graph, interface, costs),
+        // Filled in by `rates::levels_layout` when the modes include the multi-rate one.
+        levels: None,
+        // Filled in from the modes by `plan::build`.
+        plan: Plan { modes: vec![], resources: vec![], constants: Default::default() },
+    }
+}
+
+/// What the stage group binds after the interface record (binding 0) and the
+/// outputs (from 1), in this order: every binding number past the outputs
+/// comes from [`stage_binding`], so that none is counted in two places.
+#[derive(Clone, Copy)]
+enum StageSlot {
+    Stats,
+    RefineMask,
+    Interface2,
+    Work,
+    Queue,
+    ShadingRate,
+    Neighbours,
+    LevelValues,
+}
+
+/// The stage group's binding of `slot`.
+fn stage_binding(checked: &Checked, slot: StageSlot) -> u32 {
+    1 + output_count(checked) + slot as u32
+}
+
+fn output_count(checked: &Checked) -> u32 {
+    checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32
+}
+
+/// The control block every kernel binds: the contract's fields, as data.
+fn control_block() -> ControlBlock {
+    ControlBlock {
         group: GROUP_RESOURCES,
         binding: BINDING_CONTROL,
         size: Control::SIZE,
@@ -76,13 +141,21 @@ pub fn build(
                 default: f.default.map(|d| vec![d]),
             })
             .collect(),
-    };
+    }
+}
+
+/// The program's value uniforms laid out in one block (WGSL's uniform
+/// alignment), and its textures and samplers bound after the block, in
+/// declaration order.
+fn uniform_block_and_resources(
+    checked: &Checked,
+) -> (Option<UniformBlock>, Vec<ResourceBinding>, Vec<ResourceBinding>) {
     let mut fields = vec![];
     let (mut offset, mut max_align) = (0u32, 16u32);
-    let mut textures = vec![];
-    let mut samplers = vec![];
+    let (mut textures, mut samplers) = (vec![], vec![]);
     let mut binding = BINDING_UNIFORMS + 1;
     for u in &checked.uniforms {
+        let resource = |kind| ResourceBinding { name: u.name.clone(), group: GROUP_RESOURCES, binding, kind };
         match &u.kind {
             UniformKind::Value { default } => {
                 let host = u.ty.host_type();
@@ -100,21 +173,11 @@ pub fn build(
                 offset += size;
             }
             UniformKind::Texture => {
-                textures.push(ResourceBinding {
-                    name: u.name.clone(),
-                    group: GROUP_RESOURCES,
-                    binding,
-                    kind: ResourceKind::Texture,
-                });
+                textures.push(resource(ResourceKind::Texture));
                 binding += 1;
             }
             UniformKind::Sampler => {
-                samplers.push(ResourceBinding {
-                    name: u.name.clone(),
-                    group: GROUP_RESOURCES,
-                    binding,
-                    kind: ResourceKind::Sampler,
-                });
+                samplers.push(resource(ResourceKind::Sampler));
                 binding += 1;
             }
         }
@@ -125,7 +188,13 @@ pub fn build(
         size: round_up(offset, max_align),
         fields,
     });
-    let channels = checked
+    (uniforms, textures, samplers)
+}
+
+/// The G-buffer channels, a binding each in declaration order, sampled
+/// (`read_channels_from_storage` switches those it can to storage).
+fn channels(checked: &Checked) -> Vec<Channel> {
+    checked
         .inputs
         .iter()
         .enumerate()
@@ -147,9 +216,12 @@ pub fn build(
                 access: ChannelAccess::Sampled,
             }
         })
-        .collect();
-    let name = |e: &crate::check::EffectId| checked.effects[e.index()].name.clone();
-    let outputs = checked
+        .collect()
+}
+
+/// The `out` effects, bound from 1 in the stage group.
+fn outputs(checked: &Checked) -> Vec<Output> {
+    checked
         .effects
         .iter()
         .filter(|e| e.rate == Rate::Out)
@@ -161,13 +233,22 @@ pub fn build(
             group: GROUP_STAGE,
             binding: 1 + i as u32,
         })
-        .collect();
-    let effects = checked
+        .collect()
+}
+
+/// Every effect as the runtimes see it: its rate, refine bit, interface
+/// slot, resampling, dependencies, keys, the condition under which a coarse
+/// pass must evaluate it, and its operation counts.
+fn effect_layouts(checked: &Checked, graph: &EffectGraph, interface: &Interface, costs: &Costs) -> Vec<EffectLayout> {
+    let operations: HashMap<EffectId, u64> = costs.effects.iter().copied().collect();
+    let value_operations: HashMap<EffectId, u64> = costs.values.iter().copied().collect();
+    let name = |e: &EffectId| checked.effects[e.index()].name.clone();
+    checked
         .effects
         .iter()
         .enumerate()
         .map(|(i, e)| {
-            let id = crate::check::EffectId(i as u32);
+            let id = EffectId(i as u32);
             let condition = interface.conditions[i].as_ref().filter(|c| c.possible()).map(|c| {
                 let mut terms = vec![];
                 if c.fine_user {
@@ -197,82 +278,36 @@ pub fn build(
                 value_operations: value_operations.get(&id).copied(),
             }
         })
+        .collect()
+}
+
+/// The hierarchical mode's per-pixel record: the interface's flag words, a
+/// mask word per 32 coarse effects, then every coarse effect's value in
+/// evaluation order; and its work-list bindings.
+fn hierarchical_layout(checked: &Checked, graph: &EffectGraph, interface: &Interface) -> HierarchicalLayout {
+    let coarse: Vec<&crate::check::EffectInfo> =
+        graph.order.iter().map(|e| &checked.effects[e.index()]).filter(|e| e.rate == Rate::Coarse).collect();
+    let mask_words = (coarse.len() as u32).div_ceil(32).max(1);
+    let mut offset = interface.flag_words + mask_words;
+    let value_offsets = coarse
+        .iter()
+        .map(|e| {
+            let at = offset;
+            offset += e.ty.components();
+            at
+        })
         .collect();
-    Layout {
-        format: LAYOUT_FORMAT.into(),
-        control,
-        uniforms,
-        textures,
-        samplers,
-        channels,
-        interface: interface_layout(checked, interface),
-        stats: StatsLayout {
-            group: GROUP_STAGE,
-            binding: 1 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
-            counters: graph
-                .order
-                .iter()
-                .filter(|e| checked.effects[e.index()].rate == Rate::Coarse)
-                .map(|e| checked.effects[e.index()].name.clone())
-                .collect(),
-        },
-        refine_mask: ResourceBinding {
-            name: "mrsl_refine_mask".into(),
-            group: GROUP_STAGE,
-            binding: 2 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
-            kind: ResourceKind::RefineMask,
-        },
-        interface2: ResourceBinding {
-            name: "mrsl_interface2".into(),
-            group: GROUP_STAGE,
-            binding: 3 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
-            kind: ResourceKind::Storage,
-        },
-        shading_rate: ResourceBinding {
-            name: "mrsl_shading_rate".into(),
-            group: GROUP_STAGE,
-            binding: 6 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
-            kind: ResourceKind::ShadingRate,
-        },
-        neighbours: neighbours(
-            checked,
-            graph,
-            deriv,
-            7 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32,
-        ),
-        hierarchical: {
-            let outputs = checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32;
-            let coarse: Vec<&crate::check::EffectInfo> =
-                graph.order.iter().map(|e| &checked.effects[e.index()]).filter(|e| e.rate == Rate::Coarse).collect();
-            let mask_words = (coarse.len() as u32).div_ceil(32).max(1);
-            let mut offset = interface.flag_words + mask_words;
-            let value_offsets = coarse
-                .iter()
-                .map(|e| {
-                    let at = offset;
-                    offset += e.ty.components();
-                    at
-                })
-                .collect();
-            HierarchicalLayout {
-                values_binding: 0,
-                record_words: offset,
-                flag_words: interface.flag_words,
-                mask_words,
-                value_offsets,
-                // Set by `compile` from `Options::packed_records`.
-                packed: false,
-                work_binding: 4 + outputs,
-                queue_binding: 5 + outputs,
-                args_group: GROUP_ARGS,
-            }
-        },
-        outputs,
-        effects,
-        // Filled in by `rates::levels_layout` when the modes include the multi-rate one.
-        levels: None,
-        // Filled in from the modes by `plan::build`.
-        plan: Plan { modes: vec![], resources: vec![], constants: Default::default() },
+    HierarchicalLayout {
+        values_binding: 0,
+        record_words: offset,
+        flag_words: interface.flag_words,
+        mask_words,
+        value_offsets,
+        // Set by `compile` from `Options::packed_records`.
+        packed: false,
+        work_binding: stage_binding(checked, StageSlot::Work),
+        queue_binding: stage_binding(checked, StageSlot::Queue),
+        args_group: GROUP_ARGS,
     }
 }
 
@@ -290,12 +325,12 @@ pub fn read_channels_from_storage(layout: &mut Layout) {
 /// The binding of the multi-rate mode's stored values in the stage group,
 /// after the neighbour values'.
 pub fn level_values_binding(checked: &Checked) -> u32 {
-    8 + checked.effects.iter().filter(|e| e.rate == Rate::Out).count() as u32
+    stage_binding(checked, StageSlot::LevelValues)
 }
 
 /// The record of an interface: its slots by effect name, at binding 0 of the stage group.
 pub fn interface_layout(checked: &Checked, interface: &Interface) -> InterfaceLayout {
-    let name = |e: &crate::check::EffectId| checked.effects[e.index()].name.clone();
+    let name = |e: &EffectId| checked.effects[e.index()].name.clone();
     let slots = interface
         .slots
         .iter()
@@ -360,7 +395,7 @@ pub fn hierarchical_level0_values(layout: &Layout) -> bool {
 
 /// Whether a coarse effect is resampled by the nearest corner: `@nearest`, or
 /// a type that cannot be blended (int, uint, bool).
-pub fn uses_nearest(checked: &Checked, id: crate::check::EffectId) -> bool {
+pub fn uses_nearest(checked: &Checked, id: EffectId) -> bool {
     let e = &checked.effects[id.index()];
     e.nearest || e.ty.scalar() != Some(Scalar::Float)
 }

@@ -18,90 +18,8 @@ impl Checker<'_> {
         let program = self.out.program;
         // Pass 1: names, so that items may refer to each other in any order.
         for (index, item) in program.items.iter().enumerate() {
-            let name = item.name();
-            // A reserved name is reported but still registered (unbound), so
-            // that ids stay aligned with the items they index.
-            let reserved = Builtin::from_name(&name.name).is_some() || Type::from_name(&name.name).is_some();
-            if reserved {
-                self.error(err(
-                    "E0103",
-                    format!("`{}` is a reserved name", name.name),
-                    name.span,
-                    "reserved: a builtin function or type",
-                ));
-            }
-            let global = match item {
-                Item::Input(_) => Global::Input(InputId(self.out.inputs.len() as u32)),
-                Item::Uniform(_) => Global::Uniform(UniformId(self.out.uniforms.len() as u32)),
-                Item::Const(_) => Global::Const(ConstId(self.out.consts.len() as u32)),
-                Item::Function(_) => Global::Function(FunctionId(self.out.functions.len() as u32)),
-                Item::Effect(_) => Global::Effect(EffectId(self.out.effects.len() as u32)),
-            };
-            if reserved {
-            } else if let Some((_, first)) = self.globals.get(&name.name) {
-                self.error(
-                    Diagnostic::error("E0101", format!("`{}` is defined twice", name.name))
-                        .with_label(Label::primary(name.span, "defined again here"))
-                        .with_label(Label::secondary(*first, "first defined here")),
-                );
-            } else {
-                self.globals.insert(name.name.clone(), (global, name.span));
-            }
-            match item {
-                Item::Input(d) => {
-                    let ty = self.resolve_type(&d.ty);
-                    self.out.inputs.push(InputInfo {
-                        name: d.name.name.clone(),
-                        ty,
-                        key: None,
-                        background: None,
-                        decode: None,
-                    });
-                }
-                Item::Uniform(d) => {
-                    let ty = self.resolve_type(&d.ty);
-                    let kind = match ty {
-                        Type::Texture2d => UniformKind::Texture,
-                        Type::Sampler => UniformKind::Sampler,
-                        _ => UniformKind::Value { default: None },
-                    };
-                    self.out.uniforms.push(UniformInfo { name: d.name.name.clone(), ty, kind });
-                }
-                Item::Const(d) => {
-                    let ty = self.resolve_type(&d.ty);
-                    self.out.consts.push(ConstInfo { name: d.name.name.clone(), ty, value: None, item: index });
-                }
-                Item::Function(d) => {
-                    let ret = self.resolve_type(&d.ret);
-                    self.out.functions.push(FunctionInfo {
-                        name: d.name.name.clone(),
-                        ret,
-                        params: vec![],
-                        item: index,
-                        calls: vec![],
-                    });
-                }
-                Item::Effect(d) => {
-                    let ty = self.resolve_type(&d.ty);
-                    self.out.effects.push(EffectInfo {
-                        name: d.name.name.clone(),
-                        rate: d.rate,
-                        // Checked in `check_effect_decl`: only the block sizes the kernels have.
-                        block: d
-                            .coarse_block
-                            .and_then(|(n, _)| u32::try_from(n).ok())
-                            .filter(|n| COARSE_BLOCKS.contains(n)),
-                        ty,
-                        item: index,
-                        name_span: d.name.span,
-                        deps: vec![],
-                        has_refine: false,
-                        nearest: false,
-                        result: None,
-                        format: None,
-                    });
-                }
-            }
+            self.register_name(item);
+            self.register_item(index, item);
         }
         // Pass 2: declarations' own details (types allowed, attributes, defaults).
         let (mut input_i, mut uniform_i, mut const_i, mut effect_i) = (0, 0, 0, 0);
@@ -124,6 +42,100 @@ impl Checker<'_> {
                     effect_i += 1;
                 }
                 Item::Function(_) => {}
+            }
+        }
+    }
+
+    /// Binds the item's name to the id it is about to get (reported if
+    /// reserved or defined twice).
+    fn register_name(&mut self, item: &Item) {
+        let name = item.name();
+        // A reserved name is reported but still registered (unbound), so
+        // that ids stay aligned with the items they index.
+        let reserved = Builtin::from_name(&name.name).is_some() || Type::from_name(&name.name).is_some();
+        if reserved {
+            self.error(err(
+                "E0103",
+                format!("`{}` is a reserved name", name.name),
+                name.span,
+                "reserved: a builtin function or type",
+            ));
+        }
+        let global = match item {
+            Item::Input(_) => Global::Input(InputId(self.out.inputs.len() as u32)),
+            Item::Uniform(_) => Global::Uniform(UniformId(self.out.uniforms.len() as u32)),
+            Item::Const(_) => Global::Const(ConstId(self.out.consts.len() as u32)),
+            Item::Function(_) => Global::Function(FunctionId(self.out.functions.len() as u32)),
+            Item::Effect(_) => Global::Effect(EffectId(self.out.effects.len() as u32)),
+        };
+        if reserved {
+        } else if let Some((_, first)) = self.globals.get(&name.name) {
+            self.error(
+                Diagnostic::error("E0101", format!("`{}` is defined twice", name.name))
+                    .with_label(Label::primary(name.span, "defined again here"))
+                    .with_label(Label::secondary(*first, "first defined here")),
+            );
+        } else {
+            self.globals.insert(name.name.clone(), (global, name.span));
+        }
+    }
+
+    /// The item's entry in the checked program, with its declared type;
+    /// pass 2 and the bodies fill in the rest.
+    fn register_item(&mut self, index: usize, item: &Item) {
+        match item {
+            Item::Input(d) => {
+                let ty = self.resolve_type(&d.ty);
+                self.out.inputs.push(InputInfo {
+                    name: d.name.name.clone(),
+                    ty,
+                    key: None,
+                    background: None,
+                    decode: None,
+                });
+            }
+            Item::Uniform(d) => {
+                let ty = self.resolve_type(&d.ty);
+                let kind = match ty {
+                    Type::Texture2d => UniformKind::Texture,
+                    Type::Sampler => UniformKind::Sampler,
+                    _ => UniformKind::Value { default: None },
+                };
+                self.out.uniforms.push(UniformInfo { name: d.name.name.clone(), ty, kind });
+            }
+            Item::Const(d) => {
+                let ty = self.resolve_type(&d.ty);
+                self.out.consts.push(ConstInfo { name: d.name.name.clone(), ty, value: None, item: index });
+            }
+            Item::Function(d) => {
+                let ret = self.resolve_type(&d.ret);
+                self.out.functions.push(FunctionInfo {
+                    name: d.name.name.clone(),
+                    ret,
+                    params: vec![],
+                    item: index,
+                    calls: vec![],
+                });
+            }
+            Item::Effect(d) => {
+                let ty = self.resolve_type(&d.ty);
+                self.out.effects.push(EffectInfo {
+                    name: d.name.name.clone(),
+                    rate: d.rate,
+                    // Checked in `check_effect_decl`: only the block sizes the kernels have.
+                    block: d
+                        .coarse_block
+                        .and_then(|(n, _)| u32::try_from(n).ok())
+                        .filter(|n| COARSE_BLOCKS.contains(n)),
+                    ty,
+                    item: index,
+                    name_span: d.name.span,
+                    deps: vec![],
+                    has_refine: false,
+                    nearest: false,
+                    result: None,
+                    format: None,
+                });
             }
         }
     }

@@ -5,7 +5,7 @@
 use super::builtins::{BuiltinError, builtin_type};
 use super::names::{TYPE_NAMES, suggest, well_known_uniform};
 use super::typing::{binary_type, construct_check, unify};
-use super::{Callee, Checker, Ctx, Global, LocalId, Symbol, err};
+use super::{Callee, Checker, Ctx, FunctionId, Global, LocalId, Symbol, err};
 use crate::builtins::Builtin;
 use crate::diagnostic::{Diagnostic, Label};
 use crate::syntax::ast::*;
@@ -44,36 +44,7 @@ impl Checker<'_> {
             ExprKind::Float(_) => Type::AbstractFloat,
             ExprKind::Bool(_) => types::BOOL,
             ExprKind::Name(name) => self.name(e, name),
-            ExprKind::Unary(op, inner) => {
-                let t = self.expr(inner);
-                if t.is_error() {
-                    return Type::Error;
-                }
-                let ok = match op {
-                    // WGSL negates signed scalars and vectors only.
-                    UnaryOp::Neg | UnaryOp::Pos => {
-                        (t.is_numeric_value() || t.is_abstract())
-                            && t.scalar() != Some(Scalar::Uint)
-                            && !matches!(t, Type::Matrix(_))
-                    }
-                    UnaryOp::Not => matches!(t, Type::Scalar(Scalar::Bool) | Type::Vector(Scalar::Bool, _)),
-                    UnaryOp::BitNot => {
-                        matches!(t.scalar(), Some(Scalar::Int | Scalar::Uint)) && !matches!(t, Type::Matrix(_))
-                    }
-                };
-                if ok {
-                    t
-                } else {
-                    let sym = match op {
-                        UnaryOp::Neg => "-",
-                        UnaryOp::Pos => "+",
-                        UnaryOp::Not => "!",
-                        UnaryOp::BitNot => "~",
-                    };
-                    self.error(err("E0201", format!("cannot apply `{sym}` to `{t}`"), e.span, "invalid operand"));
-                    Type::Error
-                }
-            }
+            ExprKind::Unary(op, inner) => self.unary(e, *op, inner),
             ExprKind::Binary(op, a, b) => {
                 let ta = self.expr(a);
                 let tb = self.expr(b);
@@ -92,28 +63,7 @@ impl Checker<'_> {
                     }
                 }
             }
-            ExprKind::Ternary(c, a, b) => {
-                self.condition(c, "`?:` condition");
-                let ta = self.expr(a);
-                let tb = self.expr(b);
-                match unify(&ta, &tb) {
-                    // `select` is a function in WGSL: literal branches become concrete.
-                    Some(t) => t.concretize(),
-                    None => {
-                        self.error(
-                            err(
-                                "E0201",
-                                format!("`?:` branches have different types: `{ta}` and `{tb}`"),
-                                e.span,
-                                "branches must agree",
-                            )
-                            .with_label(Label::secondary(a.span, format!("`{ta}`")))
-                            .with_label(Label::secondary(b.span, format!("`{tb}`"))),
-                        );
-                        Type::Error
-                    }
-                }
-            }
+            ExprKind::Ternary(c, a, b) => self.ternary(e, c, a, b),
             ExprKind::Field { base, field } => {
                 let t = self.expr(base);
                 self.field_type(&t, field)
@@ -123,6 +73,60 @@ impl Checker<'_> {
                 self.index_type(&t, index, e.span)
             }
             ExprKind::Call { callee, args } => self.call(e, callee, args),
+        }
+    }
+
+    /// `-x`, `+x`, `!x`, `~x`: the operand types WGSL accepts.
+    fn unary(&mut self, e: &Expr, op: UnaryOp, inner: &Expr) -> Type {
+        let t = self.expr(inner);
+        if t.is_error() {
+            return Type::Error;
+        }
+        let ok = match op {
+            // WGSL negates signed scalars and vectors only.
+            UnaryOp::Neg | UnaryOp::Pos => {
+                (t.is_numeric_value() || t.is_abstract())
+                    && t.scalar() != Some(Scalar::Uint)
+                    && !matches!(t, Type::Matrix(_))
+            }
+            UnaryOp::Not => matches!(t, Type::Scalar(Scalar::Bool) | Type::Vector(Scalar::Bool, _)),
+            UnaryOp::BitNot => matches!(t.scalar(), Some(Scalar::Int | Scalar::Uint)) && !matches!(t, Type::Matrix(_)),
+        };
+        if ok {
+            t
+        } else {
+            let sym = match op {
+                UnaryOp::Neg => "-",
+                UnaryOp::Pos => "+",
+                UnaryOp::Not => "!",
+                UnaryOp::BitNot => "~",
+            };
+            self.error(err("E0201", format!("cannot apply `{sym}` to `{t}`"), e.span, "invalid operand"));
+            Type::Error
+        }
+    }
+
+    /// `c ? a : b`: a boolean condition and branches of one type.
+    fn ternary(&mut self, e: &Expr, c: &Expr, a: &Expr, b: &Expr) -> Type {
+        self.condition(c, "`?:` condition");
+        let ta = self.expr(a);
+        let tb = self.expr(b);
+        match unify(&ta, &tb) {
+            // `select` is a function in WGSL: literal branches become concrete.
+            Some(t) => t.concretize(),
+            None => {
+                self.error(
+                    err(
+                        "E0201",
+                        format!("`?:` branches have different types: `{ta}` and `{tb}`"),
+                        e.span,
+                        "branches must agree",
+                    )
+                    .with_label(Label::secondary(a.span, format!("`{ta}`")))
+                    .with_label(Label::secondary(b.span, format!("`{tb}`"))),
+                );
+                Type::Error
+            }
         }
     }
 
@@ -286,30 +290,9 @@ impl Checker<'_> {
         // Builtin names are reserved, so a builtin's name always means the builtin.
         let builtin = Builtin::from_name(name);
         let derivative = builtin.is_some_and(Builtin::is_derivative);
-        if derivative {
-            match self.ctx {
-                Ctx::Effect(id) => {
-                    if self.in_derivative {
-                        self.error(err("E0502", format!("`{name}` inside the operand of another derivative"), e.span, "nested derivative").with_note(
-                            "second derivatives are not supported; compute the first derivative as an effect and differentiate that",
-                        ));
-                    }
-                    self.out.derivative_calls.push((id, e.id));
-                }
-                _ => {
-                    self.error(
-                        err("E0501", format!("`{name}` outside an effect body"), e.span, "derivatives need a sample position")
-                            .with_note(if builtin == Some(Builtin::Sample) {
-                                "inside functions use `sample_level` or `sample_grad`, or pass the sampled value as an argument"
-                            } else {
-                                "compute the derivative in the effect and pass it as an argument"
-                            }),
-                    );
-                }
-            }
-        }
         let was_in_derivative = self.in_derivative;
         if derivative {
+            self.derivative_call(e, name, builtin);
             self.in_derivative = true;
         }
         let arg_types: Vec<Type> = args.iter().map(|a| self.expr(a)).collect();
@@ -332,80 +315,122 @@ impl Checker<'_> {
             };
         }
         if let Some(&(Global::Function(fid), _)) = self.globals.get(name) {
-            self.out.callees.insert(e.id, Callee::Function(fid));
-            if let Ctx::Function(current) = self.ctx {
-                self.out.functions[current.index()].calls.push(fid);
-            }
-            let params: Vec<Type> =
-                self.out.functions[fid.index()].params.iter().map(|p| self.out.locals[p.index()].ty.clone()).collect();
-            let ret = self.out.functions[fid.index()].ret.clone();
-            let decl_span = self.out.function_decl(fid).name.span;
-            // Parameters are registered when a body is checked; for a function
-            // declared later, take the types from its declaration.
-            let declared: Vec<Type> = self
-                .out
-                .function_decl(fid)
-                .params
-                .iter()
-                .map(|p| Type::from_name(&p.ty.name).unwrap_or(Type::Error))
-                .collect();
-            let params = if params.len() == declared.len() { params } else { declared };
-            if params.len() != args.len() {
-                self.error(
-                    err(
-                        "E0211",
-                        format!(
-                            "`{name}` takes {} argument{}, but {} were given",
-                            params.len(),
-                            plural(params.len()),
-                            args.len()
-                        ),
-                        e.span,
-                        "wrong number of arguments",
-                    )
-                    .with_label(Label::secondary(decl_span, "declared here")),
-                );
-                return ret;
-            }
-            for ((arg, at), pt) in args.iter().zip(&arg_types).zip(&params) {
-                self.expect_type(at, pt, arg.span, &format!("argument to `{name}`"));
-                self.check_fits(arg, pt);
-            }
-            return ret;
+            return self.call_function(e, name, fid, args, &arg_types);
         }
         if let Some(builtin) = builtin {
-            self.out.callees.insert(e.id, Callee::Builtin(builtin));
-            return match builtin_type(builtin, &arg_types) {
-                Ok((ret, splat_to)) => {
-                    if let Some(target) = splat_to {
-                        for (arg, at) in args.iter().zip(&arg_types) {
-                            if at.components() == 1 && target.vector_len().is_some() {
-                                self.out.splats.insert(arg.id, target.clone());
-                            }
+            return self.call_builtin(e, name, builtin, args, &arg_types);
+        }
+        self.unknown_function(name, callee);
+        Type::Error
+    }
+
+    /// A derivative (`ddx`, `fwidth`, `sample`, ...) needs a sample
+    /// position, so only an effect may take one, and not of another.
+    fn derivative_call(&mut self, e: &Expr, name: &str, builtin: Option<Builtin>) {
+        match self.ctx {
+            Ctx::Effect(id) => {
+                if self.in_derivative {
+                    self.error(err("E0502", format!("`{name}` inside the operand of another derivative"), e.span, "nested derivative").with_note(
+                        "second derivatives are not supported; compute the first derivative as an effect and differentiate that",
+                    ));
+                }
+                self.out.derivative_calls.push((id, e.id));
+            }
+            _ => {
+                self.error(
+                    err(
+                        "E0501",
+                        format!("`{name}` outside an effect body"),
+                        e.span,
+                        "derivatives need a sample position",
+                    )
+                    .with_note(if builtin == Some(Builtin::Sample) {
+                        "inside functions use `sample_level` or `sample_grad`, or pass the sampled value as an argument"
+                    } else {
+                        "compute the derivative in the effect and pass it as an argument"
+                    }),
+                );
+            }
+        }
+    }
+
+    /// A call of a function the program declares: its arguments' count and types.
+    fn call_function(&mut self, e: &Expr, name: &str, fid: FunctionId, args: &[Expr], arg_types: &[Type]) -> Type {
+        self.out.callees.insert(e.id, Callee::Function(fid));
+        if let Ctx::Function(current) = self.ctx {
+            self.out.functions[current.index()].calls.push(fid);
+        }
+        let params: Vec<Type> =
+            self.out.functions[fid.index()].params.iter().map(|p| self.out.locals[p.index()].ty.clone()).collect();
+        let ret = self.out.functions[fid.index()].ret.clone();
+        let decl_span = self.out.function_decl(fid).name.span;
+        // Parameters are registered when a body is checked; for a function
+        // declared later, take the types from its declaration.
+        let declared: Vec<Type> = self
+            .out
+            .function_decl(fid)
+            .params
+            .iter()
+            .map(|p| Type::from_name(&p.ty.name).unwrap_or(Type::Error))
+            .collect();
+        let params = if params.len() == declared.len() { params } else { declared };
+        if params.len() != args.len() {
+            self.error(
+                err(
+                    "E0211",
+                    format!(
+                        "`{name}` takes {} argument{}, but {} were given",
+                        params.len(),
+                        plural(params.len()),
+                        args.len()
+                    ),
+                    e.span,
+                    "wrong number of arguments",
+                )
+                .with_label(Label::secondary(decl_span, "declared here")),
+            );
+            return ret;
+        }
+        for ((arg, at), pt) in args.iter().zip(arg_types).zip(&params) {
+            self.expect_type(at, pt, arg.span, &format!("argument to `{name}`"));
+            self.check_fits(arg, pt);
+        }
+        ret
+    }
+
+    /// A call of a builtin: its signature, and the scalar arguments it splats.
+    fn call_builtin(&mut self, e: &Expr, name: &str, builtin: Builtin, args: &[Expr], arg_types: &[Type]) -> Type {
+        self.out.callees.insert(e.id, Callee::Builtin(builtin));
+        match builtin_type(builtin, arg_types) {
+            Ok((ret, splat_to)) => {
+                if let Some(target) = splat_to {
+                    for (arg, at) in args.iter().zip(arg_types) {
+                        if at.components() == 1 && target.vector_len().is_some() {
+                            self.out.splats.insert(arg.id, target.clone());
                         }
                     }
-                    ret
                 }
-                Err(BuiltinError::Arity(expected)) => {
-                    self.error(err(
-                        "E0211",
-                        format!(
-                            "`{name}` takes {expected}, but {} argument{} were given",
-                            args.len(),
-                            plural(args.len())
-                        ),
-                        e.span,
-                        "wrong number of arguments",
-                    ));
-                    Type::Error
-                }
-                Err(BuiltinError::Types(message)) => {
-                    let shown = arg_types.iter().map(|t| format!("`{t}`")).collect::<Vec<_>>().join(", ");
-                    self.error(err("E0212", message, e.span, format!("called with {shown}")));
-                    Type::Error
-                }
-            };
+                ret
+            }
+            Err(BuiltinError::Arity(expected)) => {
+                self.error(err(
+                    "E0211",
+                    format!("`{name}` takes {expected}, but {} argument{} were given", args.len(), plural(args.len())),
+                    e.span,
+                    "wrong number of arguments",
+                ));
+                Type::Error
+            }
+            Err(BuiltinError::Types(message)) => {
+                let shown = arg_types.iter().map(|t| format!("`{t}`")).collect::<Vec<_>>().join(", ");
+                self.error(err("E0212", message, e.span, format!("called with {shown}")));
+                Type::Error
+            }
         }
+    }
+
+    /// `name` names no function: say so, with the nearest name there is.
+    fn unknown_function(&mut self, name: &str, callee: &Ident) {
         let mut d = err("E0100", format!("unknown function `{name}`"), callee.span, "not found");
         let functions: Vec<String> = self
             .globals
@@ -424,7 +449,6 @@ impl Checker<'_> {
             d = d.with_note(format!("did you mean `{s}`?"));
         }
         self.error(d);
-        Type::Error
     }
 }
 

@@ -333,36 +333,7 @@ impl Checker<'_> {
         let (Some(ka), Some(kb)) = (Kind::of(&ta), Kind::of(&tb)) else { return Ok(None) };
         let (va, vb) = (self.value(a), self.value(b));
         if let Shl | Shr = op {
-            // The amount is a `u32` (a signed one is converted); the left
-            // operand is an `int` when only the amount is concrete.
-            let left = if ka.is_abstract() && !kb.is_abstract() { Kind::I32 } else { ka };
-            if left != ka {
-                self.fits_type(a, &crate::types::INT)?;
-            }
-            let Some(amounts) = vb else { return Ok(None) };
-            for &n in &amounts.values {
-                // A literal left operand is 64 bits wide: `1 << 40` fails
-                // because the result is too large, below.
-                let too_far = if left == Kind::AbsInt { op == Shl && n >= 64.0 } else { n >= 32.0 };
-                if n < 0.0 || too_far {
-                    return Err(shift_out_of_range(b.span, n, left));
-                }
-            }
-            let Some(va) = va else { return Ok(None) };
-            let mut values = vec![];
-            for i in 0..va.values.len().max(amounts.values.len()) {
-                let (x, n) = (at(&va, i), at(&amounts, i));
-                let r = match op {
-                    Shl => x * 2f64.powi(n as i32),
-                    _ if n >= 64.0 => 0.0,
-                    _ => (x / 2f64.powi(n as i32)).floor(),
-                };
-                if !left.fits(r) {
-                    return Err(out_of_range(e.span, left, false));
-                }
-                values.push(r);
-            }
-            return Ok(Some(ConstValue { ty: t.clone(), values }));
+            return self.fold_shift(e, t, op, (a, ka, va), (b, kb, vb));
         }
         let kind = Kind::common(ka, kb);
         // A literal operand converts to the other operand's type.
@@ -428,6 +399,49 @@ impl Checker<'_> {
                 values
             }
         };
+        Ok(Some(ConstValue { ty: t.clone(), values }))
+    }
+
+    /// `a << b` and `a >> b`: the amount in range for the left operand's
+    /// width, and the result too.
+    fn fold_shift(
+        &mut self,
+        e: &Expr,
+        t: &Type,
+        op: BinaryOp,
+        (a, ka, va): (&Expr, Kind, Option<ConstValue>),
+        (b, kb, vb): (&Expr, Kind, Option<ConstValue>),
+    ) -> Result<Option<ConstValue>, Diagnostic> {
+        use BinaryOp::*;
+        // The amount is a `u32` (a signed one is converted); the left
+        // operand is an `int` when only the amount is concrete.
+        let left = if ka.is_abstract() && !kb.is_abstract() { Kind::I32 } else { ka };
+        if left != ka {
+            self.fits_type(a, &crate::types::INT)?;
+        }
+        let Some(amounts) = vb else { return Ok(None) };
+        for &n in &amounts.values {
+            // A literal left operand is 64 bits wide: `1 << 40` fails
+            // because the result is too large, below.
+            let too_far = if left == Kind::AbsInt { op == Shl && n >= 64.0 } else { n >= 32.0 };
+            if n < 0.0 || too_far {
+                return Err(shift_out_of_range(b.span, n, left));
+            }
+        }
+        let Some(va) = va else { return Ok(None) };
+        let mut values = vec![];
+        for i in 0..va.values.len().max(amounts.values.len()) {
+            let (x, n) = (at(&va, i), at(&amounts, i));
+            let r = match op {
+                Shl => x * 2f64.powi(n as i32),
+                _ if n >= 64.0 => 0.0,
+                _ => (x / 2f64.powi(n as i32)).floor(),
+            };
+            if !left.fits(r) {
+                return Err(out_of_range(e.span, left, false));
+            }
+            values.push(r);
+        }
         Ok(Some(ConstValue { ty: t.clone(), values }))
     }
 
@@ -644,35 +658,7 @@ impl Checker<'_> {
                     |i: usize, j: usize| in_kind2(kind, mul(a[i], b[j]), mul(a[j], b[i]), |p, q| p - q, |p, q| p - q);
                 vec![c(1, 2), c(2, 0), c(0, 1)]
             }
-            Length | Distance | Normalize => {
-                let d: Vec<f64> = (0..n)
-                    .map(|i| match builtin {
-                        Distance => in_kind2(kind, arg(0, i), arg(1, i), |p, q| p - q, |p, q| p - q),
-                        _ => arg(0, i),
-                    })
-                    .collect();
-                let len = if d.len() == 1 {
-                    d[0].abs()
-                } else {
-                    let squares = d.iter().map(|v| in_kind2(kind, *v, *v, |p, q| p * q, |p, q| p * q));
-                    let sum = squares.fold(0.0, |s, v| in_kind2(kind, s, v, |p, q| p + q, |p, q| p + q));
-                    in_kind(kind, sum, f32::sqrt, f64::sqrt)
-                };
-                if builtin == Normalize {
-                    if len == 0.0 {
-                        return Err(domain_error(e.span, builtin, "a zero vector".into(), "vectors that are not zero"));
-                    }
-                    if len.is_finite() {
-                        d.iter().map(|v| in_kind2(kind, *v, len, |p, q| p / q, |p, q| p / q)).collect()
-                    } else {
-                        // naga rejects a length that overflows before
-                        // dividing by it: reported below as not finite.
-                        vec![len]
-                    }
-                } else {
-                    vec![len]
-                }
-            }
+            Length | Distance | Normalize => length_like(e, builtin, kind, &values, n)?,
             _ => {
                 let mut out = Vec::with_capacity(n);
                 for i in 0..n {
@@ -688,97 +674,138 @@ impl Checker<'_> {
                         };
                         return Err(domain_error(e.span, builtin, at, domain));
                     }
-                    out.push(match builtin {
-                        Abs if kind.is_int() => x.abs(),
-                        Sign if kind.is_int() => x.signum() * truth(x != 0.0),
-                        Min => {
-                            if kind.is_int() {
-                                x.min(y)
-                            } else {
-                                in_kind2(kind, x, y, f32::min, f64::min)
-                            }
-                        }
-                        Max => {
-                            if kind.is_int() {
-                                x.max(y)
-                            } else {
-                                in_kind2(kind, x, y, f32::max, f64::max)
-                            }
-                        }
-                        Clamp => {
-                            if y > z {
-                                let at = format!("low = {}, high = {}", shown(y), shown(z));
-                                return Err(domain_error(e.span, builtin, at, "low <= high"));
-                            }
-                            x.max(y).min(z)
-                        }
-                        Abs => in_kind(kind, x, f32::abs, f64::abs),
-                        Sign => {
-                            if x == 0.0 {
-                                0.0
-                            } else {
-                                x.signum()
-                            }
-                        }
-                        Sin => in_kind(kind, x, f32::sin, f64::sin),
-                        Cos => in_kind(kind, x, f32::cos, f64::cos),
-                        Tan => in_kind(kind, x, f32::tan, f64::tan),
-                        Asin => in_kind(kind, x, f32::asin, f64::asin),
-                        Acos => in_kind(kind, x, f32::acos, f64::acos),
-                        Atan => in_kind(kind, x, f32::atan, f64::atan),
-                        Sinh => in_kind(kind, x, f32::sinh, f64::sinh),
-                        Cosh => in_kind(kind, x, f32::cosh, f64::cosh),
-                        Tanh => in_kind(kind, x, f32::tanh, f64::tanh),
-                        Exp => in_kind(kind, x, f32::exp, f64::exp),
-                        Exp2 => in_kind(kind, x, f32::exp2, f64::exp2),
-                        Log => in_kind(kind, x, f32::ln, f64::ln),
-                        Log2 => in_kind(kind, x, f32::log2, f64::log2),
-                        Sqrt => in_kind(kind, x, f32::sqrt, f64::sqrt),
-                        InverseSqrt => in_kind(kind, x, |v| 1.0 / v.sqrt(), |v| 1.0 / v.sqrt()),
-                        Floor => in_kind(kind, x, f32::floor, f64::floor),
-                        Ceil => in_kind(kind, x, f32::ceil, f64::ceil),
-                        Fract => in_kind(kind, x, |v| v - v.floor(), |v| v - v.floor()),
-                        Round => in_kind(kind, x, f32::round_ties_even, f64::round_ties_even),
-                        Trunc => in_kind(kind, x, f32::trunc, f64::trunc),
-                        Saturate => in_kind(kind, x, |v| v.clamp(0.0, 1.0), |v| v.clamp(0.0, 1.0)),
-                        Radians => in_kind(kind, x, f32::to_radians, f64::to_radians),
-                        Degrees => in_kind(kind, x, f32::to_degrees, f64::to_degrees),
-                        Pow => in_kind2(kind, x, y, f32::powf, f64::powf),
-                        Atan2 => in_kind2(kind, x, y, f32::atan2, f64::atan2),
-                        Step => truth(x <= y),
-                        _ => return Ok(None),
-                    });
+                    if builtin == Clamp && y > z {
+                        let at = format!("low = {}, high = {}", shown(y), shown(z));
+                        return Err(domain_error(e.span, builtin, at, "low <= high"));
+                    }
+                    let Some(r) = componentwise(builtin, kind, x, y, z) else { return Ok(None) };
+                    out.push(r);
                 }
                 out
             }
         };
         let result_kind = Kind::of(t).unwrap_or(kind);
         if let Some(bad) = result.iter().find(|v| !result_kind.fits(**v)) {
-            let infinite = !bad.is_finite();
-            let args_shown = values
-                .iter()
-                .map(|v| {
-                    let parts: Vec<String> = v.values.iter().map(|x| shown(*x)).collect();
-                    if parts.len() == 1 { parts[0].clone() } else { format!("({})", parts.join(", ")) }
-                })
-                .collect::<Vec<_>>()
-                .join(", ");
-            let why = if infinite {
-                "is not a finite number".to_string()
-            } else {
-                format!("is outside the `{}` range", result_kind.name())
-            };
-            let name = builtin.name();
-            return Err(err(
-                "E0213",
-                format!("`{name}` of constant arguments overflows `{}`", result_kind.name()),
-                e.span,
-                format!("`{name}({args_shown})` {why}"),
-            )
-            .with_note("WGSL evaluates calls on constants when the shader is created, and rejects this one"));
+            return Err(builtin_overflow(e, builtin, result_kind, &values, !bad.is_finite()));
         }
         Ok(Some(ConstValue { ty: t.clone(), values: result.into_iter().map(|v| result_kind.round(v)).collect() }))
     }
+}
+
+/// A builtin applied to one component of its arguments (`y`, `z`: 0 where
+/// it takes fewer), in the arithmetic of `kind`; none for a builtin not
+/// folded here.
+fn componentwise(builtin: Builtin, kind: Kind, x: f64, y: f64, z: f64) -> Option<f64> {
+    use Builtin::*;
+    Some(match builtin {
+        Abs if kind.is_int() => x.abs(),
+        Sign if kind.is_int() => x.signum() * truth(x != 0.0),
+        Min if kind.is_int() => x.min(y),
+        Min => in_kind2(kind, x, y, f32::min, f64::min),
+        Max if kind.is_int() => x.max(y),
+        Max => in_kind2(kind, x, y, f32::max, f64::max),
+        Clamp => x.max(y).min(z),
+        Abs => in_kind(kind, x, f32::abs, f64::abs),
+        Sign if x == 0.0 => 0.0,
+        Sign => x.signum(),
+        Sin => in_kind(kind, x, f32::sin, f64::sin),
+        Cos => in_kind(kind, x, f32::cos, f64::cos),
+        Tan => in_kind(kind, x, f32::tan, f64::tan),
+        Asin => in_kind(kind, x, f32::asin, f64::asin),
+        Acos => in_kind(kind, x, f32::acos, f64::acos),
+        Atan => in_kind(kind, x, f32::atan, f64::atan),
+        Sinh => in_kind(kind, x, f32::sinh, f64::sinh),
+        Cosh => in_kind(kind, x, f32::cosh, f64::cosh),
+        Tanh => in_kind(kind, x, f32::tanh, f64::tanh),
+        Exp => in_kind(kind, x, f32::exp, f64::exp),
+        Exp2 => in_kind(kind, x, f32::exp2, f64::exp2),
+        Log => in_kind(kind, x, f32::ln, f64::ln),
+        Log2 => in_kind(kind, x, f32::log2, f64::log2),
+        Sqrt => in_kind(kind, x, f32::sqrt, f64::sqrt),
+        InverseSqrt => in_kind(kind, x, |v| 1.0 / v.sqrt(), |v| 1.0 / v.sqrt()),
+        Floor => in_kind(kind, x, f32::floor, f64::floor),
+        Ceil => in_kind(kind, x, f32::ceil, f64::ceil),
+        Fract => in_kind(kind, x, |v| v - v.floor(), |v| v - v.floor()),
+        Round => in_kind(kind, x, f32::round_ties_even, f64::round_ties_even),
+        Trunc => in_kind(kind, x, f32::trunc, f64::trunc),
+        Saturate => in_kind(kind, x, |v| v.clamp(0.0, 1.0), |v| v.clamp(0.0, 1.0)),
+        Radians => in_kind(kind, x, f32::to_radians, f64::to_radians),
+        Degrees => in_kind(kind, x, f32::to_degrees, f64::to_degrees),
+        Pow => in_kind2(kind, x, y, f32::powf, f64::powf),
+        Atan2 => in_kind2(kind, x, y, f32::atan2, f64::atan2),
+        Step => truth(x <= y),
+        _ => return None,
+    })
+}
+
+/// `length(v)`, `distance(a, b)` and `normalize(v)` over `n` components,
+/// summed in the order naga sums them.
+fn length_like(
+    e: &Expr,
+    builtin: Builtin,
+    kind: Kind,
+    values: &[ConstValue],
+    n: usize,
+) -> Result<Vec<f64>, Diagnostic> {
+    let arg = |k: usize, i: usize| at(&values[k], i);
+    let d: Vec<f64> = (0..n)
+        .map(|i| match builtin {
+            Builtin::Distance => in_kind2(kind, arg(0, i), arg(1, i), |p, q| p - q, |p, q| p - q),
+            _ => arg(0, i),
+        })
+        .collect();
+    let len = if d.len() == 1 {
+        d[0].abs()
+    } else {
+        let squares = d.iter().map(|v| in_kind2(kind, *v, *v, |p, q| p * q, |p, q| p * q));
+        let sum = squares.fold(0.0, |s, v| in_kind2(kind, s, v, |p, q| p + q, |p, q| p + q));
+        in_kind(kind, sum, f32::sqrt, f64::sqrt)
+    };
+    if builtin != Builtin::Normalize {
+        return Ok(vec![len]);
+    }
+    if len == 0.0 {
+        return Err(domain_error(e.span, builtin, "a zero vector".into(), "vectors that are not zero"));
+    }
+    if len.is_finite() {
+        Ok(d.iter().map(|v| in_kind2(kind, *v, len, |p, q| p / q, |p, q| p / q)).collect())
+    } else {
+        // naga rejects a length that overflows before dividing by it:
+        // reported by the caller as not finite.
+        Ok(vec![len])
+    }
+}
+
+/// A builtin of constant arguments whose result `result_kind` cannot hold
+/// (`infinite`: not a finite number), as WGSL rejects it.
+fn builtin_overflow(
+    e: &Expr,
+    builtin: Builtin,
+    result_kind: Kind,
+    values: &[ConstValue],
+    infinite: bool,
+) -> Diagnostic {
+    let args_shown = values
+        .iter()
+        .map(|v| {
+            let parts: Vec<String> = v.values.iter().map(|x| shown(*x)).collect();
+            if parts.len() == 1 { parts[0].clone() } else { format!("({})", parts.join(", ")) }
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    let why = if infinite {
+        "is not a finite number".to_string()
+    } else {
+        format!("is outside the `{}` range", result_kind.name())
+    };
+    let name = builtin.name();
+    err(
+        "E0213",
+        format!("`{name}` of constant arguments overflows `{}`", result_kind.name()),
+        e.span,
+        format!("`{name}({args_shown})` {why}"),
+    )
+    .with_note("WGSL evaluates calls on constants when the shader is created, and rejects this one")
 }
 
 /// One step of a builtin's arithmetic (`dot`), its failure reported as the builtin's.

@@ -22,32 +22,55 @@ impl Checker<'_> {
         step: Option<&Stmt>,
         body: &Stmt,
     ) {
-        let var = match init.map(|i| &i.kind) {
-            Some(StmtKind::Local { name, init: Some(v), ty }) => {
-                if self.const_eval(v).is_none() {
-                    self.error(err("E0401", "loop has no static bound", v.span, "the start value must be a constant"));
-                    return;
-                }
-                if !matches!(Type::from_name(&ty.name), Some(Type::Scalar(Scalar::Int | Scalar::Uint))) {
-                    self.error(err(
-                        "E0401",
-                        "loop has no static bound",
-                        ty.span,
-                        "the loop variable must be an `int` or `uint`",
-                    ));
-                    return;
-                }
-                name.name.clone()
-            }
-            _ => {
-                self.error(
-                    err("E0401", "loop has no static bound", s.span, "expected `for (int i = START; i < END; i++)`")
-                        .with_note("the loop must declare its counter with a constant start value"),
-                );
-                return;
-            }
+        let Some(var) = self.loop_counter(s, init) else { return };
+        if !self.loop_condition_is_static(s, &var, cond) || !self.loop_step_is_static(s, &var, step) {
+            return;
+        }
+        if !self.loop_trips_are_bounded(s, &var, init, cond, step) {
+            return;
+        }
+        if let Some(span) = stmt_assigns_name(body, &var) {
+            self.error(
+                err(
+                    "E0401",
+                    "loop has no static bound",
+                    span,
+                    format!("the loop variable `{var}` is assigned in the body"),
+                )
+                .with_label(Label::secondary(init.map(|i| i.span).unwrap_or(s.span), "declared here")),
+            );
+        }
+    }
+
+    /// The loop's counter: an `int` or `uint` declared with a constant start
+    /// value (else an error, and none).
+    fn loop_counter(&mut self, s: &Stmt, init: Option<&Stmt>) -> Option<String> {
+        let Some(StmtKind::Local { name, init: Some(v), ty }) = init.map(|i| &i.kind) else {
+            self.error(
+                err("E0401", "loop has no static bound", s.span, "expected `for (int i = START; i < END; i++)`")
+                    .with_note("the loop must declare its counter with a constant start value"),
+            );
+            return None;
         };
-        let is_var = |e: &Expr| matches!(&e.kind, ExprKind::Name(n) if *n == var);
+        if self.const_eval(v).is_none() {
+            self.error(err("E0401", "loop has no static bound", v.span, "the start value must be a constant"));
+            return None;
+        }
+        if !matches!(Type::from_name(&ty.name), Some(Type::Scalar(Scalar::Int | Scalar::Uint))) {
+            self.error(err(
+                "E0401",
+                "loop has no static bound",
+                ty.span,
+                "the loop variable must be an `int` or `uint`",
+            ));
+            return None;
+        }
+        Some(name.name.clone())
+    }
+
+    /// Whether the condition compares the counter with a constant (else an error).
+    fn loop_condition_is_static(&mut self, s: &Stmt, var: &str, cond: Option<&Expr>) -> bool {
+        let is_var = |e: &Expr| matches!(&e.kind, ExprKind::Name(n) if n == var);
         let bound = match cond.map(|c| &c.kind) {
             Some(ExprKind::Binary(BinaryOp::Lt | BinaryOp::Le | BinaryOp::Gt | BinaryOp::Ge | BinaryOp::Ne, a, b))
                 if is_var(a) =>
@@ -62,13 +85,13 @@ impl Checker<'_> {
             _ => None,
         };
         match bound {
-            Some(b) if self.const_eval(b).is_some() => {}
+            Some(b) if self.const_eval(b).is_some() => true,
             Some(b) => {
                 self.error(
                     err("E0401", "loop has no static bound", b.span, "not a constant")
                         .with_note("use a constant bound and test the dynamic limit inside: `for (int i = 0; i < 16; i++) { if (i >= count) break; ... }`"),
                 );
-                return;
+                false
             }
             None => {
                 let span = cond.map(|c| c.span).unwrap_or(s.span);
@@ -78,9 +101,14 @@ impl Checker<'_> {
                     span,
                     format!("expected `{var} < CONSTANT` (or <=, >, >=, !=)"),
                 ));
-                return;
+                false
             }
         }
+    }
+
+    /// Whether the step moves the counter by a constant (else an error).
+    fn loop_step_is_static(&mut self, s: &Stmt, var: &str, step: Option<&Stmt>) -> bool {
+        let is_var = |e: &Expr| matches!(&e.kind, ExprKind::Name(n) if n == var);
         let step_ok = match step.map(|st| &st.kind) {
             Some(StmtKind::Step { target, .. }) => is_var(target),
             Some(StmtKind::Assign { target, op: AssignOp::Add | AssignOp::Sub, value }) => {
@@ -96,9 +124,21 @@ impl Checker<'_> {
                 span,
                 format!("expected `{var}++`, `{var}--` or `{var} += CONSTANT`"),
             ));
-            return;
         }
-        // The shape is right; now the trip count must be finite and modest.
+        step_ok
+    }
+
+    /// With the shape right, whether the trip count is at most
+    /// [`MAX_LOOP_TRIPS`] (else an error); records the count.
+    fn loop_trips_are_bounded(
+        &mut self,
+        s: &Stmt,
+        var: &str,
+        init: Option<&Stmt>,
+        cond: Option<&Expr>,
+        step: Option<&Stmt>,
+    ) -> bool {
+        let is_var = |e: &Expr| matches!(&e.kind, ExprKind::Name(n) if n == var);
         let start = match init.map(|i| &i.kind) {
             Some(StmtKind::Local { init: Some(v), .. }) => self.const_eval(v).map(|c| c.values[0]),
             _ => None,
@@ -115,49 +155,36 @@ impl Checker<'_> {
             Some(StmtKind::Assign { op: AssignOp::Sub, value, .. }) => self.const_eval(value).map(|c| -c.values[0]),
             _ => None,
         };
-        if let (Some(mut i), Some(limit), Some(delta)) = (start, limit, delta) {
-            let holds = |i: f64| {
-                let (x, y) = if var_left { (i, limit) } else { (limit, i) };
-                match op {
-                    BinaryOp::Lt => x < y,
-                    BinaryOp::Le => x <= y,
-                    BinaryOp::Gt => x > y,
-                    BinaryOp::Ge => x >= y,
-                    _ => x != y,
-                }
-            };
-            let mut trips = 0u64;
-            while holds(i) && trips <= MAX_LOOP_TRIPS {
-                i += delta;
-                trips += 1;
+        let (Some(mut i), Some(limit), Some(delta)) = (start, limit, delta) else { return true };
+        let holds = |i: f64| {
+            let (x, y) = if var_left { (i, limit) } else { (limit, i) };
+            match op {
+                BinaryOp::Lt => x < y,
+                BinaryOp::Le => x <= y,
+                BinaryOp::Gt => x > y,
+                BinaryOp::Ge => x >= y,
+                _ => x != y,
             }
-            if trips <= MAX_LOOP_TRIPS {
-                self.out.loop_trips.insert(s.id, trips);
-            }
-            if trips > MAX_LOOP_TRIPS {
-                self.error(
-                    err(
-                        "E0402",
-                        "loop does not terminate within the iteration limit",
-                        s.span,
-                        format!("runs more than {MAX_LOOP_TRIPS} times"),
-                    )
-                    .with_note("check the direction of the step against the condition"),
-                );
-                return;
-            }
+        };
+        let mut trips = 0u64;
+        while holds(i) && trips <= MAX_LOOP_TRIPS {
+            i += delta;
+            trips += 1;
         }
-        if let Some(span) = stmt_assigns_name(body, &var) {
-            self.error(
-                err(
-                    "E0401",
-                    "loop has no static bound",
-                    span,
-                    format!("the loop variable `{var}` is assigned in the body"),
-                )
-                .with_label(Label::secondary(init.map(|i| i.span).unwrap_or(s.span), "declared here")),
-            );
+        if trips <= MAX_LOOP_TRIPS {
+            self.out.loop_trips.insert(s.id, trips);
+            return true;
         }
+        self.error(
+            err(
+                "E0402",
+                "loop does not terminate within the iteration limit",
+                s.span,
+                format!("runs more than {MAX_LOOP_TRIPS} times"),
+            )
+            .with_note("check the direction of the step against the condition"),
+        );
+        false
     }
 }
 

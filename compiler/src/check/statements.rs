@@ -123,47 +123,7 @@ impl Checker<'_> {
                 let id = self.declare_local(name, declared);
                 self.out.local_decls.insert(s.id, id);
             }
-            StmtKind::Assign { target, op, value } => {
-                let target_ty = self.lvalue(target);
-                let value_ty = self.expr(value);
-                // Whatever the operator, a literal value converts to the target's type.
-                self.check_fits(value, &target_ty);
-                // `x /= 0` is `x = x / 0`: an integer division by a constant zero.
-                if *op == AssignOp::Div
-                    && matches!(target_ty.scalar(), Some(Scalar::Int | Scalar::Uint))
-                    && self.out.constants.get(&value.id).is_some_and(|v| v.values.contains(&0.0))
-                {
-                    self.error(err(
-                        "E0205",
-                        "division by zero in a constant expression",
-                        value.span,
-                        "divides by zero",
-                    ));
-                }
-                match op {
-                    AssignOp::Set => self.expect_type(&value_ty, &target_ty, value.span, "assignment"),
-                    // Either side already reported.
-                    _ if target_ty.is_error() || value_ty.is_error() => {}
-                    _ => {
-                        let bop = match op {
-                            AssignOp::Add => BinaryOp::Add,
-                            AssignOp::Sub => BinaryOp::Sub,
-                            AssignOp::Mul => BinaryOp::Mul,
-                            _ => BinaryOp::Div,
-                        };
-                        match binary_type(bop, &target_ty, &value_ty) {
-                            Ok(result) if result.converts_to(&target_ty) => {}
-                            Ok(result) => self.error(err(
-                                "E0201",
-                                format!("`{}=` would change the type from `{target_ty}` to `{result}`", bop.symbol()),
-                                s.span,
-                                "type changes",
-                            )),
-                            Err(message) => self.error(err("E0201", message, s.span, "invalid operands")),
-                        }
-                    }
-                }
-            }
+            StmtKind::Assign { target, op, value } => self.assign(s, target, *op, value),
             StmtKind::Step { target, .. } => {
                 let t = self.lvalue(target);
                 if !matches!(t, Type::Scalar(Scalar::Int | Scalar::Uint | Scalar::Float) | Type::Error) {
@@ -183,77 +143,131 @@ impl Checker<'_> {
                 }
             }
             StmtKind::For { init, cond, step, body } => {
-                self.scopes.push(HashMap::new());
-                if let Some(i) = init {
-                    self.stmt(i);
-                }
-                if let Some(c) = cond {
-                    self.condition(c, "loop condition");
-                }
-                if let Some(st) = step {
-                    self.stmt(st);
-                }
-                self.loop_depth += 1;
-                self.scoped_stmt(body);
-                self.loop_depth -= 1;
-                self.check_static_bound(s, init.as_deref(), cond.as_ref(), step.as_deref(), body);
-                self.scopes.pop();
+                self.for_stmt(s, init.as_deref(), cond.as_ref(), step.as_deref(), body)
             }
             StmtKind::Block(b) => self.block(b),
-            StmtKind::Refine => match self.ctx {
-                Ctx::Effect(id) if self.out.effects[id.index()].rate == Rate::Coarse => {
-                    self.out.effects[id.index()].has_refine = true;
-                }
-                Ctx::Effect(id) => {
-                    let e = &self.out.effects[id.index()];
-                    let (name, rate_span) = (e.name.clone(), self.out.effect_decl(id).rate_span);
-                    self.error(
-                        err(
-                            "E0304",
-                            "`refine` outside a coarse effect",
-                            s.span,
-                            "refine is only meaningful at coarse rate",
-                        )
-                        .with_label(Label::secondary(rate_span, format!("`{name}` is computed per pixel"))),
-                    );
-                }
-                _ => self.error(
-                    err("E0304", "`refine` outside a coarse effect", s.span, "not inside a coarse effect")
-                        .with_note("`refine;` marks the enclosing coarse effect refined for this coarse sample"),
-                ),
-            },
-            StmtKind::Return(value) => match self.ctx {
-                Ctx::Function(id) => {
-                    let ret = self.out.functions[id.index()].ret.clone();
-                    match value {
-                        Some(v) => {
-                            let t = self.expr(v);
-                            self.expect_type(&t, &ret, v.span, "return value");
-                            self.check_fits(v, &ret);
-                        }
-                        None => self.error(err(
-                            "E0201",
-                            format!("this function must return a `{ret}`"),
-                            s.span,
-                            "missing value",
-                        )),
-                    }
-                }
-                _ => {
-                    if let Some(v) = value {
-                        self.expr(v);
-                    }
-                    self.error(
-                        err("E0305", "`return` in an effect", s.span, "effects do not return")
-                            .with_note("assign the effect's own name instead: `name = value;`"),
-                    );
-                }
-            },
+            StmtKind::Refine => self.refine_stmt(s),
+            StmtKind::Return(value) => self.return_stmt(s, value.as_ref()),
             StmtKind::Break | StmtKind::Continue => {
                 if self.loop_depth == 0 {
                     let word = if matches!(s.kind, StmtKind::Break) { "break" } else { "continue" };
                     self.error(err("E0306", format!("`{word}` outside a loop"), s.span, "not inside a `for` loop"));
                 }
+            }
+        }
+    }
+
+    /// `target op= value`: the value fits the target's type, and a compound
+    /// operator keeps it.
+    fn assign(&mut self, s: &Stmt, target: &Expr, op: AssignOp, value: &Expr) {
+        let target_ty = self.lvalue(target);
+        let value_ty = self.expr(value);
+        // Whatever the operator, a literal value converts to the target's type.
+        self.check_fits(value, &target_ty);
+        // `x /= 0` is `x = x / 0`: an integer division by a constant zero.
+        if op == AssignOp::Div
+            && matches!(target_ty.scalar(), Some(Scalar::Int | Scalar::Uint))
+            && self.out.constants.get(&value.id).is_some_and(|v| v.values.contains(&0.0))
+        {
+            self.error(err("E0205", "division by zero in a constant expression", value.span, "divides by zero"));
+        }
+        match op {
+            AssignOp::Set => self.expect_type(&value_ty, &target_ty, value.span, "assignment"),
+            // Either side already reported.
+            _ if target_ty.is_error() || value_ty.is_error() => {}
+            _ => {
+                let bop = match op {
+                    AssignOp::Add => BinaryOp::Add,
+                    AssignOp::Sub => BinaryOp::Sub,
+                    AssignOp::Mul => BinaryOp::Mul,
+                    _ => BinaryOp::Div,
+                };
+                match binary_type(bop, &target_ty, &value_ty) {
+                    Ok(result) if result.converts_to(&target_ty) => {}
+                    Ok(result) => self.error(err(
+                        "E0201",
+                        format!("`{}=` would change the type from `{target_ty}` to `{result}`", bop.symbol()),
+                        s.span,
+                        "type changes",
+                    )),
+                    Err(message) => self.error(err("E0201", message, s.span, "invalid operands")),
+                }
+            }
+        }
+    }
+
+    /// A `for` loop: its own scope for the counter, and a static bound.
+    fn for_stmt(&mut self, s: &Stmt, init: Option<&Stmt>, cond: Option<&Expr>, step: Option<&Stmt>, body: &Stmt) {
+        self.scopes.push(HashMap::new());
+        if let Some(i) = init {
+            self.stmt(i);
+        }
+        if let Some(c) = cond {
+            self.condition(c, "loop condition");
+        }
+        if let Some(st) = step {
+            self.stmt(st);
+        }
+        self.loop_depth += 1;
+        self.scoped_stmt(body);
+        self.loop_depth -= 1;
+        self.check_static_bound(s, init, cond, step, body);
+        self.scopes.pop();
+    }
+
+    /// `refine;` is only meaningful in a coarse effect.
+    fn refine_stmt(&mut self, s: &Stmt) {
+        match self.ctx {
+            Ctx::Effect(id) if self.out.effects[id.index()].rate == Rate::Coarse => {
+                self.out.effects[id.index()].has_refine = true;
+            }
+            Ctx::Effect(id) => {
+                let e = &self.out.effects[id.index()];
+                let (name, rate_span) = (e.name.clone(), self.out.effect_decl(id).rate_span);
+                self.error(
+                    err(
+                        "E0304",
+                        "`refine` outside a coarse effect",
+                        s.span,
+                        "refine is only meaningful at coarse rate",
+                    )
+                    .with_label(Label::secondary(rate_span, format!("`{name}` is computed per pixel"))),
+                );
+            }
+            _ => self.error(
+                err("E0304", "`refine` outside a coarse effect", s.span, "not inside a coarse effect")
+                    .with_note("`refine;` marks the enclosing coarse effect refined for this coarse sample"),
+            ),
+        }
+    }
+
+    /// `return` only in functions, with a value of the function's type.
+    fn return_stmt(&mut self, s: &Stmt, value: Option<&Expr>) {
+        match self.ctx {
+            Ctx::Function(id) => {
+                let ret = self.out.functions[id.index()].ret.clone();
+                match value {
+                    Some(v) => {
+                        let t = self.expr(v);
+                        self.expect_type(&t, &ret, v.span, "return value");
+                        self.check_fits(v, &ret);
+                    }
+                    None => self.error(err(
+                        "E0201",
+                        format!("this function must return a `{ret}`"),
+                        s.span,
+                        "missing value",
+                    )),
+                }
+            }
+            _ => {
+                if let Some(v) = value {
+                    self.expr(v);
+                }
+                self.error(
+                    err("E0305", "`return` in an effect", s.span, "effects do not return")
+                        .with_note("assign the effect's own name instead: `name = value;`"),
+                );
             }
         }
     }
