@@ -291,9 +291,9 @@ fn tiles(entry: &str) -> Dispatch {
     dispatch(entry, Workgroups::Tiles)
 }
 
-/// The stage group (group 2) the kernel declares, in binding order: what
-/// the code generator writes and what a runtime binds.
-pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
+/// The resources a kernel of `kernel`'s kind binds for its own work, before
+/// those every per-pixel pass adds (tile lists, statistics, outputs).
+fn kernel_resources(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
     use BindingType as T;
     use ResourceId as R;
     let h = &layout.hierarchical;
@@ -302,7 +302,7 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
     let block = kernel.block.unwrap_or(1);
     let interface = layout.interface.binding;
     let shading_rate = at(layout.shading_rate.binding, R::ShadingRate, T::UintTexture);
-    let mut bindings = match kernel.kind {
+    match kernel.kind {
         KernelKind::Coarse => {
             let mut coarse = vec![at(interface, R::Records { block }, T::RecordStorageTexture)];
             if layout.neighbours.words > 0 {
@@ -364,7 +364,19 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
             fine.extend(level_values(layout));
             fine
         }
-    };
+    }
+}
+
+/// The stage group (group 2) the kernel declares, in binding order: what
+/// the code generator writes and what a runtime binds.
+pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
+    use BindingType as T;
+    use ResourceId as R;
+    let h = &layout.hierarchical;
+    let at = |binding, resource, ty| PassBinding { binding, resource, ty };
+    let buffer = |binding, resource, read_only| at(binding, resource, T::Buffer { read_only });
+    let block = kernel.block.unwrap_or(1);
+    let mut bindings = kernel_resources(layout, kernel);
     // With a background rule the per-pixel passes that write the outputs shade over tile lists.
     if kernel.kind.has_tile_lists() && layout.has_background() {
         bindings.push(buffer(h.work_binding, R::TileLists, false));

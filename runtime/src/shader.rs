@@ -89,6 +89,33 @@ struct Timestamps {
     period_ns: f32,
 }
 
+impl Timestamps {
+    /// A query set of `queries` timestamps, with its resolve and readback buffers.
+    fn new(device: &wgpu::Device, queries: u32) -> Timestamps {
+        let bytes = 8 * u64::from(queries);
+        Timestamps {
+            set: device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("mrsl timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: queries,
+            }),
+            resolve: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("mrsl timestamps resolve"),
+                size: bytes,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            readback: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("mrsl timestamps readback"),
+                size: bytes,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            period_ns: 1.0,
+        }
+    }
+}
+
 /// A pipeline: the kernel and the entry point.
 type PipelineKey = (KernelRef, String);
 
@@ -129,62 +156,8 @@ impl Shader {
         let resources_layout = groups::resources_layout(device, &layout);
         let gbuffer_layout = groups::gbuffer_layout(device, &layout);
         let arguments_layout = groups::arguments_layout(device);
-        // The entry points that write indirect arguments also see group 3.
-        let writes_arguments: HashSet<(KernelRef, &str)> = plan
-            .modes
-            .iter()
-            .flat_map(|m| m.passes())
-            .flat_map(|p| p.dispatches.iter().filter(|d| d.arguments.is_some()).map(|d| (p.kernel, d.entry.as_str())))
-            .collect();
-        // A kernel kind this device cannot run (its stage group beyond the
-        // device's limits, say the hierarchical kernel's outputs and records
-        // beyond `max_storage_textures_per_shader_stage`) refuses the modes
-        // that need it when they are dispatched, not every mode here: each
-        // kernel's layout and pipelines are made under their own error scope.
-        let mut unavailable: HashMap<KernelKind, String> = HashMap::new();
-        let mut stage_layouts = HashMap::new();
-        let mut pipelines = HashMap::new();
-        for kernel in &program.kernels {
-            let kernel_ref = KernelRef::new(kernel.kind, kernel.block_size);
-            let Some(pass) = plan.modes.iter().flat_map(|m| m.passes()).find(|p| p.kernel == kernel_ref) else {
-                continue;
-            };
-            if let Some(reason) = groups::missing_feature(device, &pass.bindings) {
-                unavailable.insert(kernel.kind, reason);
-                continue;
-            }
-            let kind_scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-            let stage_layout = groups::stage_layout(device, kernel.kind.name(), &pass.bindings);
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(kernel.kind.name()),
-                source: wgpu::ShaderSource::Wgsl(kernel.wgsl.as_str().into()),
-            });
-            let groups = [Some(&resources_layout), Some(&gbuffer_layout), Some(&stage_layout), Some(&arguments_layout)];
-            let pipeline_layout = |groups: &[Option<&wgpu::BindGroupLayout>]| {
-                device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some(kernel.kind.name()),
-                    bind_group_layouts: groups,
-                    immediate_size: 0,
-                })
-            };
-            let (plain, with_arguments) = (pipeline_layout(&groups[..3]), pipeline_layout(&groups));
-            for &entry in kernel.entry_points() {
-                let layout = if writes_arguments.contains(&(kernel_ref, entry)) { &with_arguments } else { &plain };
-                let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(entry),
-                    layout: Some(layout),
-                    module: &module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    cache: None,
-                });
-                pipelines.insert((kernel_ref, entry.to_string()), pipeline);
-            }
-            stage_layouts.insert(kernel_ref, stage_layout);
-            if let Some(error) = pollster::block_on(kind_scope.pop()) {
-                unavailable.insert(kernel.kind, describe(&error));
-            }
-        }
+        let KernelPipelines { stage_layouts, pipelines, unavailable } =
+            kernel_pipelines(device, program, [&resources_layout, &gbuffer_layout, &arguments_layout]);
         let uniform_buffer = |label, size: u32| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -195,30 +168,10 @@ impl Shader {
         };
         let control = uniform_buffer("mrsl control", layout.control.size);
         let uniforms = layout.uniforms.as_ref().map(|u| uniform_buffer("mrsl uniforms", u.size));
-        let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| {
-            let queries = 2 * plan.most_passes().max(1) as u32;
-            let bytes = 8 * u64::from(queries);
-            Timestamps {
-                set: device.create_query_set(&wgpu::QuerySetDescriptor {
-                    label: Some("mrsl timestamps"),
-                    ty: wgpu::QueryType::Timestamp,
-                    count: queries,
-                }),
-                resolve: device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("mrsl timestamps resolve"),
-                    size: bytes,
-                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                    mapped_at_creation: false,
-                }),
-                readback: device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("mrsl timestamps readback"),
-                    size: bytes,
-                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                }),
-                period_ns: 1.0,
-            }
-        });
+        let timestamps = device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY)
+            .then(|| Timestamps::new(device, 2 * plan.most_passes().max(1) as u32));
         if let Some(error) = pollster::block_on(scope.pop()) {
             return Err(Error::Pipeline(describe(&error)));
         }
@@ -572,4 +525,79 @@ impl<'a> Frame<'a> {
         self.stage_groups.insert(pass.kernel, group.clone());
         group
     }
+}
+
+/// Each kernel's stage layout and pipelines, and the kernel kinds the device
+/// refused with its reasons.
+struct KernelPipelines {
+    stage_layouts: HashMap<KernelRef, wgpu::BindGroupLayout>,
+    pipelines: HashMap<PipelineKey, wgpu::ComputePipeline>,
+    unavailable: HashMap<KernelKind, String>,
+}
+
+/// Makes every kernel's stage layout and pipelines over the shared groups
+/// (`resources`, `gbuffer`, `arguments`: groups 0, 1 and 3).
+fn kernel_pipelines(
+    device: &wgpu::Device,
+    program: &CompiledProgram,
+    [resources_layout, gbuffer_layout, arguments_layout]: [&wgpu::BindGroupLayout; 3],
+) -> KernelPipelines {
+    let plan = &program.layout.plan;
+    // The entry points that write indirect arguments also see group 3.
+    let writes_arguments: HashSet<(KernelRef, &str)> = plan
+        .modes
+        .iter()
+        .flat_map(|m| m.passes())
+        .flat_map(|p| p.dispatches.iter().filter(|d| d.arguments.is_some()).map(|d| (p.kernel, d.entry.as_str())))
+        .collect();
+    // A kernel kind this device cannot run (its stage group beyond the
+    // device's limits, say the hierarchical kernel's outputs and records
+    // beyond `max_storage_textures_per_shader_stage`) refuses the modes
+    // that need it when they are dispatched, not every mode here: each
+    // kernel's layout and pipelines are made under their own error scope.
+    let mut unavailable: HashMap<KernelKind, String> = HashMap::new();
+    let mut stage_layouts = HashMap::new();
+    let mut pipelines = HashMap::new();
+    for kernel in &program.kernels {
+        let kernel_ref = KernelRef::new(kernel.kind, kernel.block_size);
+        let Some(pass) = plan.modes.iter().flat_map(|m| m.passes()).find(|p| p.kernel == kernel_ref) else {
+            continue;
+        };
+        if let Some(reason) = groups::missing_feature(device, &pass.bindings) {
+            unavailable.insert(kernel.kind, reason);
+            continue;
+        }
+        let kind_scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let stage_layout = groups::stage_layout(device, kernel.kind.name(), &pass.bindings);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(kernel.kind.name()),
+            source: wgpu::ShaderSource::Wgsl(kernel.wgsl.as_str().into()),
+        });
+        let groups = [Some(resources_layout), Some(gbuffer_layout), Some(&stage_layout), Some(arguments_layout)];
+        let pipeline_layout = |groups: &[Option<&wgpu::BindGroupLayout>]| {
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(kernel.kind.name()),
+                bind_group_layouts: groups,
+                immediate_size: 0,
+            })
+        };
+        let (plain, with_arguments) = (pipeline_layout(&groups[..3]), pipeline_layout(&groups));
+        for &entry in kernel.entry_points() {
+            let layout = if writes_arguments.contains(&(kernel_ref, entry)) { &with_arguments } else { &plain };
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            pipelines.insert((kernel_ref, entry.to_string()), pipeline);
+        }
+        stage_layouts.insert(kernel_ref, stage_layout);
+        if let Some(error) = pollster::block_on(kind_scope.pop()) {
+            unavailable.insert(kernel.kind, describe(&error));
+        }
+    }
+    KernelPipelines { stage_layouts, pipelines, unavailable }
 }

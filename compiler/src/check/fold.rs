@@ -595,27 +595,7 @@ impl Checker<'_> {
                 }
             }
         }
-        if matches!(
-            builtin,
-            Mix | Lerp
-                | Smoothstep
-                | Reflect
-                | Refract
-                | FaceForward
-                | Determinant
-                | Transpose
-                | Ddx
-                | Ddy
-                | Fwidth
-                | DdxSurface
-                | DdySurface
-                | FwidthSurface
-                | Sample
-                | SampleLevel
-                | SampleGrad
-                | Load
-                | TextureSize
-        ) {
+        if !folded(builtin) {
             return Ok(None);
         }
         let mut values = vec![];
@@ -690,6 +670,34 @@ impl Checker<'_> {
         }
         Ok(Some(ConstValue { ty: t.clone(), values: result.into_iter().map(|v| result_kind.round(v)).collect() }))
     }
+}
+
+/// Whether a call of `builtin` on constants is evaluated here; the others
+/// (derivatives, texture reads, and the interpolation, geometry and matrix
+/// builtins this folder does not implement) are left to the kernels.
+fn folded(builtin: Builtin) -> bool {
+    use Builtin::*;
+    !matches!(
+        builtin,
+        Mix | Lerp
+            | Smoothstep
+            | Reflect
+            | Refract
+            | FaceForward
+            | Determinant
+            | Transpose
+            | Ddx
+            | Ddy
+            | Fwidth
+            | DdxSurface
+            | DdySurface
+            | FwidthSurface
+            | Sample
+            | SampleLevel
+            | SampleGrad
+            | Load
+            | TextureSize
+    )
 }
 
 /// A builtin applied to one component of its arguments (`y`, `z`: 0 where

@@ -11,6 +11,7 @@ use super::effects::Evaluation;
 use super::names::{ALONE, BACKGROUND_HERE, Name, POS, SHADED, WORKGROUP_STATS};
 use super::records::{axis_neighbours, neighbours};
 use super::writer::cut;
+use crate::check::EffectId;
 use crate::types::{Scalar, Type};
 use mrsl_abi::entry;
 use mrsl_abi::geometry::CHECKERBOARD_QUADS_PER_WORKGROUP;
@@ -28,11 +29,20 @@ impl Writer<'_, '_, '_> {
     }
 
     pub(super) fn checkerboard_entries(&mut self) {
-        let c = self.checked();
         let coarse = self.coarse_live();
         // The same pixel of the edge-adjacent quads.
         let taps = neighbours(axis_neighbours(2));
         self.record_helpers();
+        self.checkerboard_shade_entry(&coarse);
+        self.checkerboard_taps(&coarse, &taps);
+        self.checkerboard_reconstruction(&coarse, &taps);
+        self.tile_list_entries();
+        self.checkerboard_final_entry(coarse.len());
+    }
+
+    /// `cb_shade`: this frame's quads evaluate every coarse effect and store it in their records.
+    fn checkerboard_shade_entry(&mut self, coarse: &[EffectId]) {
+        let c = self.checked();
         let [head, end] = cut(include_str!("templates/checkerboard_shade.wgsl"), &["EFFECTS"]);
         self.template(
             0,
@@ -43,29 +53,38 @@ impl Writer<'_, '_, '_> {
                 ("ENTRY", &entry::CB_SHADE),
             ],
         );
-        for &e in &coarse {
+        for &e in coarse {
             self.effect_chain(&[e], 1, Evaluation::Kernel);
             let info = &c.effects[e.index()];
             self.line(1, format!("{}({POS}, {});", Name::RecordPut.of(&info.name), self.effect_name(e)));
         }
         self.template(0, end, &[]);
+    }
 
+    /// The neighbouring quads' taps a pixel reconstructs from, and which lie
+    /// on its side of every key a coarse effect reads.
+    fn checkerboard_taps(&mut self, coarse: &[EffectId], taps: &str) {
         let [head, note, end] = cut(include_str!("templates/taps.wgsl"), &["IN_IMAGE", "PAIRS"]);
         self.template(0, head, &[("TAPS", &taps)]);
         // The taps serve every coarse effect together, so a tap is rejected
         // across any key a coarse effect reads (this baseline does not
         // reconstruct per effect).
         let tap_tests: Vec<String> = self
-            .keys_of(&coarse)
+            .keys_of(coarse)
             .iter()
             .map(|key| format!("ok[k] = ok[k] && ({});", key.matches(&key.load("taps[k]"), &key.load("p"))))
             .collect();
         self.neighbour_pairs("taps", &tap_tests, note, ["pair_x", "pair_y"]);
         self.template(0, end, &[]);
+    }
 
+    /// Per coarse effect, its value at a pixel from the taps on its side:
+    /// blended where the type blends, else the first tap's.
+    fn checkerboard_reconstruction(&mut self, coarse: &[EffectId], taps: &str) {
+        let c = self.checked();
         let [head, blend, first_tap, end] =
             cut(include_str!("templates/reconstruct.wgsl"), &["BLEND", "FIRST_TAP", "END"]);
-        for &e in &coarse {
+        for &e in coarse {
             let info = &c.effects[e.index()];
             let blendable =
                 matches!(info.ty, Type::Scalar(Scalar::Float) | Type::Vector(Scalar::Float, _) | Type::Matrix(_));
@@ -76,9 +95,11 @@ impl Writer<'_, '_, '_> {
             self.template(0, end, &values);
         }
         self.line(0, "");
+    }
 
-        self.tile_list_entries();
-        let coarse = coarse.len();
+    /// `cb_final`: each pixel's outputs from its record or its
+    /// reconstruction, with the statistics (`coarse`: the coarse effects counted).
+    fn checkerboard_final_entry(&mut self, coarse: usize) {
         let [head, stats, end] = cut(include_str!("templates/checkerboard_final.wgsl"), &["STATS", "COUNTS"]);
         let [value, evaluated] = cut(include_str!("templates/checkerboard_value.wgsl"), &["EVALUATE"]);
         // The background rule: a background pixel takes zeros and is not counted (but as background).

@@ -58,6 +58,23 @@ struct History {
     first: bool,
 }
 
+impl History {
+    fn new(device: &wgpu::Device, size: (u32, u32), tile: u32) -> History {
+        let rate_size = rate_image_size(size, tile);
+        History {
+            size,
+            tile,
+            raw: texture(device, "mrsl rate decisions", rate_size, RATE_IMAGE_FORMAT),
+            history: [
+                texture(device, "mrsl rate history a", rate_size, RATE_IMAGE_FORMAT),
+                texture(device, "mrsl rate history b", rate_size, RATE_IMAGE_FORMAT),
+            ],
+            current: 0,
+            first: true,
+        }
+    }
+}
+
 /// Computes rate images; create one per device and keep it across frames
 /// (it holds the history the temporal damping and reprojection need).
 pub struct RateSource {
@@ -144,49 +161,10 @@ impl RateSource {
             return Err(Error::RateUsage { what: "the rate image (target)", missing: "STORAGE_BINDING" });
         }
         if self.state.as_ref().is_none_or(|s| s.size != size || s.tile != tile) {
-            self.state = Some(History {
-                size,
-                tile,
-                raw: texture(device, "mrsl rate decisions", rate_size, RATE_IMAGE_FORMAT),
-                history: [
-                    texture(device, "mrsl rate history a", rate_size, RATE_IMAGE_FORMAT),
-                    texture(device, "mrsl rate history b", rate_size, RATE_IMAGE_FORMAT),
-                ],
-                current: 0,
-                first: true,
-            });
+            self.state = Some(History::new(device, size, tile));
         }
         let state = self.state.as_mut().expect("the history was just ensured");
-        let mut bits = 0;
-        for (on, flag) in [
-            (options.weber_fechner, Flag::WeberFechner),
-            (options.motion, Flag::Motion),
-            (state.first, Flag::FirstFrame),
-            (options.reproject && inputs.velocity.is_some(), Flag::Reproject),
-            (inputs.external.is_some(), Flag::External),
-            (options.foveation.is_some(), Flag::Foveation),
-            (options.hysteresis, Flag::Hysteresis),
-        ] {
-            if on {
-                bits |= flag.bit();
-            }
-        }
-        let fovea = options.foveation;
-        let params = Params {
-            size: [size.0, size.1],
-            rate_size: [rate_size.0, rate_size.1],
-            tile,
-            flags: bits,
-            sensitivity: options.sensitivity,
-            env_luma: options.env_luma,
-            k: options.k,
-            weber_fechner: options.weber_fechner_constant,
-            fovea_inner: fovea.map_or(0.0, |f| f.inner_radius),
-            fovea_outer: fovea.map_or(0.0, |f| f.outer_radius),
-            gaze: fovea.map_or([0.0; 2], |f| f.gaze),
-            combiners: inputs.external.map_or(0, |e| e.combiner.code()) | fovea.map_or(0, |f| f.combiner.code()) << 4,
-            color_channels: color_channels(inputs.color.format()).expect("validated"),
-        };
+        let params = params(inputs, options, size, state.first);
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         // A buffer per call rather than `queue.write_buffer`: two frames
         // encoded before one submit each keep their own parameters.
@@ -234,6 +212,43 @@ impl RateSource {
         state.current = 1 - state.current;
         state.first = false;
         Ok(())
+    }
+}
+
+/// The rate kernels' parameters for a frame of `size` pixels (`first`: no
+/// frame recorded before it).
+fn params(inputs: &RateInputs, options: &RateOptions, size: (u32, u32), first: bool) -> Params {
+    let tile = options.tile;
+    let rate_size = rate_image_size(size, tile);
+    let mut bits = 0;
+    for (on, flag) in [
+        (options.weber_fechner, Flag::WeberFechner),
+        (options.motion, Flag::Motion),
+        (first, Flag::FirstFrame),
+        (options.reproject && inputs.velocity.is_some(), Flag::Reproject),
+        (inputs.external.is_some(), Flag::External),
+        (options.foveation.is_some(), Flag::Foveation),
+        (options.hysteresis, Flag::Hysteresis),
+    ] {
+        if on {
+            bits |= flag.bit();
+        }
+    }
+    let fovea = options.foveation;
+    Params {
+        size: [size.0, size.1],
+        rate_size: [rate_size.0, rate_size.1],
+        tile,
+        flags: bits,
+        sensitivity: options.sensitivity,
+        env_luma: options.env_luma,
+        k: options.k,
+        weber_fechner: options.weber_fechner_constant,
+        fovea_inner: fovea.map_or(0.0, |f| f.inner_radius),
+        fovea_outer: fovea.map_or(0.0, |f| f.outer_radius),
+        gaze: fovea.map_or([0.0; 2], |f| f.gaze),
+        combiners: inputs.external.map_or(0, |e| e.combiner.code()) | fovea.map_or(0, |f| f.combiner.code()) << 4,
+        color_channels: color_channels(inputs.color.format()).expect("validated"),
     }
 }
 
