@@ -7,13 +7,16 @@
 //!   compiler/tests/README.md and every file under docs/ (CHANGELOG.md is
 //!   history and is not checked); in ARCHITECTURE.md and README.md, which
 //!   map the code, every `snake_case` name too;
-//! - every Rust module opens with a `//!` comment.
+//! - every Rust module opens with a `//!` comment;
+//! - no function of the crates' sources runs over 100 lines (`lengths`).
 //!
 //! Names from outside the repository (wgpu, WebGPU, the papers) are told
 //! apart by where they occur: a name counts as known when it occurs in the
 //! code of this repository (its `.rs`, `.wgsl`, `.ts` and `.mrsl` files,
 //! comments removed), so only what the repository once had and has no more
 //! fails.
+
+mod lengths;
 
 use std::collections::{BTreeSet, HashSet};
 use std::path::{Path, PathBuf};
@@ -38,7 +41,9 @@ fn main() {
                 .push(format!("{}: does not open with a `//!` comment", file.strip_prefix(&root).unwrap().display()));
         }
     }
+    failures.extend(lengths::too_long(&root, |dir| files(dir, &["rs"])));
     self_test();
+    lengths::self_test();
     if failures.is_empty() {
         println!("tidy: docs and modules are in order");
         return;
