@@ -16,6 +16,7 @@
 
 use mrsl_lab::engine_formats;
 use mrsl_lab::gpu::Gpu;
+use mrsl_lab::microbench::median;
 use mrsl_lab::scene::{ChannelData, Scene};
 use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader};
 use std::time::Instant;
@@ -91,12 +92,13 @@ fn main() {
             float_ms.push(f);
             engine_ms.push(e);
         }
+        ratios.sort_by(f64::total_cmp);
         println!(
             "{:>11}: float G-buffer {:.1} ms, depth + Rgb10a2Unorm normals {:.1} ms (medians of {pairs}); engine / float {:.3} (median of the pairs' ratios, range {:.3} to {:.3})",
             mode.name(),
-            median(&mut float_ms),
-            median(&mut engine_ms),
-            median(&mut ratios),
+            median(&float_ms),
+            median(&engine_ms),
+            median(&ratios),
             ratios.first().unwrap(),
             ratios.last().unwrap()
         );
@@ -106,10 +108,4 @@ fn main() {
 fn shader(gpu: &Gpu, source: &str, modes: &[Mode]) -> Shader {
     let program = mrsl::compile(source, &mrsl::Options::for_modes(modes)).unwrap_or_else(|d| panic!("{d:?}"));
     Shader::new(&gpu.device, &program.compiled).expect("pipelines")
-}
-
-/// Sorts `values` and returns their median.
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    values[values.len() / 2]
 }

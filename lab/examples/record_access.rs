@@ -11,8 +11,7 @@
 //! over 4 dispatches; it prints each kernel's median time and the median
 //! over rounds of each load kernel's time above the store-only kernel's.
 
-use mrsl_lab::gpu::Gpu;
-use mrsl_lab::microbench::{interleaved_rounds, median, median_above};
+use mrsl_lab::microbench;
 
 const SIZE: (u32, u32) = (1920, 1080);
 const WORDS: u32 = 10;
@@ -20,9 +19,7 @@ const DISPATCHES: u32 = 4;
 const KERNELS: [&str; 7] = ["none", "storage", "sampled", "packed", "packed_storage", "float_sampled", "float_storage"];
 
 fn main() {
-    let rounds: usize = std::env::args().nth(1).map_or(9, |a| a.parse().expect("ROUNDS is a number"));
-    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
-    println!("adapter: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
+    let (gpu, rounds) = microbench::start();
     let (device, queue) = (&gpu.device, &gpu.queue);
     let texture = |label, format, layers, usage| {
         device.create_texture(&wgpu::TextureDescriptor {
@@ -83,12 +80,7 @@ fn main() {
         })
         .collect();
 
-    let times = interleaved_rounds(kernels.len(), rounds, |k| {
-        let (pipeline, group) = &kernels[k];
-        gpu.time_dispatches(pipeline, group, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES)
-    });
-    for (k, name) in KERNELS.iter().enumerate() {
-        let extra = median_above(&times[k], &times[0]);
-        println!("{name:>8}: {:6.1} ms, loads {extra:5.1} ms (median of {rounds} rounds)", median(&times[k]));
-    }
+    let kernels: Vec<_> = kernels.iter().map(|(p, g)| (p, g)).collect();
+    let times = microbench::time_kernels(&gpu, &kernels, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES, rounds);
+    microbench::report_above_first(&KERNELS, &times, "loads");
 }

@@ -12,8 +12,7 @@
 //! median over rounds of each load kernel's time above the store-only
 //! kernel's, so that a slow moment of a shared machine weighs on all four.
 
-use mrsl_lab::gpu::Gpu;
-use mrsl_lab::microbench::{interleaved_rounds, median, median_above};
+use mrsl_lab::microbench;
 
 const SIZE: (u32, u32) = (1920, 1080);
 const BLOCK: u32 = 4;
@@ -22,9 +21,7 @@ const LAYERS: u32 = STRIDE.div_ceil(4);
 const DISPATCHES: u32 = 4;
 
 fn main() {
-    let rounds: usize = std::env::args().nth(1).map_or(9, |a| a.parse().expect("ROUNDS is a number"));
-    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
-    println!("adapter: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
+    let (gpu, rounds) = microbench::start();
     let (device, queue) = (&gpu.device, &gpu.queue);
     let grid = (SIZE.0 / BLOCK + 2, SIZE.1 / BLOCK + 2);
     let texels = (grid.0 * grid.1 * LAYERS) as usize;
@@ -84,14 +81,12 @@ fn main() {
         })
         .collect();
 
-    let times = interleaved_rounds(kernels.len(), rounds, |k| {
-        let (_, pipeline, group) = &kernels[k];
-        gpu.time_dispatches(pipeline, group, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES)
-    });
+    let pipelines: Vec<_> = kernels.iter().map(|(_, p, g)| (p, g)).collect();
+    let times = microbench::time_kernels(&gpu, &pipelines, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES, rounds);
     for (k, (name, ..)) in kernels.iter().enumerate() {
-        println!("{name:>8}: {:6.1} ms median of {rounds} rounds", median(&times[k]));
+        println!("{name:>8}: {:6.1} ms median of {rounds} rounds", microbench::median(&times[k]));
     }
-    let extra = |k: usize| median_above(&times[k], &times[0]);
+    let extra = |k: usize| microbench::median_above(&times[k], &times[0]);
     let (buffer_ms, texture_ms) = (extra(1), extra(2));
     println!(
         "loads: {:.1} ms as buffer words (24 per lane), {:.1} ms as texels (8 per lane): {:.1}x",

@@ -14,8 +14,7 @@
 //! over 4 dispatches; it prints each kernel's median time and the median
 //! over rounds of its time above the kernel without the work.
 
-use mrsl_lab::gpu::Gpu;
-use mrsl_lab::microbench::{interleaved_rounds, median, median_above};
+use mrsl_lab::microbench;
 
 const SIZE: (u32, u32) = (1920, 1080);
 const DISPATCHES: u32 = 4;
@@ -32,9 +31,7 @@ const KERNELS: [&str; 9] = [
 ];
 
 fn main() {
-    let rounds: usize = std::env::args().nth(1).map_or(9, |a| a.parse().expect("ROUNDS is a number"));
-    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
-    println!("adapter: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
+    let (gpu, rounds) = microbench::start();
     let (device, queue) = (&gpu.device, &gpu.queue);
     let texture = |label, format, texel: u32, fill: fn(u32) -> u32| {
         let t = device.create_texture(&wgpu::TextureDescriptor {
@@ -98,12 +95,7 @@ fn main() {
             gpu.entry_kernel(&module, &format!("{name}_main"), &entries)
         })
         .collect();
-    let times = interleaved_rounds(kernels.len(), rounds, |k| {
-        let (pipeline, group) = &kernels[k];
-        gpu.time_dispatches(pipeline, group, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES)
-    });
-    for (k, name) in KERNELS.iter().enumerate() {
-        let extra = median_above(&times[k], &times[0]);
-        println!("{name:>12}: {:6.1} ms, above none {extra:5.1} ms (median of {rounds} rounds)", median(&times[k]));
-    }
+    let kernels: Vec<_> = kernels.iter().map(|(p, g)| (p, g)).collect();
+    let times = microbench::time_kernels(&gpu, &kernels, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES, rounds);
+    microbench::report_above_first(&KERNELS, &times, "above none");
 }

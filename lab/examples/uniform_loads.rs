@@ -14,8 +14,7 @@
 //! over 4 dispatches; it prints each kernel's median time and the median
 //! over rounds of its time above the store-only kernel's.
 
-use mrsl_lab::gpu::Gpu;
-use mrsl_lab::microbench::{interleaved_rounds, median, median_above};
+use mrsl_lab::microbench;
 
 const SIZE: (u32, u32) = (1920, 1080);
 /// Texels per row of the texture and words per row of the buffer (`ROW` in
@@ -35,9 +34,7 @@ const KERNELS: [&str; 9] = [
 ];
 
 fn main() {
-    let rounds: usize = std::env::args().nth(1).map_or(9, |a| a.parse().expect("ROUNDS is a number"));
-    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
-    println!("adapter: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
+    let (gpu, rounds) = microbench::start();
     let (device, queue) = (&gpu.device, &gpu.queue);
     let data: Vec<u32> = (0..ROW * SIZE.1 * 4).map(|i| i.wrapping_mul(2_654_435_761)).collect();
     let texels = device.create_texture(&wgpu::TextureDescriptor {
@@ -89,12 +86,7 @@ fn main() {
             gpu.entry_kernel(&module, &format!("{name}_main"), &entries)
         })
         .collect();
-    let times = interleaved_rounds(kernels.len(), rounds, |k| {
-        let (pipeline, group) = &kernels[k];
-        gpu.time_dispatches(pipeline, group, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES)
-    });
-    for (k, name) in KERNELS.iter().enumerate() {
-        let extra = median_above(&times[k], &times[0]);
-        println!("{name:>14}: {:6.1} ms, loads {extra:5.1} ms (median of {rounds} rounds)", median(&times[k]));
-    }
+    let kernels: Vec<_> = kernels.iter().map(|(p, g)| (p, g)).collect();
+    let times = microbench::time_kernels(&gpu, &kernels, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES, rounds);
+    microbench::report_above_first(&KERNELS, &times, "loads");
 }

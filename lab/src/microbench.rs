@@ -1,6 +1,48 @@
-//! The timing the lab's microbenchmarks share (`lab/examples/record_loads.rs`,
-//! `record_access.rs`, `uniform_branch.rs`, `uniform_loads.rs`): kernels timed in interleaved
-//! rounds, and medians over the rounds.
+//! What the lab's microbenchmarks share (`lab/examples/record_loads.rs`,
+//! `record_access.rs`, `uniform_branch.rs`, `uniform_loads.rs`): the device
+//! and the rounds from the command line, kernels timed in interleaved rounds,
+//! medians over the rounds and the report of each kernel's time above the
+//! first's.
+
+use crate::gpu::Gpu;
+
+/// A microbenchmark's start: the rounds (the first command-line argument,
+/// else 9) and the device, whose adapter it prints.
+pub fn start() -> (Gpu, usize) {
+    let rounds: usize = std::env::args().nth(1).map_or(9, |a| a.parse().expect("ROUNDS is a number"));
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    println!("adapter: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
+    (gpu, rounds)
+}
+
+/// Times `kernels` (pipeline and bind group 0) over `workgroups`, each
+/// `dispatches` times per timing, in `rounds` interleaved rounds: the times
+/// per kernel.
+pub fn time_kernels(
+    gpu: &Gpu,
+    kernels: &[(&wgpu::ComputePipeline, &wgpu::BindGroup)],
+    workgroups: (u32, u32),
+    dispatches: u32,
+    rounds: usize,
+) -> Vec<Vec<f64>> {
+    interleaved_rounds(kernels.len(), rounds, |k| {
+        gpu.time_dispatches(kernels[k].0, kernels[k].1, workgroups, dispatches)
+    })
+}
+
+/// Prints each kernel's median time and the median over rounds of its time
+/// above the first kernel's (`above`: what that difference is).
+pub fn report_above_first(names: &[&str], times: &[Vec<f64>], above: &str) {
+    let width = names.iter().map(|n| n.len()).max().unwrap_or(0);
+    for (k, name) in names.iter().enumerate() {
+        let extra = median_above(&times[k], &times[0]);
+        println!(
+            "{name:>width$}: {:6.1} ms, {above} {extra:5.1} ms (median of {} rounds)",
+            median(&times[k]),
+            times[k].len()
+        );
+    }
+}
 
 /// Times each of `kernels` once to warm up, then `rounds` times in
 /// interleaved rounds whose order rotates every round, so that a shared
