@@ -17,6 +17,7 @@ const TESTS: &[(&str, fn())] = &[
     ("render_all_skips_only_the_modes_the_device_cannot_run", render_all_skips_only_the_modes_the_device_cannot_run),
     ("heatmaps_mark_background_pixels_grey", heatmaps_mark_background_pixels_grey),
     ("gpu_bench_script_writes_the_suite_report", gpu_bench_script_writes_the_suite_report),
+    ("workload_bounds_script_refines_less_in_each_variant", workload_bounds_script_refines_less_in_each_variant),
     ("ablation_times_every_variant_on_the_device", ablation_times_every_variant_on_the_device),
     (
         "gbuffer_exports_the_channels_and_what_the_program_binds",
@@ -187,6 +188,48 @@ fn gpu_bench_script_writes_the_suite_report() {
     let md = std::fs::read_to_string(dir.join("suite.md")).unwrap();
     for heading in ["## 48x27", "### sponza (48x27)", "| geometric mean speedup |", "## Not measured"] {
         assert!(md.contains(heading), "{heading} in:\n{md}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `scripts/workload-bounds.sh OUTDIR` at a small size over Sponza (with
+/// this build's mrslc): a row per mode and variant with a finite speed and
+/// quality, and each variant evaluating less of the coarse work than the
+/// defaults (so its uniforms and the keys it removes still exist in the
+/// workload: a renamed predicate uniform fails the render, a key no longer
+/// spelled as the script expects fails the script).
+fn workload_bounds_script_refines_less_in_each_variant() {
+    let dir = scratch("workload-bounds");
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../scripts/workload-bounds.sh");
+    let run = Command::new("sh")
+        .arg(script)
+        .arg(&dir)
+        .args(["--scene", "sponza", "--size", "48x27", "--rounds", "1"])
+        .env("MRSLC", env!("CARGO_BIN_EXE_mrslc"))
+        .output()
+        .expect("the script runs");
+    assert!(run.status.success(), "{}", stderr(&run));
+    let md = std::fs::read_to_string(dir.join("bounds.md")).unwrap();
+    // | scene | mode | variant | speed per round | median | MSSIM | coarse work evaluated |
+    let rows: Vec<Vec<&str>> = md
+        .lines()
+        .filter(|l| l.starts_with("| sponza |"))
+        .map(|l| l.trim_matches('|').split('|').map(str::trim).collect())
+        .collect();
+    assert_eq!(rows.len(), 6, "two modes, three variants:\n{md}");
+    let number = |cell: &str| -> f64 { cell.trim_end_matches(['x', '%']).parse().unwrap_or_else(|_| panic!("{cell}")) };
+    for row in &rows {
+        assert!(number(row[4]) > 0.0 && number(row[4]).is_finite(), "{row:?}");
+        assert!(number(row[5]) > 0.0 && number(row[5]) <= 1.0, "{row:?}");
+    }
+    for mode in ["coarse4x4", "hierarchical"] {
+        let coarse = |variant: &str| {
+            let row =
+                rows.iter().find(|r| r[1] == mode && r[2] == variant).unwrap_or_else(|| panic!("{mode} {variant}"));
+            number(row[6])
+        };
+        assert!(coarse("predicates-off") <= coarse("defaults"), "{mode}:\n{md}");
+        assert!(coarse("nothing-refined") < coarse("defaults"), "{mode}:\n{md}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

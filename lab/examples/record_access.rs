@@ -1,9 +1,12 @@
 //! Micro-benchmark behind the record modes' final pass: what reading one
 //! pixel's record (ten 32-bit words, about what sponza_lights keeps per
 //! pixel in the hierarchical mode) costs a lane at 1920x1080, as texels of
-//! the `r32uint` read-write storage array the classification writes, as
-//! the same texels through a sampled view, and packed four words to a
-//! texel of an `rgba32uint` sampled array.
+//! the `r32uint` read-write storage array the classification writes (and
+//! the same array read-only), as the same texels through a sampled view,
+//! and packed four words to a texel of an `rgba32uint` array (sampled,
+//! read-only storage, and read-write storage as the hierarchical kernel's
+//! packed records are); and a float G-buffer texel and its neighbours,
+//! sampled and as storage.
 //!
 //! `cargo run --release -p mrsl-lab --example record_access [ROUNDS]`
 //!
@@ -16,10 +19,21 @@ use mrsl_lab::microbench;
 const SIZE: (u32, u32) = (1920, 1080);
 const WORDS: u32 = 10;
 const DISPATCHES: u32 = 4;
-const KERNELS: [&str; 7] = ["none", "storage", "sampled", "packed", "packed_storage", "float_sampled", "float_storage"];
+const KERNELS: [&str; 9] = [
+    "none",
+    "storage",
+    "storage_read",
+    "sampled",
+    "packed",
+    "packed_storage",
+    "packed_read_write",
+    "float_sampled",
+    "float_storage",
+];
 
 fn main() {
-    let (gpu, rounds) = microbench::start();
+    let (gpu, rounds) = microbench::start_packing_records();
+    assert!(gpu.packs_records, "the adapter grants no read-write Rgba32Uint storage");
     let (device, queue) = (&gpu.device, &gpu.queue);
     let texture = |label, format, layers, usage| {
         device.create_texture(&wgpu::TextureDescriptor {
@@ -72,6 +86,8 @@ fn main() {
                 "sampled" => entries.push(wgpu::BindGroupEntry { binding: 1, resource: view(&words_view) }),
                 "packed" => entries.push(wgpu::BindGroupEntry { binding: 2, resource: view(&packed_view) }),
                 "packed_storage" => entries.push(wgpu::BindGroupEntry { binding: 4, resource: view(&packed_view) }),
+                "storage_read" => entries.push(wgpu::BindGroupEntry { binding: 7, resource: view(&words_view) }),
+                "packed_read_write" => entries.push(wgpu::BindGroupEntry { binding: 8, resource: view(&packed_view) }),
                 "float_sampled" => entries.push(wgpu::BindGroupEntry { binding: 5, resource: view(&floats_view) }),
                 "float_storage" => entries.push(wgpu::BindGroupEntry { binding: 6, resource: view(&floats_view) }),
                 _ => {}

@@ -9,6 +9,8 @@
 @group(0) @binding(4) var packed_storage: texture_storage_2d_array<rgba32uint, read>;
 @group(0) @binding(5) var float_sampled: texture_2d<f32>;
 @group(0) @binding(6) var float_storage: texture_storage_2d<rgba32float, read>;
+@group(0) @binding(7) var storage_words_read: texture_storage_2d_array<r32uint, read>;
+@group(0) @binding(8) var packed_read_write: texture_storage_2d_array<rgba32uint, read_write>;
 @group(0) @binding(3) var out_image: texture_storage_2d<r32uint, write>;
 
 const WORDS: i32 = {{WORDS}};
@@ -56,6 +58,28 @@ fn packed_storage_main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invo
     var acc = 0u;
     for (var k = 0; k < (WORDS + 3) / 4; k++) {
         let t = textureLoad(packed_storage, p, k);
+        acc ^= t.x ^ (t.y * 3u) ^ (t.z * 5u) ^ (t.w * 7u);
+    }
+    textureStore(out_image, p, vec4<u32>(acc));
+}
+
+// The same texels through the other storage access: `storage_read` the
+// r32uint words read-only, `packed_read_write` the rgba32uint texels read-write
+// (what the hierarchical kernel's packed records are).
+@compute @workgroup_size(64)
+fn storage_read_main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let p = pixel(wg, li);
+    var acc = 0u;
+    for (var k = 0; k < WORDS; k++) { acc ^= textureLoad(storage_words_read, p, k).x * u32(k + 1); }
+    textureStore(out_image, p, vec4<u32>(acc));
+}
+
+@compute @workgroup_size(64)
+fn packed_read_write_main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let p = pixel(wg, li);
+    var acc = 0u;
+    for (var k = 0; k < (WORDS + 3) / 4; k++) {
+        let t = textureLoad(packed_read_write, p, k);
         acc ^= t.x ^ (t.y * 3u) ^ (t.z * 5u) ^ (t.w * 7u);
     }
     textureStore(out_image, p, vec4<u32>(acc));

@@ -9,8 +9,19 @@ use crate::gpu::Gpu;
 /// A microbenchmark's start: the rounds (the first command-line argument,
 /// else 9) and the device, whose adapter it prints.
 pub fn start() -> (Gpu, usize) {
+    start_on(Gpu::new())
+}
+
+/// [`start`] on a device that grants read-write `Rgba32Uint` storage where
+/// the adapter has it ([`Gpu::with_packed_records`]): what reading records
+/// as the hierarchical kernel's packed records needs.
+pub fn start_packing_records() -> (Gpu, usize) {
+    start_on(Gpu::with_packed_records(wgpu::Limits::default().max_storage_textures_per_shader_stage))
+}
+
+fn start_on(gpu: Result<Gpu, crate::gpu::GpuError>) -> (Gpu, usize) {
     let rounds: usize = std::env::args().nth(1).map_or(9, |a| a.parse().expect("ROUNDS is a number"));
-    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let gpu = gpu.unwrap_or_else(|e| panic!("{e}"));
     println!("adapter: {} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
     (gpu, rounds)
 }
