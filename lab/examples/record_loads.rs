@@ -19,6 +19,7 @@ const BLOCK: u32 = 4;
 const STRIDE: u32 = 6;
 const LAYERS: u32 = STRIDE.div_ceil(4);
 const DISPATCHES: u32 = 4;
+const KERNELS: [&str; 4] = ["none", "buffer", "texture", "storage"];
 
 fn main() {
     let (gpu, rounds) = microbench::start();
@@ -54,36 +55,26 @@ fn main() {
     let out = gpu.output_texture("out", SIZE, wgpu::TextureFormat::R32Uint);
 
     let source = include_str!("record_loads.wgsl").replace("{{GRID_X}}", &grid.0.to_string());
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("record_loads"),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    });
     let records = texture.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),
         ..Default::default()
     });
     let out_view = out.create_view(&Default::default());
-    let kernels: Vec<(&str, wgpu::ComputePipeline, wgpu::BindGroup)> = ["none", "buffer", "texture", "storage"]
-        .into_iter()
-        .map(|name| {
-            let mut entries =
-                vec![wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&out_view) }];
-            match name {
-                "buffer" => entries.push(wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }),
-                "texture" => entries
-                    .push(wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&records) }),
-                "storage" => entries
-                    .push(wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&records) }),
-                _ => {}
-            }
-            let (pipeline, group) = gpu.entry_kernel(&module, &format!("{name}_main"), &entries);
-            (name, pipeline, group)
-        })
-        .collect();
-
-    let pipelines: Vec<_> = kernels.iter().map(|(_, p, g)| (p, g)).collect();
-    let times = microbench::time_kernels(&gpu, &pipelines, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES, rounds);
-    for (k, (name, ..)) in kernels.iter().enumerate() {
+    let kernels = microbench::kernels(&gpu, "record_loads", &source, &KERNELS, |name| {
+        let mut entries =
+            vec![wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&out_view) }];
+        match name {
+            "buffer" => entries.push(wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }),
+            "texture" => entries
+                .push(wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&records) }),
+            "storage" => entries
+                .push(wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&records) }),
+            _ => {}
+        }
+        entries
+    });
+    let times = microbench::time_kernels(&gpu, &kernels, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES, rounds);
+    for (k, name) in KERNELS.iter().enumerate() {
         println!("{name:>8}: {:6.1} ms median of {rounds} rounds", microbench::median(&times[k]));
     }
     let extra = |k: usize| microbench::median_above(&times[k], &times[0]);

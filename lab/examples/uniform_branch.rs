@@ -68,34 +68,24 @@ fn main() {
     let tile_flags_uniform = zeros(wgpu::BufferUsages::UNIFORM);
     let out = gpu.output_texture("out", SIZE, wgpu::TextureFormat::R32Uint);
     let out_view = out.create_view(&Default::default());
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("uniform_branch"),
-        source: wgpu::ShaderSource::Wgsl(include_str!("uniform_branch.wgsl").into()),
+    let kernels = microbench::kernels(&gpu, "uniform_branch", include_str!("uniform_branch.wgsl"), &KERNELS, |name| {
+        let view = |v| wgpu::BindingResource::TextureView(v);
+        let mut entries = vec![
+            wgpu::BindGroupEntry { binding: 1, resource: view(&flags_view) },
+            wgpu::BindGroupEntry { binding: 3, resource: view(&out_view) },
+        ];
+        if name != "none" && name != "barrier_only" {
+            entries.push(wgpu::BindGroupEntry { binding: 0, resource: view(&floats_view) });
+        }
+        match name {
+            "buffer_if" => entries.push(wgpu::BindGroupEntry { binding: 4, resource: tile_flags.as_entire_binding() }),
+            "uniform_buffer_if" | "dispatch_if" => {
+                entries.push(wgpu::BindGroupEntry { binding: 5, resource: tile_flags_uniform.as_entire_binding() })
+            }
+            _ => {}
+        }
+        entries
     });
-    let kernels: Vec<(wgpu::ComputePipeline, wgpu::BindGroup)> = KERNELS
-        .iter()
-        .map(|name| {
-            let view = |v| wgpu::BindingResource::TextureView(v);
-            let mut entries = vec![
-                wgpu::BindGroupEntry { binding: 1, resource: view(&flags_view) },
-                wgpu::BindGroupEntry { binding: 3, resource: view(&out_view) },
-            ];
-            if *name != "none" && *name != "barrier_only" {
-                entries.push(wgpu::BindGroupEntry { binding: 0, resource: view(&floats_view) });
-            }
-            match *name {
-                "buffer_if" => {
-                    entries.push(wgpu::BindGroupEntry { binding: 4, resource: tile_flags.as_entire_binding() })
-                }
-                "uniform_buffer_if" | "dispatch_if" => {
-                    entries.push(wgpu::BindGroupEntry { binding: 5, resource: tile_flags_uniform.as_entire_binding() })
-                }
-                _ => {}
-            }
-            gpu.entry_kernel(&module, &format!("{name}_main"), &entries)
-        })
-        .collect();
-    let kernels: Vec<_> = kernels.iter().map(|(p, g)| (p, g)).collect();
     let times = microbench::time_kernels(&gpu, &kernels, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES, rounds);
     microbench::report_above_first(&KERNELS, &times, "above none");
 }

@@ -64,29 +64,19 @@ fn main() {
     let texels_view = texels.create_view(&Default::default());
     let out = gpu.output_texture("out", SIZE, wgpu::TextureFormat::R32Uint);
     let out_view = out.create_view(&Default::default());
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("uniform_loads"),
-        source: wgpu::ShaderSource::Wgsl(include_str!("uniform_loads.wgsl").into()),
+    let kernels = microbench::kernels(&gpu, "uniform_loads", include_str!("uniform_loads.wgsl"), &KERNELS, |name| {
+        let mut entries =
+            vec![wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&out_view) }];
+        if name.ends_with("texel") {
+            entries
+                .push(wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&texels_view) });
+        } else if name.ends_with("buffer") {
+            entries.push(wgpu::BindGroupEntry { binding: 1, resource: words.as_entire_binding() });
+        } else if name.ends_with("uniform") {
+            entries.push(wgpu::BindGroupEntry { binding: 2, resource: constants.as_entire_binding() });
+        }
+        entries
     });
-    let kernels: Vec<(wgpu::ComputePipeline, wgpu::BindGroup)> = KERNELS
-        .iter()
-        .map(|name| {
-            let mut entries =
-                vec![wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&out_view) }];
-            if name.ends_with("texel") {
-                entries.push(wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&texels_view),
-                });
-            } else if name.ends_with("buffer") {
-                entries.push(wgpu::BindGroupEntry { binding: 1, resource: words.as_entire_binding() });
-            } else if name.ends_with("uniform") {
-                entries.push(wgpu::BindGroupEntry { binding: 2, resource: constants.as_entire_binding() });
-            }
-            gpu.entry_kernel(&module, &format!("{name}_main"), &entries)
-        })
-        .collect();
-    let kernels: Vec<_> = kernels.iter().map(|(p, g)| (p, g)).collect();
     let times = microbench::time_kernels(&gpu, &kernels, (SIZE.0 / 8, SIZE.1 / 8), DISPATCHES, rounds);
     microbench::report_above_first(&KERNELS, &times, "loads");
 }

@@ -1,6 +1,7 @@
 //! What the lab's microbenchmarks share (`lab/examples/record_loads.rs`,
 //! `record_access.rs`, `uniform_branch.rs`, `uniform_loads.rs`): the device
-//! and the rounds from the command line, kernels timed in interleaved rounds,
+//! and the rounds from the command line, a kernel per entry point of one WGSL
+//! source, kernels timed in interleaved rounds,
 //! medians over the rounds and the report of each kernel's time above the
 //! first's.
 
@@ -26,18 +27,36 @@ fn start_on(gpu: Result<Gpu, crate::gpu::GpuError>) -> (Gpu, usize) {
     (gpu, rounds)
 }
 
-/// Times `kernels` (pipeline and bind group 0) over `workgroups`, each
-/// `dispatches` times per timing, in `rounds` interleaved rounds: the times
-/// per kernel.
+/// A microbenchmark's kernel: its pipeline and bind group 0.
+pub type Kernel = (wgpu::ComputePipeline, wgpu::BindGroup);
+
+/// A kernel per name in `names`: the entry point `{name}_main` of the WGSL
+/// `source`, with bind group 0 made of `entries(name)`.
+pub fn kernels<'a>(
+    gpu: &Gpu,
+    label: &str,
+    source: &str,
+    names: &[&str],
+    mut entries: impl FnMut(&str) -> Vec<wgpu::BindGroupEntry<'a>>,
+) -> Vec<Kernel> {
+    let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    names.iter().map(|name| gpu.entry_kernel(&module, &format!("{name}_main"), &entries(name))).collect()
+}
+
+/// Times `kernels` over `workgroups`, each `dispatches` times per timing, in
+/// `rounds` interleaved rounds: the times per kernel.
 pub fn time_kernels(
     gpu: &Gpu,
-    kernels: &[(&wgpu::ComputePipeline, &wgpu::BindGroup)],
+    kernels: &[Kernel],
     workgroups: (u32, u32),
     dispatches: u32,
     rounds: usize,
 ) -> Vec<Vec<f64>> {
     interleaved_rounds(kernels.len(), rounds, |k| {
-        gpu.time_dispatches(kernels[k].0, kernels[k].1, workgroups, dispatches)
+        gpu.time_dispatches(&kernels[k].0, &kernels[k].1, workgroups, dispatches)
     })
 }
 
