@@ -19,6 +19,27 @@ pub const FINE_PIXELS_PER_LANE: u32 = 2;
 /// [`FINE_PIXELS_PER_LANE`] pixels each).
 pub const FINE_WORKGROUP: u32 = PIXEL_WORKGROUP / FINE_PIXELS_PER_LANE;
 
+/// Invocations of a tile workgroup (the block modes' tile kernel): one lane
+/// per coarse sample of the tile while it shades them, then four groups of
+/// [`FINE_WORKGROUP`] lanes, each over [`TILE`]² pixels at a time.
+pub const TILE_LANES: u32 = 128;
+
+/// Coarse samples per side of a tile of the tile kernel, the largest first:
+/// the compiler takes the first whose workgroup memory fits
+/// [`TILE_WORKGROUP_BYTES`] and whose tile is at least [`TILE`] pixels wide
+/// (`mrsl_abi::TileLayout`). With 8, a tile holds 9x9 samples (its own and
+/// the next tile's first row and column) on 128 lanes: one sample a lane.
+pub const TILE_SAMPLES: [u32; 3] = [8, 4, 2];
+
+/// The workgroup memory a tile kernel may use: WebGPU's default
+/// `maxComputeWorkgroupStorageSize`, which every device grants.
+pub const TILE_WORKGROUP_BYTES: u32 = 16384;
+
+/// Workgroups of the tile kernel: one per `side` x `side` pixels.
+pub fn tile_workgroups(size: (u32, u32), side: u32) -> (u32, u32) {
+    (size.0.div_ceil(side), size.1.div_ceil(side))
+}
+
 /// Invocations per side of a coarse-sample workgroup (coarse kernels and the
 /// hierarchical level-0 and classify entry points).
 pub const COARSE_WORKGROUP: u32 = 8;

@@ -1,7 +1,7 @@
 //! The kernels a program compiles to: their names, entry points in dispatch
 //! order and workgroup sizes, stated once in [`KernelKind`] and [`entry`].
 
-use crate::geometry::{COARSE_WORKGROUP, FINE_WORKGROUP, PIXEL_WORKGROUP, WORK_LIST_WORKGROUP};
+use crate::geometry::{COARSE_WORKGROUP, FINE_WORKGROUP, PIXEL_WORKGROUP, TILE_LANES, WORK_LIST_WORKGROUP};
 use serde::{Deserialize, Serialize};
 
 /// Entry-point names of the generated kernels. The runtime looks pipelines
@@ -64,6 +64,11 @@ pub mod entry {
     /// Rate-image mode, per pixel: resample at the tile's rate or evaluate, then fine effects and outputs.
     pub const RATE_FINE: &str = "rate_fine";
 
+    /// The block modes' tile kernel: one workgroup shades one screen tile end
+    /// to end (its coarse samples, their refinement and its pixels), with the
+    /// coarse-to-fine interface in workgroup memory.
+    pub const TILE: &str = "tile_main";
+
     /// Multi-rate mode: the `coarse(4)` effects resolved at every pixel
     /// from the 4x4 samples (resampled or evaluated) and stored for the
     /// 2x2 samples and the pixels to read.
@@ -107,6 +112,10 @@ pub enum KernelKind {
     Coarse,
     /// One invocation per pixel: resample or re-evaluate coarse effects, then fine effects and outputs.
     Fine,
+    /// The block modes (coarse 2x2 and 4x4) in one dispatch: a workgroup per
+    /// screen tile evaluates the tile's coarse samples into workgroup memory,
+    /// then resamples or refines its pixels from there.
+    Tile,
     /// One invocation per pixel: every effect evaluated per pixel.
     Reference,
     /// Dynamic mode, second level: one invocation per 2x2 coarse sample, shading
@@ -141,9 +150,10 @@ pub enum KernelKind {
 
 impl KernelKind {
     /// Every kind, in the order the compiler writes them.
-    pub const ALL: [KernelKind; 12] = [
+    pub const ALL: [KernelKind; 13] = [
         KernelKind::Coarse,
         KernelKind::Fine,
+        KernelKind::Tile,
         KernelKind::Reference,
         KernelKind::DynamicCoarse,
         KernelKind::DynamicFine,
@@ -161,6 +171,7 @@ impl KernelKind {
         match self {
             KernelKind::Coarse => "coarse",
             KernelKind::Fine => "fine",
+            KernelKind::Tile => "tile",
             KernelKind::Reference => "reference",
             KernelKind::DynamicCoarse => "dynamic_coarse",
             KernelKind::DynamicFine => "dynamic_fine",
@@ -185,6 +196,7 @@ impl KernelKind {
             KernelKind::Coarse => &[entry::COARSE_NEIGHBOURS, entry::COARSE],
             KernelKind::Fine => &[entry::FINE_TILES, entry::FINE_TILE_ARGS, entry::FINE_BACKGROUND, entry::FINE],
             KernelKind::Reference => &[entry::REFERENCE],
+            KernelKind::Tile => &[entry::TILE],
             KernelKind::DynamicCoarse => &[entry::DYNAMIC_COARSE],
             KernelKind::DynamicFine => {
                 &[entry::FINE_TILES, entry::FINE_TILE_ARGS, entry::FINE_BACKGROUND, entry::DYNAMIC_FINE]
@@ -251,6 +263,7 @@ impl KernelKind {
             self,
             KernelKind::Coarse
                 | KernelKind::Fine
+                | KernelKind::Tile
                 | KernelKind::MultiCoarse
                 | KernelKind::MultiResolve
                 | KernelKind::MultiFine
@@ -263,6 +276,8 @@ impl KernelKind {
         if matches!(self, KernelKind::Fine | KernelKind::DynamicFine | KernelKind::MultiResolve | KernelKind::MultiFine)
         {
             [FINE_WORKGROUP, 1, 1]
+        } else if self == KernelKind::Tile {
+            [TILE_LANES, 1, 1]
         } else if matches!(self, KernelKind::RateCoarse | KernelKind::Hierarchical) {
             // Lanes over a work list (the hierarchical kernel's last entry point shades one).
             [WORK_LIST_WORKGROUP, 1, 1]

@@ -10,7 +10,7 @@ use crate::types::{SampleType, TextureFormat, ValueType};
 use serde::{Deserialize, Serialize};
 
 /// The layout format this crate reads and writes (the `format` field).
-pub const LAYOUT_FORMAT: &str = "mrsl-layout/6";
+pub const LAYOUT_FORMAT: &str = "mrsl-layout/7";
 
 /// The refine mask's texel at a background pixel (x: no effect evaluated per
 /// pixel, y: all ones). A shaded pixel holds it only in a program with at
@@ -68,6 +68,8 @@ pub struct Layout {
     /// The block coarse kernel's neighbour values (its `coarse_neighbours`
     /// entry point writes them, `coarse_main` reads them).
     pub neighbours: NeighbourLayout,
+    /// The block modes' tile kernel: its tile and what it holds in workgroup memory.
+    pub tile: TileLayout,
     pub effects: Vec<EffectLayout>,
     /// The multi-rate mode's levels, when the program was compiled for it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -213,13 +215,47 @@ pub struct HierarchicalLayout {
 /// `ny` texels (the sample grid) and `words` layers, bound at `binding` of
 /// the stage group; effect `name`'s value starts at layer `offset`. `words`
 /// is 0 (no binding, and no dispatch of `coarse_neighbours`) when no
-/// derivative reads an effect, or when evaluating those effects would
-/// itself read effects at neighbours.
+/// derivative reads an effect, or when evaluating those effects for their
+/// values would itself read effects at neighbours.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct NeighbourLayout {
     pub binding: u32,
     pub words: u32,
     pub effects: Vec<NeighbourValue>,
+}
+
+/// The block modes' tile kernel ([`crate::KernelKind::Tile`]): a workgroup
+/// shades one tile of `samples` x `samples` blocks. It evaluates, into
+/// workgroup memory, the records of the tile's samples and of the next
+/// tile's first row and column (whose samples the tile's last blocks
+/// resample from), and of `ring` samples before the tile on each axis
+/// (where a per-pixel derivative can read a pixel of the previous tile);
+/// and before them the neighbour values ([`NeighbourLayout`]) of one more
+/// sample on every side, which the samples' derivatives read. Nothing of the
+/// interface goes through global memory.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct TileLayout {
+    /// Coarse samples per side of a tile: the tile is `samples * B` pixels wide.
+    pub samples: u32,
+    /// 1 where the records of the samples just before the tile are held too, else 0.
+    pub ring: u32,
+}
+
+impl TileLayout {
+    /// Samples per side whose records the workgroup holds: `ring + samples + 1`.
+    pub fn record_side(self) -> u32 {
+        self.ring + self.samples + 1
+    }
+
+    /// Samples per side whose neighbour values the workgroup holds: one more on each side.
+    pub fn neighbour_side(self) -> u32 {
+        self.record_side() + 2
+    }
+
+    /// The tile's side in pixels for block size `block`.
+    pub fn side(self, block: u32) -> u32 {
+        self.samples * block
+    }
 }
 
 /// Where one effect's value sits in the neighbour values ([`NeighbourLayout`]).
@@ -580,4 +616,14 @@ pub struct EffectLayout {
     /// cannot refine.
     #[serde(default)]
     pub value_operations: Option<u64>,
+    /// For a live coarse effect: how many times the block modes evaluate its
+    /// body per coarse sample (the tile kernel and the coarse kernel alike):
+    /// 1 where every derivative at a sample reads the neighbour values; 2 for
+    /// a neighbour value that refines (evaluated for its value first, then
+    /// again at the sample for its refine flag); more where derivatives
+    /// evaluate effects at the neighbouring samples in place
+    /// (`neighbours.words` 0). The tile kernel evaluates each of the samples
+    /// its workgroup holds ([`TileLayout`]) this often.
+    #[serde(default)]
+    pub sample_evaluations: Option<u32>,
 }

@@ -41,10 +41,10 @@ pub use layout::{
     BACKGROUND_MARK, Background, BevyField, Channel, ChannelAccess, ControlBlock, Decode, EffectLayout, Field,
     HierarchicalLayout, InterfaceLayout, KeyCompare, LAYOUT_FORMAT, Layout, LevelsLayout, NeighbourLayout,
     NeighbourValue, Output, Rate, RefineMaskTexel, Resample, ResourceBinding, ResourceKind, SlotLayout, StatsLayout,
-    UniformBlock,
+    TileLayout, UniformBlock,
 };
 pub use mode::{KernelRef, Mode, UnknownMode};
-pub use plan::{BindingType, Plan, ResourceId};
+pub use plan::{BindingType, Device, Plan, ResourceId};
 pub use program::{CompiledProgram, Kernel, ReadError};
 pub use shading_rate::ShadingRate;
 pub use types::{SampleType, Scalar, TextureFormat, ValueType};

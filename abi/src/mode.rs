@@ -97,12 +97,16 @@ impl Mode {
         }
     }
 
-    /// The kernels the mode dispatches, with their block sizes.
+    /// The kernels the mode dispatches, with their block sizes: those of
+    /// every plan it has (see [`crate::plan::Device`]).
     pub fn kernels(self) -> &'static [KernelRef] {
         use KernelKind as K;
         const REFERENCE: [KernelRef; 1] = [kernel(K::Reference, None)];
-        const COARSE_2X2: [KernelRef; 2] = [kernel(K::Coarse, Some(2)), kernel(K::Fine, Some(2))];
-        const COARSE_4X4: [KernelRef; 2] = [kernel(K::Coarse, Some(4)), kernel(K::Fine, Some(4))];
+        // On a GPU the tile kernel (one dispatch); on a CPU device the coarse and fine kernels.
+        const COARSE_2X2: [KernelRef; 3] =
+            [kernel(K::Tile, Some(2)), kernel(K::Coarse, Some(2)), kernel(K::Fine, Some(2))];
+        const COARSE_4X4: [KernelRef; 3] =
+            [kernel(K::Tile, Some(4)), kernel(K::Coarse, Some(4)), kernel(K::Fine, Some(4))];
         // The 4x4 level is the ordinary 4x4 coarse kernel; the dynamic mode has its own fine kernel.
         const DYNAMIC: [KernelRef; 3] = [
             kernel(K::Coarse, Some(DYNAMIC_OUTER_BLOCK)),

@@ -103,9 +103,16 @@ impl Default for PlanConstants {
 }
 
 impl Plan {
-    /// The plan of `mode`, if the program was compiled for it.
+    /// The plan of `mode` on a GPU, if the program was compiled for it.
     pub fn mode(&self, mode: Mode) -> Option<&ModePlan> {
-        self.modes.iter().find(|m| m.mode == mode)
+        self.mode_on(mode, Device::Gpu)
+    }
+
+    /// The plan of `mode` on `device`: the mode's plan for that kind of
+    /// device, else its plan for every device.
+    pub fn mode_on(&self, mode: Mode, device: Device) -> Option<&ModePlan> {
+        let of_mode = || self.modes.iter().filter(move |m| m.mode == mode);
+        of_mode().find(|m| m.device == Some(device)).or_else(|| of_mode().find(|m| m.device.is_none()))
     }
 
     /// The descriptor of a runtime-owned resource (`None` for engine-bound ones).
@@ -119,10 +126,42 @@ impl Plan {
     }
 }
 
+/// The kind of device a mode's plan is for ([`ModePlan::device`]).
+///
+/// A mode has one plan for every device unless measurement showed another
+/// layout of its kernels faster on one kind: the block modes run one tile
+/// kernel per frame on GPUs, and on CPU devices (lavapipe, SwiftShader),
+/// which run every lane of a workgroup's masked-off code and pay for each
+/// workgroup-memory word, their coarse and fine kernels
+/// (docs/evaluation.md, "One tile kernel"). Both give the same image and
+/// statistics, bit for bit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Device {
+    Gpu,
+    Cpu,
+}
+
+impl Device {
+    pub const ALL: [Device; 2] = [Device::Gpu, Device::Cpu];
+
+    /// The name in messages and on the command line (`gpu`, `cpu`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Device::Gpu => "gpu",
+            Device::Cpu => "cpu",
+        }
+    }
+}
+
 /// What one mode records, and how its statistics are read.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ModePlan {
     pub mode: Mode,
+    /// The kind of device this plan is for; `None`: every device
+    /// ([`Plan::mode_on`] picks).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub device: Option<Device>,
     /// The kernels its passes use (those of [`Mode::kernels`]).
     pub kernels: Vec<KernelRef>,
     pub steps: Vec<Step>,
@@ -191,6 +230,11 @@ pub struct Pass {
     /// in binding order. The same for every pass of the kernel.
     pub bindings: Vec<PassBinding>,
     pub dispatches: Vec<Dispatch>,
+    /// Bytes of workgroup memory the kernel declares (its `var<workgroup>`
+    /// variables, as WGSL lays them out): the device's
+    /// `maxComputeWorkgroupStorageSize` must hold them.
+    #[serde(default)]
+    pub workgroup_bytes: u32,
 }
 
 /// One binding of a pass's stage group.
@@ -456,6 +500,8 @@ pub struct DispatchContext {
 pub enum Workgroups {
     /// One per [`geometry::TILE`]² tile of pixels ([`geometry::pixel_workgroups`]).
     Tiles,
+    /// One per `side` x `side` pixels ([`geometry::tile_workgroups`]): the tile kernel.
+    PixelTiles { side: u32 },
     /// One per [`geometry::COARSE_WORKGROUP`]² coarse samples of `block`
     /// ([`geometry::coarse_workgroups`]).
     SampleGrid { block: u32 },
@@ -491,6 +537,7 @@ impl Workgroups {
         let size = context.size;
         Some(match self {
             Workgroups::Tiles => geometry::pixel_workgroups(size),
+            Workgroups::PixelTiles { side } => geometry::tile_workgroups(size, side),
             Workgroups::SampleGrid { block } => geometry::coarse_workgroups(size, block),
             Workgroups::Lattice { start, step, odd_only } => Lattice { start, step, odd_only }.workgroups(size),
             Workgroups::One => (1, 1),

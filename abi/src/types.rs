@@ -205,6 +205,15 @@ impl TextureFormat {
         self != TextureFormat::Depth32Float
     }
 
+    /// Bytes per texel.
+    pub fn texel_bytes(self) -> u32 {
+        match self {
+            TextureFormat::Rgba16Float => 8,
+            TextureFormat::Rgba8Unorm => 4,
+            other => 4 * other.components(),
+        }
+    }
+
     /// Number of channels.
     pub fn components(self) -> u32 {
         match self {

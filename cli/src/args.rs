@@ -34,6 +34,8 @@ pub struct RenderArgs {
     /// `--frames N`: N frames along the scene's camera path (see
     /// [`crate::frames`]) instead of a still frame.
     pub frames: Option<usize>,
+    /// `--plan`: the block modes' plan to run instead of the device's own.
+    pub plan: Option<mrsl_abi::Device>,
 }
 
 /// The modes of `--mode`, in the order given, each once.

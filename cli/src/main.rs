@@ -49,9 +49,9 @@ enum Command {
     },
     /// Compile a program to WGSL kernels and a layout description.
     ///
-    /// Writes the kernels of the modes asked for (all by default: 15
+    /// Writes the kernels of the modes asked for (all by default: 17
     /// kernels), named <name>.KIND.bB.wgsl for the kinds that exist per
-    /// block size (coarse and fine at 2 and 4, dynamic_coarse at 2,
+    /// block size (tile, coarse and fine at 2 and 4, dynamic_coarse at 2,
     /// dynamic_fine at 4, multi_coarse at 4 and 2, multi_resolve at 4,
     /// multi_fine at 2) and <name>.KIND.wgsl for the others (reference,
     /// hierarchical, checkerboard, rate_coarse, rate_fine), and
@@ -70,7 +70,7 @@ enum Command {
         /// hierarchical, checkerboard, rate-image, multi-rate), or all.
         #[arg(long, alias = "modes", value_parser = args::parse_modes, default_value = "all")]
         mode: args::ModeList,
-        /// With --emit coarse or fine: the block size of the kernel printed.
+        /// With --emit coarse, fine or tile: the block size of the kernel printed.
         #[arg(short, long = "block", value_parser = ["2", "4"], default_value = "4")]
         block: String,
         /// Read the G-buffer channels through read-only storage bindings (faster on
@@ -243,6 +243,10 @@ struct Render {
     /// Rate-image mode: pixels per side of a shading-rate tile.
     #[arg(long, default_value_t = mrsl_abi::shading_rate::DEFAULT_RATE_TILE, value_parser = parse_rate_tile)]
     rate_tile: u32,
+    /// The block modes' plan: gpu (one tile kernel) or cpu (a coarse and a fine kernel); default: the
+    /// one for the kind of device rendering (both give the same image).
+    #[arg(long, value_enum)]
+    plan: Option<PlanDevice>,
     /// Rate-image mode: the Weber–Fechner variant of the rate source (more conservative in the dark).
     #[arg(long)]
     weber_fechner: bool,
@@ -302,6 +306,7 @@ impl RatePreset {
 enum Emit {
     Coarse,
     Fine,
+    Tile,
     Reference,
     Layout,
 }
@@ -393,6 +398,23 @@ impl Render {
             },
             motion: !self.no_motion,
             frames: self.frames,
+            plan: self.plan.map(PlanDevice::abi),
+        }
+    }
+}
+
+/// `--plan`: which of the block modes' plans runs.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum PlanDevice {
+    Gpu,
+    Cpu,
+}
+
+impl PlanDevice {
+    fn abi(self) -> mrsl_abi::Device {
+        match self {
+            PlanDevice::Gpu => mrsl_abi::Device::Gpu,
+            PlanDevice::Cpu => mrsl_abi::Device::Cpu,
         }
     }
 }
@@ -509,6 +531,7 @@ fn compile(
             Emit::Layout => program.layout.to_json(),
             Emit::Coarse => kernel(KernelKind::Coarse)?,
             Emit::Fine => kernel(KernelKind::Fine)?,
+            Emit::Tile => kernel(KernelKind::Tile)?,
             Emit::Reference => kernel(KernelKind::Reference)?,
         };
         std::io::stdout().write_all(text.as_bytes())?;
@@ -668,11 +691,12 @@ mod tests {
         assert!(help.contains(&format!("all by default: {} kernels", all.kernels.len())), "{help}");
         let expected = mrsl::compile(&source, &Options { file_name: demo.into(), ..Options::default() }).unwrap();
         assert_eq!(all.layout.plan, expected.layout.plan);
-        assert_eq!(all.layout.plan.modes.len(), mrsl::Mode::ALL.len());
+        // The block modes have a plan for GPUs and one for CPU devices.
+        assert_eq!(all.layout.plan.modes.len(), mrsl::Mode::ALL.len() + 2);
         let two = compile(&["--mode", "coarse4x4,hierarchical"]);
         let modes: Vec<mrsl::Mode> = two.layout.plan.modes.iter().map(|m| m.mode).collect();
-        assert_eq!(modes, [mrsl::Mode::Coarse4x4, mrsl::Mode::Hierarchical]);
-        assert_eq!(two.kernels.len(), 3, "coarse b4, fine b4, hierarchical");
+        assert_eq!(modes, [mrsl::Mode::Coarse4x4, mrsl::Mode::Coarse4x4, mrsl::Mode::Hierarchical]);
+        assert_eq!(two.kernels.len(), 4, "coarse b4, fine b4, tile b4, hierarchical");
         std::fs::remove_dir_all(&dir).unwrap();
         let argv = ["mrslc", "compile", demo, "--mode", "coarse4x4", "--emit", "fine", "-b", "2"];
         let message = run(&Cli::try_parse_from(argv).unwrap()).unwrap_err().to_string();

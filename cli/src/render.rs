@@ -137,12 +137,38 @@ pub fn runnable_modes(args: &RenderArgs, shader: &Shader) -> Result<Vec<Mode>> {
     Ok(modes)
 }
 
+/// What the plan `options` run does, from its data
+/// ([`mrsl_lab::figures::PlanFigures`]), as a line of the render summary.
+fn plan_summary(shader: &Shader, options: DispatchOptions, size: (u32, u32)) -> String {
+    let device = options.device.unwrap_or(shader.device());
+    let layout = shader.layout();
+    let Some(plan) = layout.plan.mode_on(options.mode, device) else { return String::new() };
+    let f = mrsl_lab::figures::PlanFigures::of(layout, plan, size);
+    let which = match plan.device {
+        Some(d) => format!("{} plan", d.name()),
+        None => "plan".to_string(),
+    };
+    let mut line = format!(
+        "{} {which}: {} dispatches, {:.0} bytes of global memory per pixel (modelled; {:.1} of them the \
+         interface), {} bytes of workgroup memory",
+        options.mode, f.dispatches, f.global_bytes_per_pixel, f.interface_bytes_per_pixel, f.workgroup_bytes
+    );
+    if let Some(e) = f.sample_evaluations {
+        line.push_str(&format!(", at most {e} evaluation(s) of a coarse effect per coarse sample"));
+    }
+    if let Some(overlap) = f.tile_overlap {
+        line.push_str(&format!(" (a tile evaluates {overlap:.2} samples per sample it owns)"));
+    }
+    line
+}
+
 /// The dispatch options of `mode` under the command line's.
 pub fn dispatch_options(args: &RenderArgs, mode: Mode) -> DispatchOptions {
     DispatchOptions {
         force_refine: args.force_refine,
         similarity: args.similarity,
         rate_tile: args.rates.tile,
+        device: args.plan,
         ..DispatchOptions::new(mode)
     }
 }
@@ -233,13 +259,15 @@ impl Still<'_> {
         progress(&format!("rendered {mode} (first run, pipelines warming up)"), start);
         let (wall_ms, relative_to_reference) = self.wall_time(shader, mode)?;
         match relative_to_reference {
-            Some(r) => eprintln!(
-                "{mode}: {wall_ms:.1} ms {}, {:.2}x the reference's speed (median of {PAIRS} runs paired with the reference)",
+            Some((r, reference_ms)) => eprintln!(
+                "{mode}: {wall_ms:.1} ms {}, {:.2}x the reference's speed (median of {PAIRS} runs paired with \
+                 reference runs of median {reference_ms:.1} ms)",
                 crate::timing::clock(self.gpu).short(),
                 1.0 / r
             ),
             None => eprintln!("{mode}: {wall_ms:.1} ms {}", crate::timing::clock(self.gpu).short()),
         }
+        eprintln!("{}", plan_summary(shader, dispatch_options(args, mode), self.resources.size));
         let mut metrics = None;
         if args.compare {
             let pixels = gpu.read_rgba32f(self.first_output)?;
@@ -258,7 +286,7 @@ impl Still<'_> {
         if args.stats || args.output.is_none() {
             println!("{}", stats.table());
         }
-        Ok(Run { stats, metrics, wall_ms, relative_to_reference })
+        Ok(Run { stats, metrics, wall_ms, relative_to_reference: relative_to_reference.map(|(r, _)| r) })
     }
 
     /// The rate-image mode's rates: one everywhere (`--uniform-rate`), else
@@ -284,7 +312,7 @@ impl Still<'_> {
     /// Warm wall time, without instrumentation (the statistics are the first
     /// run's); with `--compare`, the median of [`PAIRS`] runs paired with the
     /// reference, and the median ratio to it.
-    fn wall_time(&self, shader: &mut Shader, mode: Mode) -> Result<(f64, Option<f64>)> {
+    fn wall_time(&self, shader: &mut Shader, mode: Mode) -> Result<(f64, Option<(f64, f64)>)> {
         let (gpu, bindings) = (self.gpu, &self.bindings);
         let timed = |mode| dispatch_options(self.args, mode).uninstrumented();
         if !self.args.compare || mode == Mode::Reference {
@@ -293,7 +321,7 @@ impl Still<'_> {
         let p = paired(PAIRS, timed(mode), timed(Mode::Reference), |o| time_run(gpu, shader, bindings, o))?;
         // The images below are this mode's again (the rate image is still the first run's).
         time_run(gpu, shader, bindings, timed(mode))?;
-        Ok((median(p.walls), Some(median(p.ratios))))
+        Ok((median(p.walls), Some((median(p.ratios), median(p.reference_walls)))))
     }
 
     /// The metrics of `pixels` against the reference, and the error image written.

@@ -116,6 +116,8 @@ pub const WARM_UP_MAX: usize = 20;
 pub struct Paired {
     pub walls: Vec<f64>,
     pub ratios: Vec<f64>,
+    /// The wall times of the reference runs, pair by pair.
+    pub reference_walls: Vec<f64>,
 }
 
 /// Times `pairs` runs of `options` with `time`, each paired with a run of
@@ -126,7 +128,7 @@ pub fn paired(
     reference: DispatchOptions,
     mut time: impl FnMut(DispatchOptions) -> Result<f64>,
 ) -> Result<Paired> {
-    let (mut walls, mut ratios) = (vec![], vec![]);
+    let (mut walls, mut ratios, mut reference_walls) = (vec![], vec![], vec![]);
     for pair in 0..pairs {
         let (wall, reference_wall) = if pair % 2 == 0 {
             let r = time(reference)?;
@@ -137,8 +139,9 @@ pub fn paired(
         };
         walls.push(wall);
         ratios.push(wall / reference_wall);
+        reference_walls.push(reference_wall);
     }
-    Ok(Paired { walls, ratios })
+    Ok(Paired { walls, ratios, reference_walls })
 }
 
 /// The median (the mean of the middle two for an even count); NaN for none.

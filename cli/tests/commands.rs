@@ -164,18 +164,24 @@ fn gpu_bench_script_writes_the_suite_report() {
     files.sort();
     assert_eq!(files, ["suite.json", "suite.md"]);
     let suite = read_json(&dir.join("suite.json"));
-    assert_eq!(suite["format"], "mrsl-suite/1");
+    assert_eq!(suite["format"], "mrsl-suite/2");
     assert!(suite["device"]["name"].as_str().is_some_and(|n| !n.is_empty()));
     let scenes = suite["scenes"].as_array().unwrap();
     assert_eq!(scenes.len(), 1, "{suite}");
     assert_eq!((scenes[0]["scene"].as_str(), scenes[0]["width"].as_u64()), (Some("sponza"), Some(48)));
     let modes = scenes[0]["modes"].as_array().unwrap();
-    assert_eq!(modes.len(), 7, "every adaptive mode");
+    assert_eq!(modes.len(), 9, "every adaptive mode, and the block modes' other plan");
+    let others: Vec<&str> =
+        modes.iter().filter(|m| !m["other_plan"].is_null()).map(|m| m["mode"].as_str().unwrap()).collect();
+    assert_eq!(others, ["coarse2x2", "coarse4x4"]);
     for m in modes {
         let figure = |key: &str| m[key].as_f64().unwrap_or_else(|| panic!("{key} of {m}"));
-        for key in ["speedup", "time_ratio", "forced_ratio", "wall_ms"] {
+        for key in ["speedup", "time_ratio", "forced_ratio", "wall_ms", "reference_ms"] {
             assert!(figure(key).is_finite() && figure(key) > 0.0, "{key} of {m}");
         }
+        let dispatches = m["figures"]["dispatches"].as_u64().unwrap();
+        assert!(dispatches >= 1, "{m}");
+        assert!(m["figures"]["global_bytes_per_pixel"].as_f64().is_some_and(|b| b > 0.0), "{m}");
         let mssim = m["metrics"]["mssim"].as_f64().unwrap();
         assert!(mssim > 0.5 && mssim <= 1.0, "{m}");
         // The floor is measured for the modes whose adaptive work one kernel edit removes.

@@ -232,11 +232,12 @@ fn a_program_compiles_to_its_kernels_and_layout(server: &Server) {
     assert_eq!(all["ok"], true);
     assert_eq!(all["diagnostics"], json!([]));
     let kernels = all["kernels"].as_array().unwrap();
-    assert_eq!(kernels.len(), 15, "every mode's kernels");
+    assert_eq!(kernels.len(), 17, "every mode's kernels");
     let coarse = kernels.iter().find(|k| k["kind"] == "coarse" && k["block"] == 4).unwrap();
     assert_eq!(coarse["file"], "program.coarse.b4.wgsl");
     assert!(coarse["wgsl"].as_str().unwrap().contains("@compute"));
-    assert_eq!(all["layout"]["plan"]["modes"].as_array().unwrap().len(), 8);
+    // Every mode, the block modes once for GPUs and once for CPU devices.
+    assert_eq!(all["layout"]["plan"]["modes"].as_array().unwrap().len(), 10);
     let one = server.post("/api/compile", &json!({ "source": source("demo.mrsl"), "modes": ["reference"] })).json();
     let kinds: Vec<&Value> = one["kernels"].as_array().unwrap().iter().map(|k| &k["kind"]).collect();
     assert_eq!(kinds, [&json!("reference")]);

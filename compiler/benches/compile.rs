@@ -2,7 +2,7 @@
 //!
 //! Run with `cargo bench -p mrsl --bench compile [-- FILTER]`. Groups:
 //!
-//! * `examples`: full [`mrsl::compile`] (default options: the fifteen
+//! * `examples`: full [`mrsl::compile`] (default options: the seventeen
 //!   kernels, coarse and fine for block sizes 2 and 4, reference, dynamic
 //!   coarse and fine, hierarchical, checkerboard, rate-image coarse and
 //!   fine, each validated by naga) of every `examples/*.mrsl`.
@@ -11,8 +11,8 @@
 //!   output, measured at several depths: `check` (front end only), `interface`
 //!   (slot allocation alone, on a pre-built checked program and graph),
 //!   `compile_reference` (one mode: the reference kernel), `compile_coarse4x4`
-//!   (one mode: the coarse and fine 4x4 kernels), `compile_default` (the fifteen
-//!   kernels), and `naga_validate` (naga parsing + validation of the fifteen
+//!   (one mode: the tile, coarse and fine 4x4 kernels), `compile_default` (the seventeen
+//!   kernels), and `naga_validate` (naga parsing + validation of the seventeen
 //!   kernels alone, one after the other: the part of `compile_default` that is
 //!   not mrsl's own code).
 //! * `growth`: the same program at N = 1,000 and 3,000 (`check`,
@@ -265,7 +265,7 @@ fn bench_generated(c: &mut Criterion) {
             });
         }
 
-        // naga's share of `compile_default`: parsing and validating the fifteen kernels.
+        // naga's share of `compile_default`: parsing and validating the seventeen kernels.
         let kernels: Vec<String> = mrsl::compile(&source, &default)
             .expect("generated program compiles")
             .compiled
@@ -310,7 +310,7 @@ fn bench_growth(c: &mut Criterion) {
     group.finish();
 }
 
-/// The derivative chain of each length, all fifteen kernels.
+/// The derivative chain of each length, all seventeen kernels.
 fn bench_chain(c: &mut Criterion) {
     let options = mrsl::Options::default();
     let mut group = c.benchmark_group("chain");

@@ -42,6 +42,10 @@ pub struct DerivSite<'a> {
     pub node: NodeId,
     pub call: Span,
     pub builtin: crate::builtins::Builtin,
+    /// Whether the call sits in a statement that only decides the effect's
+    /// refine flag ([`DerivInfo::value_skips`]): an evaluation for the value
+    /// alone never runs it.
+    pub decides_only: bool,
 }
 
 /// Per-program derivative information.
@@ -129,10 +133,60 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
                 node: call.id,
                 call: call.span,
                 builtin: *builtin,
+                decides_only: false,
             });
         }
     }
+    mark_decides_only(&mut info, program);
     (info, diagnostics)
+}
+
+/// Sets [`DerivSite::decides_only`] on the derivative calls inside each
+/// effect's skipped statements.
+fn mark_decides_only(info: &mut DerivInfo, program: &Program) {
+    let effects = program.items.iter().filter_map(|item| match item {
+        Item::Effect(effect) => Some(effect),
+        _ => None,
+    });
+    for (k, effect) in effects.enumerate() {
+        let (Some(skips), EffectBody::Block(b)) = (info.value_skips.get(&EffectId(k as u32)), &effect.body) else {
+            continue;
+        };
+        let mut inside = vec![];
+        for s in &b.stmts {
+            skipped_statements(s, skips, &mut inside);
+        }
+        let mut calls = vec![];
+        for s in inside {
+            visit_stmt_exprs(s, &mut |e| visit_expr(e, &mut |x| calls.extend(info.site_of.get(&x.id).copied())));
+        }
+        for site in calls {
+            info.sites[site].decides_only = true;
+        }
+    }
+}
+
+/// The outermost statements of `s` (itself included) that are in `skips`.
+fn skipped_statements<'s>(s: &'s Stmt, skips: &HashSet<NodeId>, out: &mut Vec<&'s Stmt>) {
+    if skips.contains(&s.id) {
+        out.push(s);
+        return;
+    }
+    match &s.kind {
+        StmtKind::If { then, otherwise, .. } => {
+            skipped_statements(then, skips, out);
+            if let Some(o) = otherwise {
+                skipped_statements(o, skips, out);
+            }
+        }
+        StmtKind::For { init, step, body, .. } => {
+            for sub in [init.as_deref(), step.as_deref(), Some(body.as_ref())].into_iter().flatten() {
+                skipped_statements(sub, skips, out);
+            }
+        }
+        StmtKind::Block(b) => b.stmts.iter().for_each(|sub| skipped_statements(sub, skips, out)),
+        _ => {}
+    }
 }
 
 /// W0003 for each surface derivative (`fwidth_surface`, ...) that can only

@@ -9,11 +9,12 @@ use crate::graph::EffectGraph;
 use crate::interface::Interface;
 use crate::syntax::ast::Rate;
 use crate::types::{Scalar, Type, round_up};
+use mrsl_abi::geometry;
 use mrsl_abi::{
     BINDING_CONTROL, BINDING_UNIFORMS, CONTROL_FIELDS, Channel, ChannelAccess, Control, ControlBlock, Decode,
     EffectLayout, Field, GROUP_ARGS, GROUP_GBUFFER, GROUP_RESOURCES, GROUP_STAGE, HierarchicalLayout, InterfaceLayout,
     LAYOUT_FORMAT, Layout, NeighbourLayout, NeighbourValue, Output, Plan, Resample, ResourceBinding, ResourceKind,
-    SampleType, SlotLayout, StatsLayout, TextureFormat, UniformBlock, ValueType,
+    SampleType, SlotLayout, StatsLayout, TextureFormat, TileLayout, UniformBlock, ValueType,
 };
 use std::collections::{BTreeSet, HashMap};
 
@@ -68,7 +69,7 @@ pub fn build(
         binding: stage_binding(checked, slot),
         kind,
     };
-    Layout {
+    let mut layout = Layout {
         format: LAYOUT_FORMAT.into(),
         control: control_block(),
         uniforms,
@@ -90,6 +91,7 @@ pub fn build(
         interface2: stage_resource(StageSlot::Interface2, "mrsl_interface2", ResourceKind::Storage),
         shading_rate: stage_resource(StageSlot::ShadingRate, "mrsl_shading_rate", ResourceKind::ShadingRate),
         neighbours: neighbours(checked, graph, deriv, stage_binding(checked, StageSlot::Neighbours)),
+        tile: TileLayout { samples: 0, ring: u32::from(pixels_read_coarse_at_neighbours(checked, graph, deriv)) },
         hierarchical: hierarchical_layout(checked, graph, interface),
         outputs: outputs(checked),
         effects: effect_layouts(checked, graph, interface, costs),
@@ -97,6 +99,75 @@ pub fn build(
         levels: None,
         // Filled in from the modes by `plan::build`.
         plan: Plan { modes: vec![], resources: vec![], constants: Default::default() },
+    };
+    let evaluations = sample_evaluations(checked, graph, deriv, &layout.neighbours);
+    for (effect, count) in layout.effects.iter_mut().zip(evaluations) {
+        effect.sample_evaluations = count;
+    }
+    layout
+}
+
+/// [`mrsl_abi::EffectLayout::sample_evaluations`] of every effect: how
+/// often the block modes' coarse pass evaluates each live coarse effect's
+/// body per coarse sample, given the neighbour values it stores.
+fn sample_evaluations(
+    checked: &Checked,
+    graph: &EffectGraph,
+    deriv: &DerivInfo,
+    neighbours: &NeighbourLayout,
+) -> Vec<Option<u32>> {
+    let n = checked.effects.len();
+    let mut count = vec![0u32; n];
+    let coarse = |e: EffectId| graph.live[e.index()] && checked.effects[e.index()].rate == Rate::Coarse;
+    let stored: BTreeSet<EffectId> = (0..n as u32)
+        .map(EffectId)
+        .filter(|e| neighbours.effects.iter().any(|v| v.name == checked.effects[e.index()].name))
+        .collect();
+    // The neighbour values' pass evaluates them and what they read, each once.
+    let chain: BTreeSet<EffectId> = stored.iter().flat_map(|&e| graph.closure(e, checked)).collect();
+    for e in &chain {
+        count[e.index()] += 1;
+    }
+    for e in (0..n as u32).map(EffectId).filter(|&e| coarse(e)) {
+        // A stored value is read back at its own sample unless its flag is needed.
+        if !stored.contains(&e) || checked.effects[e.index()].has_refine {
+            count[e.index()] += 1;
+            at_neighbours(checked, graph, deriv, e, false, 1, neighbours.words == 0, &mut count);
+        }
+    }
+    (0..n).map(|i| coarse(EffectId(i as u32)).then_some(count[i])).collect()
+}
+
+/// Adds the evaluations the derivatives in `e`'s body make at neighbouring
+/// samples, `times` over, when they evaluate there (`in_place`): the effects
+/// each operand reads and what those read, at one position per `ddx` or
+/// `ddy`, two per `fwidth` or `sample`; and so on for the derivatives their
+/// values take. With `value_only`, only the derivatives a value needs.
+#[allow(clippy::too_many_arguments, reason = "one recursion over the same facts")]
+fn at_neighbours(
+    checked: &Checked,
+    graph: &EffectGraph,
+    deriv: &DerivInfo,
+    e: EffectId,
+    value_only: bool,
+    times: u32,
+    in_place: bool,
+    count: &mut [u32],
+) {
+    if !in_place {
+        return;
+    }
+    for site in deriv.sites.iter().filter(|s| s.effect == e && !(value_only && s.decides_only)) {
+        let positions = match site.builtin.plain_derivative() {
+            crate::builtins::Builtin::Ddx | crate::builtins::Builtin::Ddy => 1,
+            _ => 2,
+        };
+        for &read in &site.effects {
+            for x in graph.closure(read, checked) {
+                count[x.index()] += times * positions;
+                at_neighbours(checked, graph, deriv, x, true, times * positions, in_place, count);
+            }
+        }
     }
 }
 
@@ -276,6 +347,8 @@ fn effect_layouts(checked: &Checked, graph: &EffectGraph, interface: &Interface,
                 pass_condition: condition,
                 operations: operations.get(&id).copied(),
                 value_operations: value_operations.get(&id).copied(),
+                // Filled in with the neighbour values, by `build`.
+                sample_evaluations: None,
             }
         })
         .collect()
@@ -362,7 +435,11 @@ fn neighbours(checked: &Checked, graph: &EffectGraph, deriv: &DerivInfo, binding
         .filter(|e| graph.live[e.index()])
         .collect();
     let evaluated: BTreeSet<EffectId> = needed.iter().flat_map(|&e| graph.closure(e, checked)).collect();
-    let nested = deriv.sites.iter().any(|site| evaluated.contains(&site.effect) && !site.effects.is_empty());
+    // Only the derivatives a value needs run at a neighbour (`DerivSite::decides_only`).
+    let nested = deriv
+        .sites
+        .iter()
+        .any(|site| evaluated.contains(&site.effect) && !site.effects.is_empty() && !site.decides_only);
     let mut words = 0;
     let mut effects = vec![];
     if !nested {
@@ -373,6 +450,39 @@ fn neighbours(checked: &Checked, graph: &EffectGraph, deriv: &DerivInfo, binding
         }
     }
     NeighbourLayout { binding, words, effects }
+}
+
+/// Whether a per-pixel evaluation (a fine effect, or a refined coarse effect
+/// evaluated for its value) takes a derivative of an operand that reads a
+/// coarse effect: then the value at the neighbouring pixel is resolved from
+/// that pixel's corners, which at the image's last column or row (the quad
+/// pair taken to the left) can be the previous tile's.
+fn pixels_read_coarse_at_neighbours(checked: &Checked, graph: &EffectGraph, deriv: &DerivInfo) -> bool {
+    let coarse = |e: EffectId| checked.effects[e.index()].rate == Rate::Coarse;
+    deriv.sites.iter().filter(|site| graph.live[site.effect.index()] && !site.decides_only).any(|site| {
+        site.effects.iter().any(|&e| graph.live[e.index()] && graph.closure(e, checked).into_iter().any(coarse))
+    })
+}
+
+/// The tile kernel's tile ([`TileLayout`]): the most samples per side of
+/// [`geometry::TILE_SAMPLES`] whose workgroup memory fits WebGPU's default
+/// limit, else the fewest (its kernel then runs on devices that grant more).
+pub fn tile_layout(layout: &Layout) -> TileLayout {
+    let ring = layout.tile.ring;
+    let fits = |samples| tile_workgroup_bytes(layout, TileLayout { samples, ring }) <= geometry::TILE_WORKGROUP_BYTES;
+    let all = geometry::TILE_SAMPLES;
+    let samples = all.iter().copied().find(|&s| fits(s)).unwrap_or(all[all.len() - 1]);
+    TileLayout { samples, ring }
+}
+
+/// The workgroup memory of the tile kernel with `tile`, as WebGPU counts it
+/// (each variable rounded up to 16 bytes): the records, the neighbour
+/// values and the statistics counters. A test holds the kernels to it.
+pub fn tile_workgroup_bytes(layout: &Layout, tile: TileLayout) -> u32 {
+    let records = layout.interface.stride_words.max(1) * tile.record_side().pow(2);
+    let neighbours = layout.neighbours.words * tile.neighbour_side().pow(2);
+    let variable = |words: u32| (4 * words).div_ceil(16) * 16;
+    variable(records) + variable(neighbours) + variable(layout.stats_counters() as u32)
 }
 
 /// The storage textures WebGPU guarantees a shader stage
@@ -398,4 +508,48 @@ pub fn hierarchical_level0_values(layout: &Layout) -> bool {
 pub fn uses_nearest(checked: &Checked, id: EffectId) -> bool {
     let e = &checked.effects[id.index()];
     e.nearest || e.ty.scalar() != Some(Scalar::Float)
+}
+
+#[cfg(test)]
+mod tests {
+    use mrsl_abi::Layout;
+
+    fn layout(source: &str) -> Layout {
+        crate::compile(source, &crate::Options::for_modes(&[mrsl_abi::Mode::Coarse4x4])).unwrap().layout.clone()
+    }
+
+    fn evaluations(layout: &Layout) -> Vec<(&str, Option<u32>)> {
+        layout.effects.iter().map(|e| (e.name.as_str(), e.sample_evaluations)).collect()
+    }
+
+    /// A derivative of an effect reads the neighbour values: every body runs
+    /// once per sample, the stored one in the neighbour pass. A stored effect
+    /// that refines runs again at the sample, for its flag. An effect whose
+    /// neighbour evaluation takes a derivative of another effect in turn is
+    /// evaluated in place: once at the sample and once per position of each
+    /// difference that reads it (`fwidth`: two).
+    #[test]
+    fn sample_evaluations_count_the_bodies_a_sample_runs() {
+        let head = "in float3 normal;\ncoarse effect float a = normal.x * normal.y;\n";
+        let stored = format!(
+            "{head}coarse effect float b {{\n    b = a * 2.0;\n    if (fwidth(a) > 0.1) refine;\n}}\n\
+             fine out float4 color = float4(b);\n"
+        );
+        assert_eq!(evaluations(&layout(&stored)), [("a", Some(1)), ("b", Some(1)), ("color", None)]);
+        let refining = stored.replace(
+            "coarse effect float a = normal.x * normal.y;",
+            "coarse effect float a {\n    a = normal.x;\n    if (a > 0.5) refine;\n}",
+        );
+        assert_eq!(evaluations(&layout(&refining)), [("a", Some(2)), ("b", Some(1)), ("color", None)]);
+        let nested = format!(
+            "{head}coarse effect float b = ddx(a);\ncoarse effect float c {{\n    c = b;\n    if (fwidth(b) > 0.1) refine;\n}}\n\
+             fine out float4 color = float4(c);\n"
+        );
+        let nested = layout(&nested);
+        assert_eq!(nested.neighbours.words, 0, "b's value takes a derivative of a: evaluated in place");
+        // c: once. b: once, and at two positions for c's fwidth. a: once for
+        // b at the sample, and per evaluation of b elsewhere once for itself
+        // and once for b's ddx: 1 + 1 + 2 x 2.
+        assert_eq!(evaluations(&nested), [("a", Some(6)), ("b", Some(3)), ("c", Some(1)), ("color", None)]);
+    }
 }

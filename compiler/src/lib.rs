@@ -204,7 +204,7 @@ pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnosti
 /// Parses and validates WGSL with naga, as WebGPU requires (no optional
 /// capabilities), on a thread with a large stack (see `validate::STACK`).
 pub fn validate_wgsl(wgsl: &str) -> Result<(), String> {
-    with_stack(|| naga_validate(wgsl)).map_err(|f| f.report)
+    with_stack(|| naga_validate(wgsl)).map(|_| ()).map_err(|f| f.report)
 }
 
 /// Everything after the checks: interface, layout, kernels and their validation.
@@ -223,6 +223,7 @@ fn generate(
         layout::read_channels_from_storage(&mut layout);
     }
     layout.hierarchical.packed = options.packed_records;
+    layout.tile = layout::tile_layout(&layout);
     let levels = options.modes.contains(&Mode::MultiRate).then(|| rates::levels(checked, graph));
     if let Some(levels) = &levels {
         layout.levels = Some(levels.layout(checked, layout::level_values_binding(checked)));
@@ -255,6 +256,7 @@ fn generate(
         )
     });
     let mut kernels = vec![];
+    let mut memory = vec![];
     let wanted = options.kernels();
     let texts: Vec<(KernelKind, Option<u32>, String)> = wanted
         .into_iter()
@@ -273,17 +275,19 @@ fn generate(
         .collect();
     // naga validation dominates compile time; the kernels are independent, so
     // they are validated on as many threads as there are kernels.
-    let verdicts: Vec<Result<(), NagaFailure>> = std::thread::scope(|scope| {
+    let verdicts: Vec<Result<u32, NagaFailure>> = std::thread::scope(|scope| {
         let handles: Vec<_> = texts.iter().map(|(_, _, wgsl)| spawn_validation(scope, wgsl)).collect();
         handles.into_iter().map(join_validation).collect()
     });
     for ((kind, block, wgsl), verdict) in texts.into_iter().zip(verdicts) {
-        if let Err(failure) = verdict {
-            let what = match block {
-                Some(b) => format!("{} kernel ({b}x{b})", kind.name()),
-                None => format!("{} kernel", kind.name()),
-            };
-            return Err(vec![
+        let workgroup_bytes = match verdict {
+            Ok(bytes) => bytes,
+            Err(failure) => {
+                let what = match block {
+                    Some(b) => format!("{} kernel ({b}x{b})", kind.name()),
+                    None => format!("{} kernel", kind.name()),
+                };
+                return Err(vec![
                 Diagnostic::bug(format!("internal compiler error: the generated {what} failed naga validation"))
                     .with_note(
                         "the program passed every check, so this is a bug in mrsl; please report it with the program",
@@ -291,9 +295,12 @@ fn generate(
                     .with_note(format!("naga: {}", failure.message))
                     .with_note(generated_context(&wgsl, failure.offset)),
             ]);
-        }
+            }
+        };
         kernels.push(Kernel { kind, block_size: block, wgsl });
+        memory.push((KernelRef::new(kind, block), workgroup_bytes));
     }
+    plan::set_workgroup_bytes(&mut layout.plan, &memory);
     Ok(Program { compiled: CompiledProgram::new(kernels, layout), warnings: diagnostics })
 }
 

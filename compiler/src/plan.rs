@@ -12,12 +12,15 @@ use mrsl_abi::plan::{
     BackgroundCounts, BindingType, Counts, Dispatch, Evaluations, Extent, ModePlan, Pass, PassBinding, Plan,
     ResourceDesc, ResourceId, SampleCount, Shape, Stage, Step, WorkListCounts, Workgroups,
 };
-use mrsl_abi::{KernelKind, KernelRef, Layout, Mode, TextureFormat, entry};
+use mrsl_abi::{Device, KernelKind, KernelRef, Layout, Mode, TextureFormat, entry};
 
 /// The plan of `modes` (each once, in [`Mode::ALL`] order) for a program of `layout`.
 pub fn build(layout: &Layout, modes: &[Mode]) -> Plan {
-    let modes: Vec<ModePlan> =
-        Mode::ALL.into_iter().filter(|m| modes.contains(m)).map(|mode| mode_plan(layout, mode)).collect();
+    let modes: Vec<ModePlan> = Mode::ALL
+        .into_iter()
+        .filter(|m| modes.contains(m))
+        .flat_map(|mode| devices(mode).into_iter().map(move |device| mode_plan(layout, mode, device)))
+        .collect();
     let mut ids: Vec<ResourceId> = modes.iter().flat_map(|m| m.resources()).filter(|id| !id.engine_bound()).collect();
     ids.sort();
     ids.dedup();
@@ -25,8 +28,28 @@ pub fn build(layout: &Layout, modes: &[Mode]) -> Plan {
     Plan { modes, resources, constants: Default::default() }
 }
 
-/// The steps and counts of one mode.
-fn mode_plan(layout: &Layout, mode: Mode) -> ModePlan {
+/// Sets every pass's `workgroup_bytes` from its kernel's, as validation measured them.
+pub fn set_workgroup_bytes(plan: &mut Plan, kernels: &[(KernelRef, u32)]) {
+    for step in plan.modes.iter_mut().flat_map(|m| m.steps.iter_mut()) {
+        if let Step::Pass(pass) = step {
+            pass.workgroup_bytes = kernels.iter().find(|(k, _)| *k == pass.kernel).map_or(0, |(_, bytes)| *bytes);
+        }
+    }
+}
+
+/// The kinds of device `mode` has a plan of its own for (`None`: one plan
+/// for every device). The block modes run the tile kernel on GPUs and the
+/// coarse and fine kernels on CPU devices, where they measured faster
+/// (docs/evaluation.md, "One tile kernel").
+fn devices(mode: Mode) -> Vec<Option<Device>> {
+    match mode {
+        Mode::Coarse2x2 | Mode::Coarse4x4 => vec![Some(Device::Gpu), Some(Device::Cpu)],
+        _ => vec![None],
+    }
+}
+
+/// The steps and counts of one mode on `device`.
+fn mode_plan(layout: &Layout, mode: Mode, device: Option<Device>) -> ModePlan {
     let mut steps = vec![Step::Clear { resource: ResourceId::Statistics }];
     let counts = match mode {
         Mode::Reference => {
@@ -39,6 +62,7 @@ fn mode_plan(layout: &Layout, mode: Mode) -> ModePlan {
                 background: None,
             }
         }
+        Mode::Coarse2x2 | Mode::Coarse4x4 if device == Some(Device::Gpu) => tile_steps(layout, mode, &mut steps),
         Mode::Coarse2x2 | Mode::Coarse4x4 | Mode::Dynamic => block_steps(layout, mode, &mut steps),
         Mode::Hierarchical => hierarchical_steps(layout, &mut steps),
         Mode::Checkerboard => {
@@ -59,12 +83,35 @@ fn mode_plan(layout: &Layout, mode: Mode) -> ModePlan {
         let sampled = !matches!(counts.samples, SampleCount::None);
         counts.background = Some(BackgroundCounts { pixels, samples: sampled.then_some(samples) });
     }
-    ModePlan { mode, kernels: mode.kernels().to_vec(), steps, counts }
+    let used: Vec<KernelRef> = steps
+        .iter()
+        .filter_map(|s| match s {
+            Step::Pass(p) => Some(p.kernel),
+            _ => None,
+        })
+        .collect();
+    let kernels = mode.kernels().iter().copied().filter(|k| used.contains(k)).collect();
+    ModePlan { mode, device, kernels, steps, counts }
 }
 
-/// The block modes and the dynamic mode: the coarse samples (their
-/// neighbour values first, when the program stores them), the dynamic
-/// mode's 2x2 level, then the per-pixel pass.
+/// The block modes: one dispatch of the tile kernel, a workgroup per tile
+/// of the layout's `tile` samples per side.
+fn tile_steps(layout: &Layout, mode: Mode, steps: &mut Vec<Step>) -> Counts {
+    let block = mode.block_size().expect("block modes have a block size");
+    let kernel = KernelRef::new(KernelKind::Tile, Some(block));
+    let tiles = dispatch(entry::TILE, Workgroups::PixelTiles { side: layout.tile.side(block) });
+    steps.push(pass(layout, "mrsl tiles", Stage::Fine, kernel, vec![tiles]));
+    Counts {
+        samples: SampleCount::Grid { block, counter: None },
+        evaluations: Evaluations::SamplesAndCounted,
+        work_lists: None,
+        background: None,
+    }
+}
+
+/// The block modes on CPU devices and the dynamic mode: the coarse samples
+/// (their neighbour values first, when the program stores them), the
+/// dynamic mode's 2x2 level, then the per-pixel pass.
 fn block_steps(layout: &Layout, mode: Mode, steps: &mut Vec<Step>) -> Counts {
     let block = mode.block_size().expect("block modes have a block size");
     let samples = Workgroups::SampleGrid { block };
@@ -280,7 +327,9 @@ fn rate_image_steps(layout: &Layout, steps: &mut Vec<Step>) -> Counts {
 }
 
 fn pass(layout: &Layout, label: &str, stage: Stage, kernel: KernelRef, dispatches: Vec<Dispatch>) -> Step {
-    Step::Pass(Pass { label: label.into(), stage, kernel, bindings: stage_bindings(layout, kernel), dispatches })
+    let bindings = stage_bindings(layout, kernel);
+    // Measured on the kernel once it is written (`mrsl::compile`).
+    Step::Pass(Pass { label: label.into(), stage, kernel, bindings, dispatches, workgroup_bytes: 0 })
 }
 
 fn dispatch(entry: &str, workgroups: Workgroups) -> Dispatch {
@@ -311,6 +360,8 @@ fn kernel_resources(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
             coarse
         }
         KernelKind::Fine => vec![at(interface, R::Records { block }, T::RecordTexture)],
+        // Its interface and neighbour values are in workgroup memory.
+        KernelKind::Tile => vec![],
         // Reads the 4x4 level, writes the 2x2 level and counts its samples.
         KernelKind::DynamicCoarse => vec![
             at(interface, R::Records { block: DYNAMIC_OUTER_BLOCK }, T::RecordTexture),
@@ -385,7 +436,7 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
     // With a background rule the coarse kernels count the background samples.
     // (The multi-rate mode counts its 2x2 samples, those of its finest grid.)
     let counts_background = match kernel.kind {
-        KernelKind::Coarse | KernelKind::RateCoarse => true,
+        KernelKind::Coarse | KernelKind::RateCoarse | KernelKind::Tile => true,
         KernelKind::MultiCoarse => block == DYNAMIC_INNER_BLOCK,
         _ => false,
     } && layout.has_background();
@@ -401,7 +452,8 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
                 .map(|(index, o)| at(o.binding, R::Output { index }, T::StorageTexture { format: o.format })),
         );
     }
-    let counts = kernel.kind.is_fine() || matches!(kernel.kind, KernelKind::Hierarchical | KernelKind::Checkerboard);
+    let counts = kernel.kind.is_fine()
+        || matches!(kernel.kind, KernelKind::Tile | KernelKind::Hierarchical | KernelKind::Checkerboard);
     // The multi-rate resolve pass counts the `coarse(4)` effects, where there are any.
     let counts = counts && (kernel.kind != KernelKind::MultiResolve || has_outer_effects(layout));
     if counts && !layout.stats.counters.is_empty() {
@@ -410,6 +462,8 @@ pub fn stage_bindings(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
         bindings.push(at(layout.refine_mask.binding, R::RefineMask, T::StorageTexture { format }));
     }
     bindings.sort_by_key(|b| b.binding);
+    // The tile kernel counts background samples and re-evaluations in the same statistics.
+    bindings.dedup();
     bindings
 }
 
@@ -522,7 +576,11 @@ mod tests {
         let source = "in float3 normal;\ncoarse effect float d = normal.y;\nfine out float4 color = float4(d);\n";
         let program = crate::compile(source, &crate::Options::default()).unwrap();
         let plan = &program.layout.plan;
-        assert_eq!(plan.modes.len(), Mode::ALL.len());
+        // Every mode has a plan, and the block modes one per kind of device.
+        for mode in Mode::ALL {
+            let plans: Vec<Option<Device>> = plan.modes.iter().filter(|m| m.mode == mode).map(|m| m.device).collect();
+            assert_eq!(plans, devices(mode), "{mode}");
+        }
         for mode in &plan.modes {
             for pass in mode.passes() {
                 assert_eq!(pass.bindings, stage_bindings(&program.layout, pass.kernel), "{}", pass.label);
@@ -559,15 +617,15 @@ mod tests {
         }
     }
 
-    /// With a background rule the block and dynamic fine passes classify
-    /// the tiles and shade the two lists indirectly; without one they shade
-    /// every tile directly.
+    /// With a background rule the block (on CPU devices) and dynamic fine
+    /// passes classify the tiles and shade the two lists indirectly; without
+    /// one they shade every tile directly.
     #[test]
     fn fine_passes_shade_tile_lists_only_with_a_background_rule() {
         let body = "coarse effect float d = normal.y;\nfine out float4 color = float4(d);\n";
         let fine_entries = |source: &str, mode: Mode| {
             let program = crate::compile(source, &crate::Options::default()).unwrap();
-            let plan = program.layout.plan.mode(mode).unwrap().clone();
+            let plan = program.layout.plan.mode_on(mode, Device::Cpu).unwrap().clone();
             let fine = plan.passes().find(|p| p.stage == Stage::Fine).unwrap().clone();
             let cleared = plan.steps.contains(&Step::Clear { resource: ResourceId::TileCounts });
             (fine.dispatches.iter().map(|d| d.entry.clone()).collect::<Vec<_>>(), cleared)
@@ -579,6 +637,36 @@ mod tests {
             let listed = [entry::FINE_TILES, entry::FINE_TILE_ARGS, entry::FINE_BACKGROUND, main];
             assert_eq!(fine_entries(&with, mode), (listed.iter().map(|e| e.to_string()).collect(), true), "{mode}");
             assert_eq!(fine_entries(&format!("in float3 normal;\n{body}"), mode), (vec![main.to_string()], false));
+        }
+    }
+
+    /// On a GPU the block modes are one dispatch of the tile kernel, which
+    /// binds no interface (it is in workgroup memory) and declares the
+    /// workgroup memory the plan reports; with a background rule too.
+    #[test]
+    fn block_modes_are_one_tile_dispatch_on_a_gpu() {
+        let body = "coarse effect float d = normal.y;\nfine out float4 color = float4(d);\n";
+        for source in [
+            format!("in float3 normal;\n{body}"),
+            format!("in float3 normal;\n@background(255) in uint material;\n{body}"),
+        ] {
+            let program = crate::compile(&source, &crate::Options::default()).unwrap();
+            for mode in [Mode::Coarse2x2, Mode::Coarse4x4] {
+                let block = mode.block_size().unwrap();
+                let plan = program.layout.plan.mode_on(mode, Device::Gpu).unwrap();
+                let passes: Vec<&Pass> = plan.passes().collect();
+                assert_eq!(passes.len(), 1, "{mode}");
+                assert_eq!(passes[0].kernel, KernelRef::new(KernelKind::Tile, Some(block)));
+                let side = program.layout.tile.side(block);
+                assert_eq!(passes[0].dispatches, vec![dispatch(entry::TILE, Workgroups::PixelTiles { side })]);
+                let clears = plan.steps.iter().filter(|s| matches!(s, Step::Clear { .. })).count();
+                assert_eq!(clears, 1, "only the statistics are cleared");
+                assert!(passes[0].bindings.iter().all(|b| !matches!(b.resource, ResourceId::Records { .. })));
+                let bytes = passes[0].workgroup_bytes;
+                assert!(bytes > 0 && bytes <= geometry::TILE_WORKGROUP_BYTES, "{bytes}");
+                let estimate = crate::layout::tile_workgroup_bytes(&program.layout, program.layout.tile);
+                assert!(bytes <= estimate, "the layout's estimate {estimate} bounds the kernel's {bytes} bytes");
+            }
         }
     }
 }

@@ -46,7 +46,9 @@ pub(crate) struct NagaFailure {
     pub offset: Option<usize>,
 }
 
-pub(crate) fn naga_validate(wgsl: &str) -> Result<(), NagaFailure> {
+/// Parses and validates `wgsl`; on success, the bytes of workgroup memory it
+/// declares ([`workgroup_bytes`]).
+pub(crate) fn naga_validate(wgsl: &str) -> Result<u32, NagaFailure> {
     let module = naga::front::wgsl::parse_str(wgsl).map_err(|e| {
         let mut message = e.message().to_string();
         for (_, label) in e.labels().filter(|(_, l)| !l.is_empty()) {
@@ -76,7 +78,22 @@ pub(crate) fn naga_validate(wgsl: &str) -> Result<(), NagaFailure> {
                 offset: e.location(wgsl).map(|l| l.offset as usize),
             }
         })?;
-    Ok(())
+    Ok(workgroup_bytes(&module))
+}
+
+/// The workgroup memory a module declares, as WebGPU counts it against
+/// `maxComputeWorkgroupStorageSize`: each `var<workgroup>`'s size rounded up to 16 bytes.
+fn workgroup_bytes(module: &naga::Module) -> u32 {
+    let mut layouter = naga::proc::Layouter::default();
+    if layouter.update(module.to_ctx()).is_err() {
+        return 0;
+    }
+    module
+        .global_variables
+        .iter()
+        .filter(|(_, g)| g.space == naga::AddressSpace::WorkGroup)
+        .map(|(_, g)| layouter[g.ty].size.div_ceil(16) * 16)
+        .sum()
 }
 
 /// Starts validating `wgsl` on a thread with a [`STACK`]-byte stack (or, if
@@ -84,7 +101,7 @@ pub(crate) fn naga_validate(wgsl: &str) -> Result<(), NagaFailure> {
 pub(crate) fn spawn_validation<'scope>(
     scope: &'scope std::thread::Scope<'scope, '_>,
     wgsl: &'scope str,
-) -> Result<std::thread::ScopedJoinHandle<'scope, Result<(), NagaFailure>>, Result<(), NagaFailure>> {
+) -> Result<std::thread::ScopedJoinHandle<'scope, Result<u32, NagaFailure>>, Result<u32, NagaFailure>> {
     std::thread::Builder::new()
         .name("mrsl-naga".into())
         .stack_size(STACK)
@@ -93,8 +110,8 @@ pub(crate) fn spawn_validation<'scope>(
 }
 
 pub(crate) fn join_validation(
-    started: Result<std::thread::ScopedJoinHandle<'_, Result<(), NagaFailure>>, Result<(), NagaFailure>>,
-) -> Result<(), NagaFailure> {
+    started: Result<std::thread::ScopedJoinHandle<'_, Result<u32, NagaFailure>>, Result<u32, NagaFailure>>,
+) -> Result<u32, NagaFailure> {
     match started {
         Ok(handle) => handle.join().unwrap_or_else(|_| {
             let message = "naga panicked while validating".to_string();

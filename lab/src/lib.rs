@@ -28,6 +28,9 @@
 //! - [`runtime_dir`]: a private `XDG_RUNTIME_DIR` where there is none, so
 //!   that Mesa's Vulkan drivers print no error line.
 //! - [`metrics`]: RMSE, PSNR, MSSIM and FLIP against a reference image.
+//! - [`figures`]: what a mode's plan does that any device can report
+//!   (dispatches, global bytes per pixel, workgroup memory, evaluations
+//!   per coarse sample).
 //!
 //! The vector maths is glam's, but for `vector::normalize` (see there why).
 //!
@@ -36,12 +39,13 @@
 //! `rig` ← `mesh_scene` ← `scene` ← `scene_file`, `fixtures` ← `scene`, and
 //! `camera` ← `camera_path` ← `scene`, with `gpu`, `gbuffer`, `hash` and `vector`
 //! beneath them all; `uniforms` (used from `rig` on) depends on no other
-//! module, `metrics` on `color` alone, and `runtime_dir` on none.
+//! module, `metrics` on `color` alone, and `runtime_dir` and `figures` on none.
 
 pub mod camera;
 pub mod camera_path;
 pub mod color;
 pub mod engine_formats;
+pub mod figures;
 pub mod fixtures;
 pub mod gbuffer;
 pub mod gpu;

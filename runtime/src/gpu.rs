@@ -110,3 +110,12 @@ pub fn describe(error: &wgpu::Error) -> String {
         other => other.to_string(),
     }
 }
+
+/// The kind of device `device` is, for the plans it runs by default: a CPU
+/// device (a software rasteriser such as lavapipe or SwiftShader) or a GPU.
+pub fn device_kind(device: &wgpu::Device) -> mrsl_abi::Device {
+    match device.adapter_info().device_type {
+        wgpu::DeviceType::Cpu => mrsl_abi::Device::Cpu,
+        _ => mrsl_abi::Device::Gpu,
+    }
+}

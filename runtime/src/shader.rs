@@ -10,7 +10,7 @@ use crate::pool::ResourcePool;
 use crate::uniforms::UniformValues;
 use crate::{Mode, Stats};
 use mrsl_abi::plan::{DispatchContext, ModePlan, Pass, SampleCount, Stage, Step, Workgroups};
-use mrsl_abi::{CompiledProgram, Control, GROUP_ARGS, KernelKind, KernelRef, Layout, Plan, ResourceId, Scalar};
+use mrsl_abi::{CompiledProgram, Control, Device, GROUP_ARGS, KernelKind, KernelRef, Layout, Plan, ResourceId, Scalar};
 use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
@@ -57,6 +57,12 @@ pub struct DispatchOptions {
     /// ablation of docs/evaluation.md, 18% for the demo at 640x360;
     /// docs/runtime.md, section 5).
     pub statistics: bool,
+    /// Which of the mode's plans to run ([`mrsl_abi::Device`]): `None`, the
+    /// one for the kind of device the shader was made on (a CPU device, such
+    /// as lavapipe, or a GPU); `Some` to run the other (the block modes'
+    /// tile kernel on a CPU device, say, to compare them). Every plan of a
+    /// mode gives the same image and statistics, bit for bit.
+    pub device: Option<Device>,
 }
 
 impl DispatchOptions {
@@ -71,6 +77,7 @@ impl DispatchOptions {
             similarity: Self::DEFAULT_SIMILARITY,
             rate_tile: mrsl_abi::shading_rate::DEFAULT_RATE_TILE,
             statistics: true,
+            device: None,
         }
     }
 
@@ -141,6 +148,8 @@ pub struct Shader {
     frame: u32,
     timestamps: Option<Timestamps>,
     last: Option<(DispatchOptions, (u32, u32))>,
+    /// The kind of device the shader runs on, whose plans it runs by default.
+    device: Device,
 }
 
 impl Shader {
@@ -191,6 +200,7 @@ impl Shader {
             frame: 0,
             timestamps,
             last: None,
+            device: crate::gpu::device_kind(device),
         })
     }
 
@@ -254,19 +264,34 @@ impl Shader {
     /// [`Error::UnsupportedMode`], saying which kernel and why). Lets a tool
     /// that renders several modes skip one before binding anything.
     pub fn supports(&self, mode: Mode) -> Result<(), Error> {
+        self.supports_on(mode, self.device)
+    }
+
+    /// [`Shader::supports`] for the mode's plan on `device` ([`DispatchOptions::device`]).
+    pub fn supports_on(&self, mode: Mode, device: Device) -> Result<(), Error> {
         let unsupported = |reason: String| Error::UnsupportedMode(mode.name().into(), reason);
-        if let Some((kind, reason)) = mode.kernels().iter().find_map(|k| self.unavailable.get_key_value(&k.kind)) {
+        let Some(plan) = self.plan.mode_on(mode, device) else {
+            return Err(unsupported("the program's plan does not list it".into()));
+        };
+        if let Some((kind, reason)) = plan.kernels.iter().find_map(|k| self.unavailable.get_key_value(&k.kind)) {
             return Err(unsupported(format!("the device cannot run its {kind} kernel: {reason}")));
         }
         let has =
             |k: &KernelRef| k.kind.entry_points().iter().all(|e| self.pipelines.contains_key(&(*k, e.to_string())));
-        if let Some(missing) = mode.kernels().iter().find(|k| !has(k)) {
+        if let Some(missing) = plan.kernels.iter().find(|k| !has(k)) {
             return Err(unsupported(format!("the program was compiled without its {missing} kernel")));
         }
-        match self.plan.mode(mode) {
-            Some(_) => Ok(()),
-            None => Err(unsupported("the program's plan does not list it".into())),
-        }
+        Ok(())
+    }
+
+    /// The kind of device whose plans [`Shader::encode`] runs by default.
+    pub fn device(&self) -> Device {
+        self.device
+    }
+
+    /// The plan `options` run, once [`Shader::supports_on`] accepted it.
+    fn plan_of(&self, options: &DispatchOptions) -> &ModePlan {
+        self.plan.mode_on(options.mode, options.device.unwrap_or(self.device)).expect("checked by supports")
     }
 
     /// Whether [`Shader::encode`] can run `mode` for a `size` image:
@@ -276,8 +301,13 @@ impl Shader {
     /// interface buffer past a 128 MiB storage binding). Lets a tool skip one
     /// mode at a size another mode can still render.
     pub fn supports_size(&self, mode: Mode, size: (u32, u32)) -> Result<(), Error> {
-        self.supports(mode)?;
-        let plan = self.plan.mode(mode).expect("checked by supports");
+        self.supports_size_on(mode, self.device, size)
+    }
+
+    /// [`Shader::supports_size`] for the mode's plan on `device`.
+    pub fn supports_size_on(&self, mode: Mode, device: Device, size: (u32, u32)) -> Result<(), Error> {
+        self.supports_on(mode, device)?;
+        let plan = self.plan.mode_on(mode, device).expect("checked by supports");
         crate::validate::size(&self.plan, plan, size)
     }
 
@@ -292,9 +322,10 @@ impl Shader {
         bindings: &Bindings,
         options: DispatchOptions,
     ) -> Result<(), Error> {
-        self.supports_size(options.mode, bindings.size)?;
+        let device_kind = options.device.unwrap_or(self.device);
+        self.supports_size_on(options.mode, device_kind, bindings.size)?;
         let whole = Arc::clone(&self.plan);
-        let plan = whole.mode(options.mode).expect("checked by supports");
+        let plan = whole.mode_on(options.mode, device_kind).expect("checked by supports");
         crate::validate::bindings(&self.layout, plan, bindings, options.rate_tile)?;
         let uniform_bytes = match &self.layout.uniforms {
             Some(block) => Some(self.uniform_values.bytes(block)?),
@@ -417,7 +448,7 @@ impl Shader {
         if !options.statistics {
             return Err(Error::StatisticsOff);
         }
-        let plan = self.plan.mode(options.mode).expect("the last dispatch's mode has a plan");
+        let plan = self.plan_of(&options);
         let read = |id: ResourceId| -> Result<Vec<u32>, Error> {
             let buffer = self.pool.readback(id).ok_or_else(|| Error::Readback(format!("{id:?} was not read back")))?;
             read_buffer(device, buffer)
@@ -449,7 +480,7 @@ impl Shader {
     /// [`Shader::set_timestamp_period`] first for times in milliseconds.
     pub fn read_timings(&self, device: &wgpu::Device) -> Result<Option<crate::Timings>, Error> {
         let (options, _) = self.last.ok_or_else(|| Error::Readback("nothing was dispatched yet".into()))?;
-        let plan = self.plan.mode(options.mode).expect("the last dispatch's mode has a plan");
+        let plan = self.plan_of(&options);
         match &self.timestamps {
             Some(t) => Ok(Some(timings(plan, &read_buffer(device, &t.readback)?, t.period_ns))),
             None => Ok(None),
@@ -564,6 +595,16 @@ fn kernel_pipelines(
             continue;
         };
         if let Some(reason) = groups::missing_feature(device, &pass.bindings) {
+            unavailable.insert(kernel.kind, reason);
+            continue;
+        }
+        let workgroup_limit = device.limits().max_compute_workgroup_storage_size;
+        if pass.workgroup_bytes > workgroup_limit {
+            let reason = format!(
+                "it needs {} bytes of workgroup memory, more than the device's {workgroup_limit} \
+                 (`max_compute_workgroup_storage_size`)",
+                pass.workgroup_bytes
+            );
             unavailable.insert(kernel.kind, reason);
             continue;
         }

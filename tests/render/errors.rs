@@ -303,5 +303,5 @@ pub fn compiled_kernels_are_those_of_the_modes() {
         assert_eq!(kernels(&program), wanted, "{modes:?}");
     }
     let all = mrsl_runtime::compile(source, "modes.mrsl").unwrap();
-    assert_eq!(kernels(&all).len(), 15);
+    assert_eq!(kernels(&all).len(), 17);
 }

@@ -198,25 +198,72 @@ pub fn dispatch_in_turn<const N: usize>(
     bindings.shading_rate = Some(&shading_rate);
     let mut dispatched = vec![];
     for options in options {
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        shader.encode(&gpu.device, &gpu.queue, &mut encoder, &bindings, options)?;
-        gpu.queue.submit([encoder.finish()]);
-        let stats = shader.read_stats(&gpu.device);
-        let pixels = gpu.read_rgba32f(&outputs[0].1).map_err(|e| Error::Readback(e.to_string()))?;
-        let (refine_masks, refine_masks_y) = match shader.refine_mask() {
-            Some(t) => {
-                let texels = gpu.read_texture(t).map_err(|e| Error::Readback(e.to_string()))?;
-                // rg32uint: the mask is the first word of each 8-byte texel, then `.y`.
-                let word = |t: &[u8]| u32::from_le_bytes([t[0], t[1], t[2], t[3]]);
-                let x = texels.chunks_exact(8).map(|t| word(&t[..4])).collect();
-                let y = texels.chunks_exact(8).map(|t| word(&t[4..])).collect();
-                (Some(x), Some(y))
+        let first = dispatch_once(gpu, &mut shader, &bindings, &outputs[0].1, options)?;
+        // A mode with a plan per kind of device (the block modes: the tile
+        // kernel on GPUs, the coarse and fine kernels on CPU devices) runs
+        // every plan here, whatever the device, and each must give the same
+        // image, statistics and refine mask, bit for bit.
+        if options.device.is_none() {
+            let own = shader.device();
+            let plans = program.layout.plan.modes.iter().filter(|m| m.mode == options.mode && m.device.is_some());
+            for device in plans.filter_map(|m| m.device).filter(|d| *d != own) {
+                let other = dispatch_once(
+                    gpu,
+                    &mut shader,
+                    &bindings,
+                    &outputs[0].1,
+                    DispatchOptions { device: Some(device), ..options },
+                )?;
+                assert_same_dispatch(&first, &other, options, device);
             }
-            None => (None, None),
-        };
-        dispatched.push(Dispatched { pixels, stats, refine_masks, refine_masks_y });
+        }
+        dispatched.push(first);
     }
     Ok(dispatched.try_into().unwrap_or_else(|_| unreachable!("one result per dispatch")))
+}
+
+/// One dispatch of [`dispatch_in_turn`], read back: the first output `color`,
+/// the statistics and the refine mask.
+fn dispatch_once(
+    gpu: &Gpu,
+    shader: &mut Shader,
+    bindings: &Bindings,
+    color: &wgpu::Texture,
+    options: DispatchOptions,
+) -> Result<Dispatched, Error> {
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    shader.encode(&gpu.device, &gpu.queue, &mut encoder, bindings, options)?;
+    gpu.queue.submit([encoder.finish()]);
+    let stats = shader.read_stats(&gpu.device);
+    let pixels = gpu.read_rgba32f(color).map_err(|e| Error::Readback(e.to_string()))?;
+    let (refine_masks, refine_masks_y) = match shader.refine_mask() {
+        Some(t) => {
+            let texels = gpu.read_texture(t).map_err(|e| Error::Readback(e.to_string()))?;
+            // rg32uint: the mask is the first word of each 8-byte texel, then `.y`.
+            let word = |t: &[u8]| u32::from_le_bytes([t[0], t[1], t[2], t[3]]);
+            let x = texels.chunks_exact(8).map(|t| word(&t[..4])).collect();
+            let y = texels.chunks_exact(8).map(|t| word(&t[4..])).collect();
+            (Some(x), Some(y))
+        }
+        None => (None, None),
+    };
+    Ok(Dispatched { pixels, stats, refine_masks, refine_masks_y })
+}
+
+/// Two plans of one mode gave the same image (bit for bit), statistics and refine masks.
+#[track_caller]
+fn assert_same_dispatch(first: &Dispatched, other: &Dispatched, options: DispatchOptions, device: mrsl_abi::Device) {
+    let what = format!("{} (forced: {}), its {} plan", options.mode, options.force_refine, device.name());
+    let bits = |p: &[[f32; 4]]| p.iter().flat_map(|t| t.map(f32::to_bits)).collect::<Vec<u32>>();
+    assert!(
+        bits(&first.pixels) == bits(&other.pixels),
+        "{what}: another image (worst {} ulps)",
+        worst_ulps(&first.pixels, &other.pixels)
+    );
+    let counts = |s: &Result<Stats, Error>| s.as_ref().ok().map(|s| Stats { timings: None, ..s.clone() });
+    assert_eq!(counts(&first.stats), counts(&other.stats), "{what}: other statistics");
+    assert!(first.refine_masks == other.refine_masks, "{what}: another refine mask");
+    assert!(first.refine_masks_y == other.refine_masks_y, "{what}: another refine mask (.y)");
 }
 
 /// Bindings of a test program: its channels and outputs by name, and the

@@ -166,8 +166,13 @@ export interface KernelRef {
   block: number | null;
 }
 
+/** The kind of device a mode's plan is for (`mrsl_abi::Device`). */
+export type PlanDevice = 'gpu' | 'cpu';
+
 export interface ModePlan {
   mode: Mode;
+  /** Absent: the plan for every device. */
+  device?: PlanDevice;
   kernels: KernelRef[];
   steps: Step[];
   counts: Counts;
@@ -186,6 +191,8 @@ export interface Pass {
   kernel: KernelRef;
   bindings: PassBinding[];
   dispatches: Dispatch[];
+  /** Bytes of workgroup memory the kernel declares (against `maxComputeWorkgroupStorageSize`). */
+  workgroup_bytes?: number;
 }
 
 export interface PassBinding {
@@ -253,6 +260,7 @@ export type Extent =
 
 export type Workgroups =
   | { kind: 'tiles' }
+  | { kind: 'pixel_tiles'; side: number }
   | { kind: 'sample_grid'; block: number }
   | { kind: 'lattice'; start: number; step: number; odd_only?: boolean }
   | { kind: 'one' }

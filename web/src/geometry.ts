@@ -76,6 +76,8 @@ export function directWorkgroups(g: PlanConstants, w: Workgroups, c: DispatchCon
   switch (w.kind) {
     case 'tiles':
       return [divCeil(width, g.tile), divCeil(height, g.tile)];
+    case 'pixel_tiles':
+      return [divCeil(width, w.side), divCeil(height, w.side)];
     case 'sample_grid': {
       const [nx, ny] = sampleGrid(c.size, w.block);
       return [divCeil(nx, g.coarse_workgroup), divCeil(ny, g.coarse_workgroup)];

@@ -3,7 +3,7 @@
 // output textures, and records every mode's passes into the page's
 // GPUCommandEncoder by interpreting the plan. See README.md.
 
-export type { Mode, Layout, Plan, ModePlan } from './contract.js';
+export type { Mode, Layout, Plan, ModePlan, PlanDevice } from './contract.js';
 export { MODES } from './contract.js';
 export { MrslError, type ErrorKind } from './errors.js';
 export { Shader, DEFAULT_SIMILARITY, DEFAULT_RATE_TILE, type Bindings, type DispatchOptions } from './shader.js';

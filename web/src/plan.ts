@@ -1,8 +1,14 @@
 // Reading the pass plan: the passes of a mode, the resources its steps name,
 // and what the plan does with each resource (which decides its usages).
 
-import type { ModePlan, Pass, Plan, ResourceDesc, ResourceId } from './contract.js';
+import type { Mode, ModePlan, Pass, Plan, PlanDevice, ResourceDesc, ResourceId } from './contract.js';
 import { engineBound, resourceKey } from './contract.js';
+
+/** The plan of `mode` on `device`: the mode's plan for that kind of device, else its plan for every device. */
+export function modePlan(plan: Plan, mode: Mode, device: PlanDevice): ModePlan | undefined {
+  const of = plan.modes.filter((m) => m.mode === mode);
+  return of.find((m) => m.device === device) ?? of.find((m) => m.device === undefined);
+}
 
 /** The compute passes of a mode, in order. */
 export function passes(mode: ModePlan): Pass[] {

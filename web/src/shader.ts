@@ -3,12 +3,12 @@
 // `Shader.encode` interprets the mode's plan: one loop over its steps, with
 // no dispatch rule of its own.
 
-import type { KernelRef, Mode, ModePlan, Pass, ResourceId } from './contract.js';
+import type { KernelRef, Mode, ModePlan, Pass, PlanDevice, ResourceId } from './contract.js';
 import { MODES } from './contract.js';
 import { MrslError } from './errors.js';
 import { directWorkgroups, type DispatchContext, type Size } from './geometry.js';
 import * as groups from './groups.js';
-import { mostPasses, passes, planResources } from './plan.js';
+import { modePlan, mostPasses, passes, planResources } from './plan.js';
 import { ResourcePool } from './pool.js';
 import type { CompiledProgram, Kernel } from './program.js';
 import { makeStats, type Stats, type Timings } from './stats.js';
@@ -41,6 +41,12 @@ export interface DispatchOptions {
   rateTile?: number;
   /** Count per-pixel re-evaluations and write the refine mask (default on). */
   statistics?: boolean;
+  /**
+   * Which of the mode's plans to run: `'gpu'` (default; the block modes' tile
+   * kernel) or `'cpu'` (their coarse and fine kernels, faster on a CPU device
+   * such as SwiftShader). Both give the same image and statistics.
+   */
+  device?: PlanDevice;
 }
 
 /** The hierarchical mode's default similarity: a standard deviation of about 3% of the values. */
@@ -131,12 +137,12 @@ export class Shader {
     return this.#uniforms.get(name);
   }
 
-  /** Whether `encode` can run `mode`; throws `unsupported-mode` saying why not. */
-  supports(mode: Mode): void {
+  /** Whether `encode` can run `mode` (its plan for `device`); throws `unsupported-mode` saying why not. */
+  supports(mode: Mode, device: PlanDevice = 'gpu'): void {
     if (!MODES.includes(mode)) {
       throw new MrslError('unknown-mode', `unknown mode \`${mode}\` (expected ${MODES.join(', ')})`, mode);
     }
-    const plan = this.program.layout.plan.modes.find((m) => m.mode === mode);
+    const plan = modePlan(this.program.layout.plan, mode, device);
     const unsupported = (reason: string) =>
       new MrslError('unsupported-mode', `mode \`${mode}\` is not supported by this program: ${reason}`, mode);
     if (!plan) throw unsupported("the program's plan does not list it");
@@ -171,13 +177,14 @@ export class Shader {
       similarity: options.similarity ?? DEFAULT_SIMILARITY,
       rateTile: options.rateTile ?? DEFAULT_RATE_TILE,
       statistics: options.statistics ?? true,
+      device: options.device ?? 'gpu',
     };
     if (!Number.isFinite(o.similarity) || o.similarity < 0) {
       throw new MrslError('bad-option', `similarity is ${o.similarity}, but it must be a finite number >= 0`);
     }
-    this.supports(o.mode);
+    this.supports(o.mode, o.device);
     const layout = this.program.layout;
-    const plan = layout.plan.modes.find((m) => m.mode === o.mode) as ModePlan;
+    const plan = modePlan(layout.plan, o.mode, o.device) as ModePlan;
     checkSize(layout.plan, plan, bindings.size, this.device.limits);
     checkBindings(layout, plan, bindings, o.rateTile);
     const uniformBytes = this.#uniformBuffer ? this.#uniforms.bytes() : null;
@@ -299,7 +306,7 @@ export class Shader {
       throw new MrslError('statistics-off', 'the last dispatch ran with statistics off, so it counted nothing');
     }
     const layout = this.program.layout;
-    const plan = layout.plan.modes.find((m) => m.mode === last.options.mode) as ModePlan;
+    const plan = modePlan(layout.plan, last.options.mode, last.options.device) as ModePlan;
     const read = async (id: ResourceId) => {
       const buffer = this.#pool.readback(id);
       if (!buffer) throw new MrslError('readback', `reading results back failed: ${id.id} was not read back`);
@@ -348,6 +355,11 @@ async function makeKernel(
 ): Promise<{ stage: GPUBindGroupLayout; pipelines: Map<string, GPUComputePipeline> } | { refused: string }> {
   const missing = groups.missingFeature(device, kernelPasses[0]!.bindings);
   if (missing !== null) return { refused: missing };
+  const memory = kernelPasses[0]!.workgroup_bytes ?? 0;
+  const limit = device.limits.maxComputeWorkgroupStorageSize;
+  if (memory > limit) {
+    return { refused: `it needs ${memory} bytes of workgroup memory, more than the device's ${limit} (maxComputeWorkgroupStorageSize)` };
+  }
   device.pushErrorScope('validation');
   const stage = groups.stageLayout(device, kernel.kind, kernelPasses[0]!.bindings);
   const module = device.createShaderModule({ label: kernel.kind, code: kernel.wgsl });

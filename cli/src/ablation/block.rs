@@ -308,13 +308,17 @@ pub(super) const VARIANTS: [Variant; 15] = [
     },
 ];
 
-/// `program` with the block fine kernel of size `block` refining nothing
+/// `program` with the block fine and tile kernels of size `block` refining nothing
 /// ([`nothing_refined`]): the block mode's fixed cost, which `bench --suite`
 /// reports as its floor. `None` when the kernel has nothing to edit.
 pub fn refining_nothing(program: &CompiledProgram, block: u32) -> Option<CompiledProgram> {
-    let fine = program.kernel(KernelKind::Fine, block)?;
-    let wgsl = nothing_refined(&fine.wgsl)?;
-    Some(super::with_kernel(program, (KernelKind::Fine, Some(block)), &wgsl))
+    // Both plans' kernels: the fine kernel (CPU devices) and the tile kernel (GPUs).
+    let mut edited = program.clone();
+    for kind in [KernelKind::Fine, KernelKind::Tile] {
+        let wgsl = nothing_refined(&program.kernel(kind, block)?.wgsl)?;
+        edited = super::with_kernel(&edited, (kind, Some(block)), &wgsl);
+    }
+    Some(edited)
 }
 
 #[cfg(test)]

@@ -27,7 +27,7 @@ mod hierarchical;
 pub use block::refining_nothing;
 pub use hierarchical::shading_nothing;
 use indicatif::{ProgressBar, ProgressStyle};
-use mrsl_abi::{CompiledProgram, KernelKind};
+use mrsl_abi::{CompiledProgram, Device, KernelKind};
 use mrsl_lab::gpu::Gpu;
 use mrsl_runtime::{Bindings, DispatchOptions, Mode, Shader};
 use std::fmt::Write as _;
@@ -93,11 +93,14 @@ impl Target {
         })
     }
 
-    /// The kernel the variants edit, as `(kind, block size)`.
-    fn kernel(self) -> (KernelKind, Option<u32>) {
-        match self {
-            Target::Block(block) => (KernelKind::Fine, Some(block)),
-            Target::Hierarchical => (KernelKind::Hierarchical, None),
+    /// The kernel the variants edit, as `(kind, block size)`, in the mode's
+    /// plan on `device`: for the block modes the fine kernel (CPU devices)
+    /// or the tile kernel (GPUs), whose pixels are the fine kernel's code.
+    fn kernel(self, device: Device) -> (KernelKind, Option<u32>) {
+        match (self, device) {
+            (Target::Block(block), Device::Cpu) => (KernelKind::Fine, Some(block)),
+            (Target::Block(block), Device::Gpu) => (KernelKind::Tile, Some(block)),
+            (Target::Hierarchical, _) => (KernelKind::Hierarchical, None),
         }
     }
 
@@ -111,7 +114,7 @@ impl Target {
     /// What the report calls the edited kernel.
     fn what(self) -> &'static str {
         match self {
-            Target::Block(_) => "fine kernel",
+            Target::Block(_) => "fine kernel (or tile kernel)",
             Target::Hierarchical => "hierarchical kernel",
         }
     }
@@ -156,7 +159,11 @@ pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>> {
     let modes = [Mode::Reference, args.mode];
     let DeviceProgram { name, program, gpu } =
         compile_for_device(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &modes)?;
-    let (programs, skipped) = variants(args, &name, &program, target)?;
+    let device = match gpu.adapter_info.device_type {
+        wgpu::DeviceType::Cpu => Device::Cpu,
+        _ => Device::Gpu,
+    };
+    let (programs, skipped) = variants(args, &name, &program, target, device)?;
     let device_name = format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
     eprintln!("ablation: {name}, {}, on {device_name}, {}x{}", target.title(args.mode), args.size.0, args.size.1);
     let mut scene = bind_scene(&gpu, &args.scene, Some(args.size))?;
@@ -176,7 +183,12 @@ pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>> {
     let runs: Vec<(usize, Mode)> =
         std::iter::once((0, Mode::Reference)).chain((0..programs.len()).map(|k| (k, args.mode))).collect();
     let times = time_rounds(args.runs.max(1), &runs, |k, mode| {
-        time_run(&gpu, &mut shaders[k], &bindings, DispatchOptions::new(mode))
+        time_run(
+            &gpu,
+            &mut shaders[k],
+            &bindings,
+            DispatchOptions { device: Some(device), ..DispatchOptions::new(mode) },
+        )
     })?;
     let background_tiles = match target {
         Target::Block(_) if program.layout.background_counters().is_some() => {
@@ -201,13 +213,22 @@ fn variants(
     name: &str,
     program: &mrsl::Program,
     target: Target,
+    device: Device,
 ) -> Result<(Programs, Vec<&'static str>)> {
     let full: &CompiledProgram = program;
-    let (kind, block) = target.kernel();
+    let (kind, block) = target.kernel(device);
     let kernel = full.kernels.iter().find(|k| k.kind == kind && k.block_size == block);
     let kernel = kernel.with_context(|| format!("the program has no {}", target.what()))?;
     let mut programs: Programs = vec![("full", "nothing", full.clone())];
-    if let Target::Block(_) = target {
+    let mut skipped = vec![];
+    // The compaction and the coarse pass's variants edit the coarse and fine
+    // kernels, which the block modes run on CPU devices alone.
+    let two_pass = matches!(target, Target::Block(_)) && device == Device::Cpu;
+    if matches!(target, Target::Block(_)) && !two_pass {
+        skipped.push("compacted (added)");
+        skipped.extend(coarse::VARIANTS.iter().map(|v| v.name));
+    }
+    if two_pass {
         let source = match &args.program {
             Some(path) => crate::read_source(path)?,
             None => WORKLOAD_PROGRAM.to_string(),
@@ -228,20 +249,20 @@ fn variants(
             compacted.compiled.clone(),
         ));
     }
-    let mut skipped = vec![];
     for v in target.variants() {
         match apply(v, &kernel.wgsl) {
-            Some(wgsl) => programs.push((v.name, v.removes, with_kernel(full, target.kernel(), &wgsl))),
+            Some(wgsl) => programs.push((v.name, v.removes, with_kernel(full, (kind, block), &wgsl))),
             None => skipped.push(v.name),
         }
     }
-    if let Target::Block(block) = target {
+    if let (Target::Block(block), true) = (target, two_pass) {
         // The coarse pass's variants: its kernel edited, the fine pass emptied.
         let coarse = full.kernel(KernelKind::Coarse, block).context("the program has no coarse kernel")?;
         for v in &coarse::VARIANTS {
             match v.apply(&coarse.wgsl, &kernel.wgsl) {
                 Some((c, f)) => {
-                    let p = with_kernel(&with_kernel(full, (KernelKind::Coarse, Some(block)), &c), target.kernel(), &f);
+                    let p =
+                        with_kernel(&with_kernel(full, (KernelKind::Coarse, Some(block)), &c), (kind, Some(block)), &f);
                     programs.push((v.name, v.removes, p));
                 }
                 None => skipped.push(v.name),

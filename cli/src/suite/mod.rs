@@ -17,6 +17,7 @@ use crate::timing::{Clock, median, paired, time_run, warm_up};
 use anyhow::{Context, Result, anyhow, bail};
 use mrsl_abi::CompiledProgram;
 use mrsl_abi::shading_rate::DEFAULT_RATE_TILE;
+use mrsl_lab::figures::PlanFigures;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::metrics::Metrics;
 use mrsl_lab::scene::Scene;
@@ -63,6 +64,13 @@ impl Device {
 #[derive(Debug, Clone, Serialize)]
 pub struct ModeRun {
     pub mode: Mode,
+    /// The block modes' plan that ran ([`mrsl_abi::Device`]) when it is not
+    /// the one the device runs by default (`None`: the default).
+    pub other_plan: Option<mrsl_abi::Device>,
+    /// The median wall time of the reference runs it was paired with.
+    pub reference_ms: f64,
+    /// What the plan run does, from its data ([`PlanFigures`]).
+    pub figures: PlanFigures,
     /// Median over the pairs of this mode's wall time / the reference's.
     pub time_ratio: f64,
     pub speedup: f64,
@@ -161,7 +169,7 @@ pub fn suite(args: &SuiteArgs) -> Result<Vec<PathBuf>> {
         }
     }
     let suite = Suite {
-        format: "mrsl-suite/1",
+        format: "mrsl-suite/2",
         program: name,
         device,
         adapters,
@@ -225,18 +233,29 @@ fn measure_scene(
         .collect::<Result<_>>()?;
     let mut bound = Bound { gpu, shader, bindings, first_output, reference, size: scene.size, runs };
     let (mut modes, mut unsupported, mut background) = (vec![], vec![], 0);
-    for mode in Mode::ALL.into_iter().filter(|m| *m != Mode::Reference) {
-        if let Err(e) = bound.shader.supports_size(mode, bound.size) {
+    let own = bound.shader.device();
+    // Every mode on the device's plan, then the block modes' other plan.
+    let other_plans = program.layout.plan.modes.iter().filter(|m| m.device.is_some_and(|d| d != own));
+    let runs_of: Vec<(Mode, Option<mrsl_abi::Device>)> = Mode::ALL
+        .into_iter()
+        .filter(|m| *m != Mode::Reference)
+        .map(|m| (m, None))
+        .chain(other_plans.map(|m| (m.mode, m.device)))
+        .collect();
+    for (mode, other_plan) in runs_of {
+        let device = other_plan.unwrap_or(own);
+        if let Err(e) = bound.shader.supports_size_on(mode, device, bound.size) {
             unsupported.push((mode, e.to_string()));
             continue;
         }
         let floor = floors.iter_mut().find(|(m, _)| *m == mode).map(|(_, s)| s);
         let at = Instant::now();
-        let (run, background_pixels) = bound.measure_mode(mode, floor)?;
+        let (run, background_pixels) = bound.measure_mode(mode, other_plan, floor)?;
         eprintln!(
-            "suite: {scene_name} {}x{} {mode}: {:.2}x, MSSIM {:.4}, forced {:.2} ({:.0} s)",
+            "suite: {scene_name} {}x{} {}: {:.2}x, MSSIM {:.4}, forced {:.2} ({:.0} s)",
             size.0,
             size.1,
+            report::label(&run),
             run.speedup,
             run.metrics.mssim,
             run.forced_ratio,
@@ -283,24 +302,37 @@ impl Bound<'_> {
     /// camera), paired timings at its defaults, forced and (block modes)
     /// with nothing refined, and its image against the reference. Also the
     /// background pixels its statistics counted.
-    fn measure_mode(&mut self, mode: Mode, floor: Option<&mut Shader>) -> Result<(ModeRun, u64)> {
+    fn measure_mode(
+        &mut self,
+        mode: Mode,
+        other_plan: Option<mrsl_abi::Device>,
+        floor: Option<&mut Shader>,
+    ) -> Result<(ModeRun, u64)> {
         let gpu = self.gpu;
-        let options = DispatchOptions::new(mode);
+        let options = DispatchOptions { device: other_plan, ..DispatchOptions::new(mode) };
         if mode == Mode::RateImage {
             let rates = RateOptions::preset(Preset::Balanced);
             crate::rates::settle(gpu, &mut self.shader, &self.bindings, self.first_output, &rates, options)?;
         }
         let reference = DispatchOptions::new(Mode::Reference).uninstrumented();
-        // The median ratio to the reference and the median wall time.
-        let ratio =
-            |shader: &mut Shader, bindings: &Bindings, options: DispatchOptions, runs: usize| -> Result<(f64, f64)> {
-                warm(gpu, || time_run(gpu, shader, bindings, options))?;
-                let p = paired(runs, options, reference, |o| time_run(gpu, shader, bindings, o))?;
-                Ok((median(p.ratios), median(p.walls)))
-            };
-        let (time_ratio, wall_ms) = ratio(&mut self.shader, &self.bindings, options.uninstrumented(), self.runs)?;
+        // The median ratio to the reference, the median wall time and the reference's.
+        let ratio = |shader: &mut Shader,
+                     bindings: &Bindings,
+                     options: DispatchOptions,
+                     runs: usize|
+         -> Result<(f64, f64, f64)> {
+            warm(gpu, || time_run(gpu, shader, bindings, options))?;
+            let p = paired(runs, options, reference, |o| time_run(gpu, shader, bindings, o))?;
+            Ok((median(p.ratios), median(p.walls), median(p.reference_walls)))
+        };
+        let (time_ratio, wall_ms, reference_ms) =
+            ratio(&mut self.shader, &self.bindings, options.uninstrumented(), self.runs)?;
         let forced = DispatchOptions { force_refine: true, ..options }.uninstrumented();
-        let (forced_ratio, _) = ratio(&mut self.shader, &self.bindings, forced, self.runs)?;
+        let (forced_ratio, ..) = ratio(&mut self.shader, &self.bindings, forced, self.runs)?;
+        let device = other_plan.unwrap_or(self.shader.device());
+        let layout = self.shader.layout();
+        let plan = layout.plan.mode_on(mode, device).context("the mode has a plan")?;
+        let figures = PlanFigures::of(layout, plan, self.size);
         let floor_ratio = match floor {
             Some(floor) => Some(self.floor_ratio(floor, options.uninstrumented())?),
             None => None,
@@ -313,6 +345,9 @@ impl Bound<'_> {
         let speedup = 1.0 / time_ratio;
         let run = ModeRun {
             mode,
+            other_plan,
+            reference_ms,
+            figures,
             time_ratio,
             speedup,
             wall_ms,

@@ -21,8 +21,13 @@ pub fn markdown(suite: &Suite) -> String {
          adapters present: {}. Timed by {}. Each ratio is the median over {} pairs of a run of the mode and a run of the reference \
          beside it (alternately before and after); speedup = 1 / that ratio. Quality against the reference image of the \
          same program. Efficiency = speedup x coarse shaded fraction. Forced: every predicate true. Floor: the fixed \
-         cost of the adaptive machinery (the block fine kernel with nothing refined; the hierarchical kernel shading \
-         nothing past level 0). Took {:.0} s.\n",
+         cost of the adaptive machinery (the block modes' fine or tile kernel with nothing refined; the hierarchical \
+         kernel shading nothing past level 0). Reference ms: the median of the reference runs a row's runs were \
+         paired with. From the plan: dispatches per frame, global bytes per pixel (each pass's bound resources, \
+         G-buffer texels and outputs touched once; statistics off; in brackets the coarse-to-fine interface's share), the largest workgroup memory of the mode's \
+         kernels, and the most evaluations of a coarse effect's body per coarse sample (with, for the tile kernel, \
+         the samples a workgroup evaluates per sample it owns). A block mode's other plan (`(cpu plan)`, \
+         `(gpu plan)`) is the one this kind of device does not run by default. Took {:.0} s.\n",
         suite.program,
         d.name,
         d.backend,
@@ -51,17 +56,34 @@ pub fn markdown(suite: &Suite) -> String {
     md
 }
 
-/// The modes of the tables, in order.
-fn modes(runs: &[&SceneRun]) -> Vec<Mode> {
-    Mode::ALL.into_iter().filter(|m| runs.iter().any(|r| r.modes.iter().any(|x| x.mode == *m))).collect()
+/// What a row is called: the mode, and for a block mode's plan that is not
+/// the device's own, which plan (`coarse4x4 (gpu plan)`).
+pub fn label(run: &ModeRun) -> String {
+    match run.other_plan {
+        Some(device) => format!("{} ({} plan)", run.mode, device.name()),
+        None => run.mode.to_string(),
+    }
 }
 
-/// The fastest mode at MSSIM >= [`MSSIM_BAR`], or the reference itself
-/// (`None`, 1x) when no such mode is faster than it.
+/// The rows of the tables, in order: each mode on the device's plans, then
+/// the block modes' other plans.
+fn labels(runs: &[&SceneRun]) -> Vec<String> {
+    let mut labels: Vec<String> = vec![];
+    for run in runs.iter().flat_map(|r| &r.modes) {
+        let l = label(run);
+        if !labels.contains(&l) {
+            labels.push(l);
+        }
+    }
+    labels
+}
+
+/// The fastest mode at MSSIM >= [`MSSIM_BAR`] on the device's own plans,
+/// or the reference itself (`None`, 1x) when no such mode is faster than it.
 pub fn best(run: &SceneRun) -> (Option<Mode>, f64) {
     run.modes
         .iter()
-        .filter(|m| m.metrics.mssim >= MSSIM_BAR && m.speedup > 1.0)
+        .filter(|m| m.other_plan.is_none() && m.metrics.mssim >= MSSIM_BAR && m.speedup > 1.0)
         .max_by(|a, b| a.speedup.total_cmp(&b.speedup))
         .map_or((None, 1.0), |m| (Some(m.mode), m.speedup))
 }
@@ -84,16 +106,15 @@ fn summary(md: &mut String, runs: &[&SceneRun]) {
         let _ = writeln!(md, "No scene was measured at this size.\n");
         return;
     }
-    let modes = modes(runs);
-    let header: Vec<String> = modes.iter().map(|m| m.to_string()).collect();
-    let _ = writeln!(md, "| over {} scenes | {} | best at MSSIM >= {MSSIM_BAR} |", runs.len(), header.join(" | "));
+    let modes = labels(runs);
+    let _ = writeln!(md, "| over {} scenes | {} | best at MSSIM >= {MSSIM_BAR} |", runs.len(), modes.join(" | "));
     let _ = writeln!(md, "|---|{}---|", "---|".repeat(modes.len()));
-    let of = |mode: Mode| -> Vec<(&str, &ModeRun)> {
-        runs.iter().filter_map(|r| r.modes.iter().find(|m| m.mode == mode).map(|m| (r.scene.as_str(), m))).collect()
+    let of = |l: &String| -> Vec<(&str, &ModeRun)> {
+        runs.iter().filter_map(|r| r.modes.iter().find(|m| label(m) == *l).map(|m| (r.scene.as_str(), m))).collect()
     };
     let bests: Vec<(&str, f64)> = runs.iter().map(|r| (r.scene.as_str(), best(r).1)).collect();
     let mut row = |label: &str, cell: &dyn Fn(&Column) -> String, best_cell: String| {
-        let cells: Vec<String> = modes.iter().map(|&m| cell(&of(m))).collect();
+        let cells: Vec<String> = modes.iter().map(|m| cell(&of(m))).collect();
         let _ = writeln!(md, "| {label} | {} | {best_cell} |", cells.join(" | "));
     };
     let worst = |v: &[(&str, f64)]| {
@@ -145,17 +166,25 @@ fn scene_table(md: &mut String, run: &SceneRun) {
     );
     let _ = writeln!(
         md,
-        "| mode | speedup | ms | MSSIM | PSNR dB | FLIP | shaded | coarse shaded | efficiency | forced / reference | floor / reference |"
+        "| mode | speedup | ms | reference ms | MSSIM | PSNR dB | FLIP | shaded | coarse shaded | efficiency | \
+         forced / reference | floor / reference | dispatches | global B/px (interface) | workgroup B | evaluations / sample |"
     );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for m in &run.modes {
         let floor = m.floor_ratio.map_or("-".into(), |f| format!("{f:.3}"));
+        let f = &m.figures;
+        let evaluations = match (f.sample_evaluations, f.tile_overlap) {
+            (Some(e), Some(overlap)) => format!("{e} (x{overlap:.2} tile overlap)"),
+            (Some(e), None) => e.to_string(),
+            _ => "-".into(),
+        };
         let _ = writeln!(
             md,
-            "| {} | {:.2}x | {} | {:.4} | {:.1} | {:.4} | {:.1}% | {:.1}% | {:.2} | {:.2} | {floor} |",
-            m.mode,
+            "| {} | {:.2}x | {} | {} | {:.4} | {:.1} | {:.4} | {:.1}% | {:.1}% | {:.2} | {:.2} | {floor} | {} | {:.0} ({:.1}) | {} | {evaluations} |",
+            label(m),
             m.speedup,
             milliseconds(m.wall_ms),
+            milliseconds(m.reference_ms),
             m.metrics.mssim,
             m.metrics.psnr,
             m.metrics.flip,
@@ -163,6 +192,10 @@ fn scene_table(md: &mut String, run: &SceneRun) {
             100.0 * m.coarse_shaded_fraction,
             m.efficiency,
             m.forced_ratio,
+            f.dispatches,
+            f.global_bytes_per_pixel,
+            f.interface_bytes_per_pixel,
+            f.workgroup_bytes,
         );
     }
     for (mode, reason) in &run.unsupported {

@@ -158,7 +158,7 @@ impl Writer<'_, '_, '_> {
     /// sample, and `mrsl_at_<effect>` reads them.
     pub(super) fn stores_neighbours(&self) -> bool {
         // The multi-rate mode's coarse kernels evaluate derivatives' neighbours in place.
-        self.file == KernelKind::Coarse && self.i.layout.neighbours.words > 0
+        (self.file == KernelKind::Coarse || self.writes_coarse_part()) && self.i.layout.neighbours.words > 0
     }
 
     /// The effects of the neighbour values, in layout order, with their word offsets.
@@ -200,6 +200,9 @@ impl Writer<'_, '_, '_> {
     pub(super) fn neighbour_value(&self, e: EffectId, texel: &str) -> String {
         let (_, offset) = self.neighbour_values().into_iter().find(|&(v, _)| v == e).expect("a stored effect");
         let ty = &self.checked().effects[e.index()].ty;
+        if self.writes_coarse_part() {
+            return unpack_with(ty, |j| Self::tile_neighbour_word(offset + j, texel));
+        }
         unpack_with(ty, |j| format!("textureLoad({NEIGHBOURS}, {texel}, {}).x", offset + j))
     }
 
@@ -218,7 +221,11 @@ impl Writer<'_, '_, '_> {
             let info = &c.effects[e.index()];
             for (j, word) in pack_words(&self.effect_name(e), &info.ty).iter().enumerate() {
                 let layer = offset + j as u32;
-                let store = format!("textureStore({NEIGHBOURS}, {texel}, {layer}, vec4<u32>({word}, 0u, 0u, 0u));");
+                let store = if self.writes_coarse_part() {
+                    Self::tile_neighbour_store(layer, word)
+                } else {
+                    format!("textureStore({NEIGHBOURS}, {texel}, {layer}, vec4<u32>({word}, 0u, 0u, 0u));")
+                };
                 self.line(indent, store);
             }
         }
@@ -271,12 +278,16 @@ impl Writer<'_, '_, '_> {
         }
         if let Some((_, samples)) = self.i.layout.background_counters().filter(|_| !self.is_outer_level()) {
             let on = super::pixel::statistics_enabled();
-            self.line(1, format!("if ({on} && {BACKGROUND}({POS})) {{ atomicAdd(&{STATS}[{samples}], 1u); }}"));
+            let background =
+                if self.writes_coarse_part() { self.owned_background() } else { format!("{BACKGROUND}({POS})") };
+            self.line(1, format!("if ({on} && {background}) {{ atomicAdd(&{STATS}[{samples}], 1u); }}"));
         }
         self.coarse_values();
         self.record_flags();
         self.record_slots();
-        if self.writes_record_texels() {
+        if self.writes_coarse_part() {
+            self.tile_record_stores();
+        } else if self.writes_record_texels() {
             self.record_texels();
         }
         self.template(0, tail, &[]);
@@ -433,7 +444,14 @@ impl Writer<'_, '_, '_> {
         }
         // A texel holds four words of a record: one load per corner and texel.
         let texels = ["i0", "vec2<i32>(i1.x, i0.y)", "vec2<i32>(i0.x, i1.y)", "i1"];
-        for layer in 0..stride.div_ceil(4) {
+        if self.file == KernelKind::Tile {
+            // The tile kernel's records are in workgroup memory, a word at a time.
+            for w in 0..stride {
+                let words: Vec<String> = texels.iter().map(|at| Self::tile_corner_word(w, at)).collect();
+                self.line(1, format!("c.w{w} = vec4<u32>({});", words.join(", ")));
+            }
+        }
+        for layer in 0..stride.div_ceil(4).min(if self.file == KernelKind::Tile { 0 } else { u32::MAX }) {
             for (corner, at) in TEXELS.iter().zip(texels) {
                 self.line(1, format!("let {corner}_{layer} = textureLoad({INTERFACE}, {at}, {layer}, 0);"));
             }
@@ -606,6 +624,15 @@ impl Writer<'_, '_, '_> {
 
     /// Entry point of the block and dynamic fine kernels and of the reference kernel.
     pub(super) fn pixel_entry(&mut self) {
+        if self.file == KernelKind::Tile {
+            self.tile_pixel_blocks(self.block, FINE_PIXELS_PER_LANE);
+            return self.tile_entry(|w| {
+                w.tile_pixels_head();
+                w.fine_lanes();
+                w.line(0, "}");
+                w.line(0, "");
+            });
+        }
         if self.compacts() {
             self.tile_pixel_blocks(self.block, 1);
             self.tile_list_entries();

@@ -231,6 +231,11 @@ impl<'b> Writer<'_, '_, 'b> {
             self.line(0, format!("@group({group}) @binding({binding}) var {name}: {texture}; // {}", ch.format));
         }
         self.template(0, stage, &[]);
+        if self.file == KernelKind::Tile {
+            // Its stage group is declared from the plan's bindings.
+            self.tile_stage_group();
+            return self.template(0, end, &[]);
+        }
         match self.kind {
             // (The multi-rate kernels are written as the block kernels of their family.)
             KernelKind::Coarse
@@ -239,6 +244,7 @@ impl<'b> Writer<'_, '_, 'b> {
             | KernelKind::MultiCoarse
             | KernelKind::MultiResolve
             | KernelKind::MultiFine => self.interface_bindings(),
+            KernelKind::Tile => unreachable!("the tile kernel is written by the fine family's writer"),
             KernelKind::DynamicCoarse => self.dynamic_coarse_bindings(),
             KernelKind::Hierarchical => self.hierarchical_bindings(),
             KernelKind::Checkerboard => self.checkerboard_bindings(),
@@ -888,7 +894,8 @@ impl<'b> Writer<'_, '_, 'b> {
         if self.stores_neighbours() {
             for (e, _) in self.neighbour_values() {
                 let info = &c.effects[e.index()];
-                self.line(0, format!("// `{}` at another sample, as `coarse_neighbours` stored it there.", info.name));
+                let by = if self.writes_coarse_part() { "the tile's first phase" } else { "`coarse_neighbours`" };
+                self.line(0, format!("// `{}` at another sample, as {by} stored it there.", info.name));
                 self.line(0, format!("fn {}({POS}: vec2<i32>) -> {} {{", Name::At.of(&info.name), info.ty.wgsl()));
                 self.line(1, format!("return {};", self.neighbour_value(e, POS)));
                 self.line(0, "}");

@@ -446,37 +446,47 @@ impl<'b> Writer<'_, '_, 'b> {
     /// statistics on, writes the refine mask and counts the coarse effects
     /// it re-evaluates; then the effects (see [`Writer::pixel_main`]).
     pub(super) fn fine_main(&mut self) {
-        let counted = self.counts_stats();
-        self.pixel_main(
-            |w, scope| {
-                if !counted {
-                    return;
-                }
-                if scope == Scope::Position {
-                    w.resolve_preamble(2, "");
-                }
-                // `mrsl_last` holds the innermost level: effects refined there are evaluated per pixel.
-                let (last, from_inner) = if w.kind == KernelKind::DynamicFine {
-                    (INNER_BLOCK, format!("{BLOCK}.refined0 & ~{INNER_BLOCK}.refined0"))
-                } else {
-                    (BLOCK, "0u".to_string())
-                };
-                w.statistics_on(2);
-                let mask_y = w.mask_y(last, &from_inner);
-                w.template(3, include_str!("templates/rate.wgsl"), &[("LAST", &last), ("FROM_INNER", &mask_y)]);
-                // (A loaded effect is counted where the resolve pass evaluated it.)
-                let counted: Vec<EffectId> = w.coarse_live().into_iter().filter(|&e| !w.is_loaded(e)).collect();
-                for e in counted {
-                    let k = w.coarse_index[&e] as usize;
-                    w.count_refined(k, &format!("{IS_REFINED}({LAST_BLOCK}, {k}u)"));
-                }
-                // The multi-rate mode counts its background pixels once, in its last pass.
-                if w.file != KernelKind::MultiResolve {
-                    w.count_background(LAST_BLOCK);
-                }
-                w.line(2, "}");
-            },
-            |w, e, indent| w.effect_chain(&[e], indent, Evaluation::Kernel),
-        );
+        self.pixel_main(|w, scope| w.fine_prologue(scope), |w, e, indent| w.fine_coarse_value(e, indent));
+    }
+
+    /// The work of [`Self::fine_main`]'s lanes without its entry point (the
+    /// tile kernel's `mrsl_tile_pixels`).
+    pub(super) fn fine_lanes(&mut self) {
+        self.pixel_lanes(&mut |w, scope| w.fine_prologue(scope), &mut |w, e, indent| w.fine_coarse_value(e, indent));
+    }
+
+    fn fine_coarse_value(&mut self, e: EffectId, indent: usize) {
+        self.effect_chain(&[e], indent, Evaluation::Kernel);
+    }
+
+    /// A fine pixel's refine mask and statistics, where the kernel counts them.
+    fn fine_prologue(&mut self, scope: Scope) {
+        if !self.counts_stats() {
+            return;
+        }
+        let w = self;
+        if scope == Scope::Position {
+            w.resolve_preamble(2, "");
+        }
+        // `mrsl_last` holds the innermost level: effects refined there are evaluated per pixel.
+        let (last, from_inner) = if w.kind == KernelKind::DynamicFine {
+            (INNER_BLOCK, format!("{BLOCK}.refined0 & ~{INNER_BLOCK}.refined0"))
+        } else {
+            (BLOCK, "0u".to_string())
+        };
+        w.statistics_on(2);
+        let mask_y = w.mask_y(last, &from_inner);
+        w.template(3, include_str!("templates/rate.wgsl"), &[("LAST", &last), ("FROM_INNER", &mask_y)]);
+        // (A loaded effect is counted where the resolve pass evaluated it.)
+        let counted: Vec<EffectId> = w.coarse_live().into_iter().filter(|&e| !w.is_loaded(e)).collect();
+        for e in counted {
+            let k = w.coarse_index[&e] as usize;
+            w.count_refined(k, &format!("{IS_REFINED}({LAST_BLOCK}, {k}u)"));
+        }
+        // The multi-rate mode counts its background pixels once, in its last pass.
+        if w.file != KernelKind::MultiResolve {
+            w.count_background(LAST_BLOCK);
+        }
+        w.line(2, "}");
     }
 }

@@ -62,6 +62,7 @@ mod names;
 mod pixel;
 mod rate;
 mod records;
+mod tile;
 mod tiles;
 mod words;
 mod writer;
@@ -180,9 +181,11 @@ impl Cache {
 /// Writes one kernel. `block` is the coarse block size (ignored by the reference kernel).
 pub(crate) fn write_string(inputs: &Inputs, kind: KernelKind, block: u32) -> String {
     // The multi-rate kernels are the block kernels over a view of the program.
+    // The tile kernel is the fine kernel's module, with the coarse kernel's
+    // functions written into it (`tile`).
     let family = match kind {
         KernelKind::MultiCoarse => KernelKind::Coarse,
-        KernelKind::MultiResolve | KernelKind::MultiFine => KernelKind::Fine,
+        KernelKind::MultiResolve | KernelKind::MultiFine | KernelKind::Tile => KernelKind::Fine,
         other => other,
     };
     let mut w = Writer::new(inputs, family, if kind == KernelKind::Reference { 1 } else { block });
@@ -305,6 +308,32 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
             let f = FunctionId(k as u32);
             self.cached(Piece::Function(f), |w| w.function(f));
         }
+        self.effect_functions();
+        match self.kind {
+            KernelKind::Coarse | KernelKind::DynamicCoarse | KernelKind::MultiCoarse => self.coarse_entry(),
+            KernelKind::Fine | KernelKind::DynamicFine | KernelKind::MultiResolve | KernelKind::MultiFine => {
+                self.fine_support();
+                self.pixel_entry();
+            }
+            KernelKind::Tile => unreachable!("the tile kernel is written by the fine family's writer"),
+            KernelKind::Reference => self.pixel_entry(),
+            KernelKind::Hierarchical => self.hierarchical_entries(),
+            KernelKind::Checkerboard => self.checkerboard_entries(),
+            KernelKind::RateCoarse => self.rate_coarse_entries(),
+            KernelKind::RateFine => {
+                self.rate_tiles();
+                self.rate_fine_support();
+                self.rate_fine_entry();
+            }
+        }
+    }
+}
+
+impl Writer<'_, '_, '_> {
+    /// The packed dependencies, every effect function this kernel calls,
+    /// the derivative helpers and the functions of effects at other positions.
+    fn effect_functions(&mut self) {
+        let c = self.checked();
         self.args_structs();
         let value_only = self.value_only_effects();
         let keeps_flags = self.keeps_refine_flags();
@@ -321,22 +350,18 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
         }
         self.derivative_helpers();
         self.neighbour_functions();
-        match self.kind {
-            KernelKind::Coarse | KernelKind::DynamicCoarse | KernelKind::MultiCoarse => self.coarse_entry(),
-            KernelKind::Fine | KernelKind::DynamicFine | KernelKind::MultiResolve | KernelKind::MultiFine => {
-                self.fine_support();
-                self.pixel_entry();
-            }
-            KernelKind::Reference => self.pixel_entry(),
-            KernelKind::Hierarchical => self.hierarchical_entries(),
-            KernelKind::Checkerboard => self.checkerboard_entries(),
-            KernelKind::RateCoarse => self.rate_coarse_entries(),
-            KernelKind::RateFine => {
-                self.rate_tiles();
-                self.rate_fine_support();
-                self.rate_fine_entry();
-            }
-        }
+    }
+
+    /// The tile kernel's coarse part ([`tile`]): what the coarse kernel's
+    /// module holds but its bindings, constants and user functions (which
+    /// the tile kernel declares once), with its entry points as functions.
+    fn coarse_part(&mut self) {
+        self.matrix_selects();
+        self.position_helpers();
+        self.input_loaders();
+        self.key_functions();
+        self.effect_functions();
+        self.tile_phases();
     }
 }
 
@@ -349,6 +374,9 @@ fn describe(kind: KernelKind, block: u32) -> String {
             format!("fine kernel, {block}x{block} blocks: one invocation per {FINE_PIXELS_PER_LANE} pixels of a block")
         }
         KernelKind::Reference => "reference kernel: every effect per pixel".to_string(),
+        KernelKind::Tile => format!(
+            "tile kernel, {block}x{block} blocks: a workgroup per tile shades its coarse samples, then its pixels"
+        ),
         KernelKind::DynamicCoarse => format!(
             "dynamic mode, second level: one invocation per {inner}x{inner} coarse sample inside refined {outer}x{outer} blocks"
         ),

@@ -18,6 +18,7 @@
 //! this module spells one in a string literal. A name renamed here and not
 //! in a template (or the reverse) fails them.
 
+use std::collections::BTreeSet;
 use std::fmt::Display;
 
 /// A family of generated names: a prefix, then what tells the members apart.
@@ -346,6 +347,77 @@ pub(super) const LOCAL_ID: &str = "mrsl_lid";
 /// `mrsl_tile_args(word, tiles, per_tile)`: indirect arguments over a hierarchical tile list.
 pub(super) const TILE_ARGS: &str = "mrsl_tile_args";
 
+/// The tile kernel ([`super::tile`]): its samples per side and ring (layout
+/// `tile`), the slots of its records and neighbour values, the workgroup
+/// memory holding them, the tile's first sample (a private variable its
+/// entry point sets), where a sample's record and neighbour values sit, its
+/// phases (a sample's neighbour values, a sample, a group's pixels) and
+/// their parameters.
+pub(super) const TILE_SAMPLES: &str = "MRSL_TILE";
+pub(super) const TILE_RING: &str = "MRSL_RING";
+pub(super) const RECORD_SLOTS: &str = "MRSL_RECORD_SLOTS";
+pub(super) const NEIGHBOUR_SLOTS: &str = "MRSL_NEIGHBOUR_SLOTS";
+pub(super) const WORKGROUP_RECORDS: &str = "mrsl_wg_records";
+pub(super) const WORKGROUP_NEIGHBOURS: &str = "mrsl_wg_neighbours";
+pub(super) const ORIGIN: &str = "mrsl_origin";
+pub(super) const RECORD_SLOT: &str = "mrsl_record_slot";
+pub(super) const NEIGHBOUR_SLOT: &str = "mrsl_neighbour_slot";
+pub(super) const TILE_NEIGHBOURS: &str = "mrsl_tile_neighbours";
+pub(super) const TILE_SAMPLE: &str = "mrsl_tile_sample";
+pub(super) const TILE_PIXELS: &str = "mrsl_tile_pixels";
+pub(super) const SLOT: &str = "mrsl_slot";
+pub(super) const OWNED: &str = "mrsl_owned";
+
+/// The tile kernel's coarse part is the coarse kernel's functions renamed
+/// into a namespace of their own ([`coarse_part_name`]): in it a position
+/// is a coarse sample, in the rest of the kernel a pixel, and the two sets
+/// of helpers (`mrsl_grid`, `mrsl_load_<input>`, `mrsl_eval_<effect>`, ...)
+/// live in one module. No other generated name starts with these.
+pub(super) const COARSE_PART: &str = "mrsl_c_";
+pub(super) const COARSE_PART_TYPE: &str = "MrslC_";
+
+/// A generated name of the coarse kernel as the tile kernel's coarse part
+/// names it: `mrsl_grid` is `mrsl_c_grid`, `MrslSurface_p` is `MrslC_Surface_p`.
+pub(super) fn coarse_part_name(name: &str) -> String {
+    if let Some(rest) = name.strip_prefix("mrsl_") {
+        format!("{COARSE_PART}{rest}")
+    } else if let Some(rest) = name.strip_prefix("Mrsl") {
+        format!("{COARSE_PART_TYPE}{rest}")
+    } else {
+        panic!("`{name}` is not a generated name")
+    }
+}
+
+/// `text` with every function and structure it defines renamed into the
+/// coarse part's namespace, at its definition and at every use.
+pub(super) fn rename_into_coarse_part(text: &str) -> String {
+    let defined: BTreeSet<&str> = text
+        .lines()
+        .filter_map(|line| line.strip_prefix("fn ").or_else(|| line.strip_prefix("struct ")))
+        .map(|rest| &rest[..rest.find(|c: char| !is_ident_char(c)).unwrap_or(rest.len())])
+        .collect();
+    let mut out = String::with_capacity(text.len() + text.len() / 8);
+    let mut rest = text;
+    while let Some(start) = rest.find(|c: char| c.is_ascii_alphabetic() || c == '_') {
+        out.push_str(&rest[..start]);
+        let word = &rest[start..];
+        let len = word.find(|c: char| !is_ident_char(c)).unwrap_or(word.len());
+        let ident = &word[..len];
+        if defined.contains(ident) {
+            out.push_str(&coarse_part_name(ident));
+        } else {
+            out.push_str(ident);
+        }
+        rest = &word[len..];
+    }
+    out.push_str(rest);
+    out
+}
+
+fn is_ident_char(c: char) -> bool {
+    c.is_ascii_alphanumeric() || c == '_'
+}
+
 /// The words of one record, and the coarse kernels' block size.
 pub(super) const STRIDE: &str = "MRSL_STRIDE";
 pub(super) const BLOCK_SIZE: &str = "MRSL_BLOCK";
@@ -418,6 +490,20 @@ pub(super) const FIXED: &[&str] = &[
     TILE_INVOCATION,
     LOCAL_ID,
     TILE_ARGS,
+    TILE_SAMPLES,
+    TILE_RING,
+    RECORD_SLOTS,
+    NEIGHBOUR_SLOTS,
+    WORKGROUP_RECORDS,
+    WORKGROUP_NEIGHBOURS,
+    ORIGIN,
+    RECORD_SLOT,
+    NEIGHBOUR_SLOT,
+    TILE_NEIGHBOURS,
+    TILE_SAMPLE,
+    TILE_PIXELS,
+    SLOT,
+    OWNED,
     STRIDE,
     BLOCK_SIZE,
     BLOCK_STRUCT,
@@ -617,10 +703,25 @@ mod tests {
         let prefixes: BTreeSet<&str> = Name::ALL.iter().map(|n| n.prefix()).collect();
         assert_eq!(prefixes.len(), Name::ALL.len(), "two families share a prefix");
         assert!(FIXED.iter().chain(&prefixes).all(|n| starts_name(n)), "every name is in the generated namespace");
+        // The coarse part's namespace holds no other name.
+        let coarse_part = |n: &&str| n.starts_with(COARSE_PART) || n.starts_with(COARSE_PART_TYPE);
+        assert!(!FIXED.iter().chain(&prefixes).any(coarse_part), "a name starts like the tile kernel's coarse part");
+        assert_eq!(coarse_part_name("MrslSurface_p"), "MrslC_Surface_p");
         assert_eq!(
             names_in("let mrsl_b = mrsl_resolve{{S}}(mrsl_pos); // `Mrsl` mrslc xmrsl_a"),
             ["mrsl_b", "mrsl_resolve", "mrsl_pos"]
         );
         assert_eq!(string_literals("f(\"a\\\"b\", '\"'); // \"c\"\n\"d\""), ["a\\\"b", "d"]);
+    }
+
+    #[test]
+    fn definitions_are_renamed_where_they_are_used() {
+        let text = "fn mrsl_grid() -> i32 { return 1; }\nstruct MrslSurface_p { p: f32 }\n\
+                    fn mrsl_eval_a(x: MrslSurface_p) -> i32 { return mrsl_grid() + mrsl_u.k + mrsl_gridx; }\n";
+        assert_eq!(
+            rename_into_coarse_part(text),
+            "fn mrsl_c_grid() -> i32 { return 1; }\nstruct MrslC_Surface_p { p: f32 }\n\
+             fn mrsl_c_eval_a(x: MrslC_Surface_p) -> i32 { return mrsl_c_grid() + mrsl_u.k + mrsl_gridx; }\n"
+        );
     }
 }

@@ -130,16 +130,31 @@ impl Writer<'_, '_, '_> {
         self.template(0, head, &[("WORKGROUP", &workgroup), ("ENTRY", &self.file.main_entry_point())]);
         let tile = self.surface_tile(1);
         self.template(0, tail, &[("FIRST", &if pairs { FIRST } else { POS }), ("TILE", &tile)]);
+        self.pixel_lanes(&mut prologue, &mut coarse);
+        if self.counts_stats() {
+            self.flush_workgroup_stats(x);
+        }
+        self.line(0, "}");
+    }
+
+    /// The body of [`Self::pixel_main`] after its lane's first pixel, without
+    /// the statistics' flush: the lane's pixels' work.
+    pub(super) fn pixel_lanes(
+        &mut self,
+        prologue: &mut impl FnMut(&mut Self, Scope),
+        coarse: &mut impl FnMut(&mut Self, EffectId, usize),
+    ) {
+        let pairs = matches!(self.kind, KernelKind::Fine | KernelKind::DynamicFine);
         let counted = self.counts_stats();
         if pairs && !self.coarse_live().is_empty() {
-            self.effect_major_pixels(&mut prologue);
+            self.effect_major_pixels(prologue);
         } else if pairs {
             // No coarse effects: the pixels' work, one after the other.
             for k in 0..FINE_PIXELS_PER_LANE {
                 let at = self.lane_pixel(k);
                 self.line(1, format!("if (all({at} < {GRID}())) {{"));
                 self.line(2, format!("let {POS} = {at};"));
-                self.pixel_body(2, &mut prologue, &mut coarse);
+                self.pixel_body(2, prologue, coarse);
                 self.line(1, "}");
             }
         } else {
@@ -147,17 +162,13 @@ impl Writer<'_, '_, '_> {
             let returns = !counted && !matches!(self.kind, KernelKind::Hierarchical | KernelKind::Checkerboard);
             if returns {
                 self.line(1, format!("if (any({POS} >= {GRID}())) {{ return; }}"));
-                self.pixel_body(1, &mut prologue, &mut coarse);
+                self.pixel_body(1, prologue, coarse);
             } else {
                 self.line(1, format!("if (all({POS} < {GRID}())) {{"));
-                self.pixel_body(2, &mut prologue, &mut coarse);
+                self.pixel_body(2, prologue, coarse);
                 self.line(1, "}");
             }
         }
-        if counted {
-            self.flush_workgroup_stats(x);
-        }
-        self.line(0, "}");
     }
 
     /// The end of a counting entry point of `lanes` lanes: the workgroup's

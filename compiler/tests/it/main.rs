@@ -25,11 +25,13 @@ pub fn compile_ok(source: &str) -> mrsl::Program {
 
 /// The kernels `Options::default()` asks for, as (kind, block size), in the
 /// canonical order of `CompiledProgram::kernels` (by kind, then block size).
-pub const DEFAULT_KERNELS: [(KernelKind, Option<u32>); 15] = [
+pub const DEFAULT_KERNELS: [(KernelKind, Option<u32>); 17] = [
     (KernelKind::Coarse, Some(2)),
     (KernelKind::Coarse, Some(4)),
     (KernelKind::Fine, Some(2)),
     (KernelKind::Fine, Some(4)),
+    (KernelKind::Tile, Some(2)),
+    (KernelKind::Tile, Some(4)),
     (KernelKind::Reference, None),
     (KernelKind::DynamicCoarse, Some(2)),
     (KernelKind::DynamicFine, Some(4)),

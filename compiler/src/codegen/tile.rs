@@ -1,0 +1,226 @@
+//! The block modes' tile kernel (`tile_main`, [`KernelKind::Tile`]): one
+//! workgroup shades one screen tile end to end, in one dispatch per frame.
+//!
+//! It is the block coarse kernel and the block fine kernel in one module,
+//! with the coarse-to-fine interface in workgroup memory instead of a
+//! record texture:
+//!
+//! 1. the neighbour values (layout `neighbours`: the coarse effects the
+//!    samples' derivatives read at other samples) of every sample the
+//!    tile's samples take differences with, into workgroup memory;
+//! 2. the tile's samples and the next tile's first row and column (layout
+//!    `tile`): their coarse effects, evaluated once each, with derivatives
+//!    reading the values of step 1, then their refine flags and records,
+//!    into workgroup memory;
+//! 3. the tile's pixels, as the fine kernel shades them, with the corners'
+//!    records read from workgroup memory.
+//!
+//! A position is a coarse sample in the first two phases and a pixel in the
+//! third, and the helpers of both sets of positions share their names
+//! (`mrsl_grid`, `mrsl_load_<input>`, `mrsl_eval_<effect>`, ...). So the
+//! coarse part is written by the coarse kernel's writer and renamed into a
+//! namespace of its own ([`names::coarse_part_name`]): every function and
+//! structure it defines, and every use of them in it. Whatever both parts
+//! only use (bindings, user functions, constants, workgroup memory) is
+//! declared once by the fine part.
+
+use super::names::{
+    self, BACKGROUND, FIRST, GRID, LANE, NEIGHBOUR_SLOT, NEIGHBOUR_SLOTS, Name, OWNED, POS, RECORD_SLOT, RECORD_SLOTS,
+    REFINE_MASK, SLOT, STATS, TILE_NEIGHBOURS, TILE_PIXEL, TILE_PIXELS, TILE_SAMPLE, WORKGROUP, WORKGROUP_NEIGHBOURS,
+    WORKGROUP_RECORDS, WORKGROUP_STATS,
+};
+use super::writer::cut;
+use super::{Inputs, Writer};
+use mrsl_abi::geometry::{FINE_WORKGROUP, TILE, TILE_LANES};
+use mrsl_abi::plan::{BindingType, ResourceId};
+use mrsl_abi::{GROUP_STAGE, KernelKind, KernelRef, entry};
+
+impl Writer<'_, '_, '_> {
+    /// Whether this writer writes the tile kernel's coarse part (the
+    /// coarse family's writer) rather than its module (the fine family's).
+    pub(super) fn writes_coarse_part(&self) -> bool {
+        self.file == KernelKind::Tile && self.kind == KernelKind::Coarse
+    }
+
+    /// In the tile kernel's bindings: its tile's constants, its workgroup
+    /// memory (records, neighbour values) and where a sample sits in it.
+    pub(super) fn tile_memory(&mut self) {
+        let tile = self.i.layout.tile;
+        let stride = self.i.interface.stride.max(1);
+        let words = self.i.layout.neighbours.words;
+        let record_slots = tile.record_side().pow(2);
+        let neighbour_slots = tile.neighbour_side().pow(2);
+        let [head, tail] = cut(include_str!("templates/tile_memory.wgsl"), &["NEIGHBOURS"]);
+        let values: &super::writer::Values = &[
+            ("SAMPLES", &tile.samples),
+            ("RING", &tile.ring),
+            ("RECORD_SLOTS", &record_slots),
+            ("NEIGHBOUR_SLOTS", &neighbour_slots),
+            ("RECORD_WORDS", &(stride * record_slots)),
+        ];
+        self.template(0, head, values);
+        if words > 0 {
+            let ty = format!("array<u32, {}>", words * neighbour_slots);
+            self.line(0, format!("var<workgroup> {WORKGROUP_NEIGHBOURS}: {ty};"));
+        }
+        self.template(0, tail, values);
+    }
+
+    /// The tile kernel's stage group, declared binding by binding from the
+    /// plan's `PassBinding`s (`crate::plan::stage_bindings`, which the
+    /// runtimes bind by): the statistics, the refine mask and the outputs;
+    /// then its workgroup memory.
+    pub(super) fn tile_stage_group(&mut self) {
+        let l = self.i.layout;
+        let kernel = KernelRef::new(KernelKind::Tile, Some(self.block));
+        for b in crate::plan::stage_bindings(l, kernel) {
+            let (name, ty, what) = match (b.resource, b.ty) {
+                (ResourceId::Statistics, BindingType::Buffer { read_only: false }) => (
+                    STATS.to_string(),
+                    "array<atomic<u32>>".to_string(),
+                    "The statistics counters (layout `stats`).".to_string(),
+                ),
+                (ResourceId::RefineMask, BindingType::StorageTexture { format }) => (
+                    REFINE_MASK.to_string(),
+                    format!("texture_storage_2d<{format}, write>"),
+                    "Per pixel: .x bit k = coarse effect k evaluated per pixel.".to_string(),
+                ),
+                (ResourceId::Output { index }, BindingType::StorageTexture { format }) => (
+                    Name::Out.of(&l.outputs[index].name),
+                    format!("texture_storage_2d<{format}, write>"),
+                    format!("Output `{}`.", l.outputs[index].name),
+                ),
+                (resource, ty) => unreachable!("the tile kernel binds no {resource:?} as {ty:?}"),
+            };
+            let space = if matches!(b.ty, BindingType::Buffer { .. }) { "<storage, read_write>" } else { "" };
+            self.line(0, format!("// {what}"));
+            self.line(0, format!("@group({GROUP_STAGE}) @binding({}) var{space} {name}: {ty};", b.binding));
+        }
+        if self.counts_stats() {
+            let counters = self.workgroup_counters();
+            self.line(0, format!("var<workgroup> {WORKGROUP_STATS}: array<atomic<u32>, {counters}>;"));
+        }
+        self.tile_memory();
+    }
+
+    /// The tile kernel's record word `word` of the sample at slot `slot` (WGSL).
+    pub(super) fn tile_record_word(word: u32, slot: &str) -> String {
+        format!("{WORKGROUP_RECORDS}[{word}u * {RECORD_SLOTS} + {slot}]")
+    }
+
+    /// The tile kernel's neighbour-value word `word` of sample `sample` (WGSL, in the coarse part).
+    pub(super) fn tile_neighbour_word(word: u32, sample: &str) -> String {
+        format!("{WORKGROUP_NEIGHBOURS}[{word}u * {NEIGHBOUR_SLOTS} + {NEIGHBOUR_SLOT}({sample})]")
+    }
+
+    /// The neighbour values' word `word` stored at the sample the coarse part's
+    /// `mrsl_tile_neighbours` evaluates (a statement).
+    pub(super) fn tile_neighbour_store(word: u32, value: &str) -> String {
+        format!("{WORKGROUP_NEIGHBOURS}[{word}u * {NEIGHBOUR_SLOTS} + {SLOT}] = {value};")
+    }
+
+    /// The coarse part's entry points, as functions of the sample they
+    /// evaluate: `mrsl_tile_neighbours` (nothing without neighbour values)
+    /// and `mrsl_tile_sample`.
+    pub(super) fn tile_phases(&mut self) {
+        if self.stores_neighbours() {
+            let [head, tail] = cut(include_str!("templates/tile_neighbours.wgsl"), &["BODY"]);
+            self.template(0, head, &[]);
+            self.store_neighbour_values(1, POS);
+            self.template(0, tail, &[]);
+        }
+        self.coarse_main(include_str!("templates/tile_sample.wgsl"));
+    }
+
+    /// The condition under which the coarse part counts a background sample.
+    pub(super) fn owned_background(&self) -> String {
+        format!("{OWNED} && {BACKGROUND}({POS})")
+    }
+
+    /// The coarse part's record words stored into the workgroup's records.
+    pub(super) fn tile_record_stores(&mut self) {
+        for w in 0..self.i.interface.stride {
+            let store = format!("{} = {};", Self::tile_record_word(w, SLOT), names::Name::RecordWord.of(w));
+            self.line(1, store);
+        }
+    }
+
+    /// Where the fine part's corners read word `word` of corner sample `at` (WGSL).
+    pub(super) fn tile_corner_word(word: u32, at: &str) -> String {
+        Self::tile_record_word(word, &format!("{RECORD_SLOT}({at})"))
+    }
+
+    /// The tile kernel's entry point and what only it needs: the coarse part,
+    /// the pixels of one [`TILE`]² tile for one group of lanes
+    /// (`mrsl_tile_pixels`), and `tile_main`.
+    pub(super) fn tile_entry(&mut self, pixels: impl FnOnce(&mut Self)) {
+        let coarse = coarse_part(self.i, self.block);
+        self.code.push_str(&coarse);
+        let what = format!("{TILE}x{TILE} tile `{WORKGROUP}` for lane `{LANE}` of a group of {FINE_WORKGROUP}");
+        self.line(0, format!("// The pixels of {what}."));
+        pixels(self);
+        let tile = self.i.layout.tile;
+        let side = tile.side(self.block);
+        let per_side = side / TILE;
+        let [head, neighbours, samples, tail] =
+            cut(include_str!("templates/tile_main.wgsl"), &["NEIGHBOURS", "SAMPLES", "PIXELS"]);
+        let values: &super::writer::Values = &[
+            ("ENTRY", &entry::TILE),
+            ("SIDE", &side),
+            ("TILE", &TILE),
+            ("GROUP", &FINE_WORKGROUP),
+            ("GROUPS", &(per_side * per_side)),
+            ("PER_SIDE", &per_side),
+            ("LANES", &TILE_LANES),
+            ("GRID", &names::coarse_part_name(GRID)),
+            ("NEIGHBOUR_SIDE", &tile.neighbour_side()),
+            ("RECORD_SIDE", &tile.record_side()),
+            ("TILE_NEIGHBOURS", &names::coarse_part_name(TILE_NEIGHBOURS)),
+            ("TILE_SAMPLE", &names::coarse_part_name(TILE_SAMPLE)),
+        ];
+        self.template(0, head, values);
+        if self.i.layout.neighbours.words > 0 {
+            self.template(0, neighbours, values);
+        }
+        self.template(0, samples, values);
+        self.template(0, tail, values);
+        // Each group of lanes takes every `groups_at_once`-th tile of TILE² pixels.
+        let (groups, groups_at_once) = (per_side * per_side, TILE_LANES / FINE_WORKGROUP);
+        for first in (0..groups).step_by(groups_at_once as usize) {
+            let group = format!("{LANE} / {FINE_WORKGROUP}u + {first}u");
+            let tile = format!("{WORKGROUP}.xy * {per_side}u + vec2<u32>(g % {per_side}u, g / {per_side}u)");
+            let call = format!("{TILE_PIXELS}({tile}, {LANE} % {FINE_WORKGROUP}u);");
+            self.line(1, "{");
+            self.line(2, format!("let g = {group};"));
+            if first + groups_at_once > groups {
+                self.line(2, format!("if (g < {groups}u) {{ {call} }}"));
+            } else {
+                self.line(2, call);
+            }
+            self.line(1, "}");
+        }
+        if self.counts_stats() {
+            self.flush_workgroup_stats(TILE_LANES);
+        }
+        self.line(0, "}");
+    }
+
+    /// The opening line of `mrsl_tile_pixels`.
+    pub(super) fn tile_pixels_head(&mut self) {
+        self.line(0, format!("fn {TILE_PIXELS}({WORKGROUP}: vec2<u32>, {LANE}: u32) {{"));
+        self.line(1, format!("let {FIRST} = {TILE_PIXEL}({WORKGROUP}, {LANE});"));
+    }
+}
+
+/// The coarse part of the tile kernel over `inputs` at block size `block`:
+/// the coarse kernel's functions and phases, renamed ([`names::rename_into_coarse_part`]).
+fn coarse_part(inputs: &Inputs, block: u32) -> String {
+    let mut w = Writer::new(inputs, KernelKind::Coarse, block);
+    w.file = KernelKind::Tile;
+    w.line(0, "// ---- The coarse part: positions are coarse samples ----");
+    w.line(0, "");
+    w.coarse_part();
+    w.line(0, "// ---- The fine part: positions are pixels ----");
+    w.line(0, "");
+    names::rename_into_coarse_part(&w.code.into_string())
+}
