@@ -185,6 +185,10 @@ struct Bench {
     /// on the first scene (writes ablation.md).
     #[arg(long, conflicts_with = "suite")]
     ablation: bool,
+    /// With --ablation of a block mode: the plan whose kernels are edited and timed, gpu (the tile
+    /// kernel) or cpu (the coarse and fine kernels); default: the rendering device's own.
+    #[arg(long, value_enum, requires = "ablation")]
+    plan: Option<PlanDevice>,
     /// Instead of the sweep: every mode at its defaults over the scene suite
     /// (or the --scene list) at each --size, paired with the reference:
     /// speedup, quality, forced and nothing-refined times (writes suite.md
@@ -477,6 +481,7 @@ fn bench(b: &Bench) -> Result<ExitCode> {
             mode,
             runs: b.runs,
             out_dir: b.out_dir.clone(),
+            plan: b.plan.map(PlanDevice::abi),
         };
         return Ok(written(ablation::ablation(&args)));
     }

@@ -241,16 +241,24 @@ fn workload_bounds_script_refines_less_in_each_variant() {
 }
 
 /// `bench --ablation` at a small size, for the block modes' fine and coarse
-/// passes and for the hierarchical kernel: every variant of the workload's
-/// kernels builds a pipeline on the device and is timed (the unit tests
-/// only check that naga accepts them), and none is left out as not
-/// applicable.
+/// passes (their CPU plan), their tile kernel (their GPU plan) and the
+/// hierarchical kernel: every variant of the workload's kernels builds a
+/// pipeline on the device and is timed (the unit tests only check that naga
+/// accepts them), and none is left out as not applicable but those of the
+/// other plan's kernels.
 fn ablation_times_every_variant_on_the_device() {
     let dir = scratch("ablation");
-    for (mode, at_least) in [("coarse4x4", 24), ("hierarchical", 14)] {
-        let out = dir.join(mode);
+    let tile_only = "tile: no samples, tile: no neighbour values, tile: no pixels";
+    let fine_only = "compacted (added), coarse pass, no predicates";
+    for (name, mode, plan, at_least, left_out) in [
+        ("coarse4x4", "coarse4x4", "cpu", 24, Some(tile_only)),
+        ("tile", "coarse4x4", "gpu", 15, Some(fine_only)),
+        ("hierarchical", "hierarchical", "", 14, None),
+    ] {
+        let out = dir.join(name);
         let args = ["bench", "--ablation", "--modes", mode, "--scene", "sponza", "--size", "48x27", "--runs", "1"];
-        let run = mrslc(&[&args[..], &["-o", out.to_str().unwrap()]].concat());
+        let plan: &[&str] = if plan.is_empty() { &[] } else { &["--plan", plan] };
+        let run = mrslc(&[&args[..], plan, &["-o", out.to_str().unwrap()]].concat());
         assert!(run.status.success(), "{mode}: {}", stderr(&run));
         let md = std::fs::read_to_string(out.join("ablation.md")).unwrap();
         let rows: Vec<&str> = md.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| variant")).collect();
@@ -259,7 +267,14 @@ fn ablation_times_every_variant_on_the_device() {
             let ms: f64 = row.split('|').nth(3).unwrap().trim().parse().unwrap_or_else(|_| panic!("{row}"));
             assert!(ms.is_finite() && ms > 0.0, "{mode}: {row}");
         }
-        assert!(!md.contains("Not applicable"), "{mode}: every variant applies to the workload:\n{md}");
+        let not_applicable = md.lines().find_map(|l| l.strip_prefix("Not applicable to this program's kernel: "));
+        match left_out {
+            None => assert!(not_applicable.is_none(), "{name}: every variant applies to the workload:\n{md}"),
+            Some(start) => assert!(
+                not_applicable.is_some_and(|l| l.starts_with(start)),
+                "{name}: only the other plan's variants are left out:\n{md}"
+            ),
+        }
     }
     let coarse = std::fs::read_to_string(dir.join("coarse4x4/ablation.md")).unwrap();
     for variant in ["| coarse pass, no predicates |", "| launches |"] {

@@ -198,6 +198,40 @@ pub(super) fn no_fine_work(w: &str) -> Option<String> {
     })
 }
 
+/// The tile kernel without one of its phases: its call deleted, so that
+/// what the phase wrote in workgroup memory stays zero (WGSL zeroes it).
+/// `None` for a kernel without the call (the fine kernel).
+fn without_call(w: &str, call: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let start = l.find(call)?;
+        let end = start + l[start..].find(");")? + 2;
+        Some(format!("{}{}", &l[..start], &l[end..]))
+    })
+}
+
+/// The tile kernel's samples not evaluated: its records zero (nothing
+/// flagged, every coarse effect resampled as zero).
+fn no_tile_samples(w: &str) -> Option<String> {
+    without_call(w, "mrsl_c_tile_sample(")
+}
+
+/// The tile kernel's neighbour values not evaluated (the derivatives at the samples read zero).
+fn no_tile_neighbours(w: &str) -> Option<String> {
+    without_call(w, "mrsl_c_tile_neighbours(")
+}
+
+/// The tile kernel's pixels not shaded (left: its coarse phases and the launch).
+fn no_tile_pixels(w: &str) -> Option<String> {
+    edit_lines(w, |l| {
+        let t = l.trim_start();
+        if t.starts_with("mrsl_tile_pixels(") {
+            return Some(String::new());
+        }
+        // The last group's guarded call.
+        t.starts_with("if (g < ").then(|| String::new())
+    })
+}
+
 /// Every pixel as the background rule leaves it: no corners loaded, no
 /// resolve, every coarse effect reading zero, the fine effects still
 /// evaluated and stored: what a pixel of a tile known to be wholly
@@ -230,7 +264,7 @@ pub(super) fn background_channel_loaded(w: &str) -> Option<String> {
 /// The variants. Removing the key tests or the flag reads from the full
 /// kernel would also change what is refined, so those parts are measured
 /// within the fixed cost (nothing refined), where they decide nothing.
-pub(super) const VARIANTS: [Variant; 15] = [
+pub(super) const VARIANTS: [Variant; 18] = [
     Variant {
         name: "no instrumentation",
         removes: "the statistics atomics, their barrier and the refine-mask store (`DispatchOptions::statistics` off)",
@@ -306,6 +340,21 @@ pub(super) const VARIANTS: [Variant; 15] = [
         removes: "everything the fine pass does per pixel (left: the coarse pass and the launches)",
         edits: &[no_fine_work],
     },
+    Variant {
+        name: "tile: no samples",
+        removes: "the tile kernel's sample phase: its records stay zero, so nothing is flagged and every coarse effect resamples zero (its neighbour values and pixels kept)",
+        edits: &[no_tile_samples],
+    },
+    Variant {
+        name: "tile: no neighbour values",
+        removes: "the tile kernel's first phase: the values its samples' derivatives read are zero",
+        edits: &[no_tile_neighbours],
+    },
+    Variant {
+        name: "tile: no pixels",
+        removes: "the tile kernel's pixel phase (left: its coarse phases, barriers and launch)",
+        edits: &[no_tile_pixels],
+    },
 ];
 
 /// `program` with the block fine and tile kernels of size `block` refining nothing
@@ -334,10 +383,22 @@ mod tests {
         let program = mrsl::compile(WORKLOAD_PROGRAM, &mrsl::Options::default()).unwrap();
         for block in [2, 4] {
             let fine = &program.kernel(KernelKind::Fine, block).unwrap().wgsl;
+            let tile = &program.kernel(KernelKind::Tile, block).unwrap().wgsl;
             for v in &VARIANTS {
-                let edited = apply(v, fine).unwrap_or_else(|| panic!("{}: no line to edit", v.name));
-                assert_ne!(&edited, fine, "{}", v.name);
-                mrsl::validate_wgsl(&edited).unwrap_or_else(|e| panic!("{} (block {block}): {e}", v.name));
+                // The tile kernel's pixels are the fine kernel's code: every variant edits
+                // it but the one of the background tiles' entry point, which it has not;
+                // the fine kernel has no tile phases.
+                let kernels: &[&String] = match v.name {
+                    name if name.starts_with("tile: ") => &[tile],
+                    "background channel loaded (added)" => &[fine],
+                    _ => &[fine, tile],
+                };
+                for &kernel in kernels {
+                    let edited = apply(v, kernel).unwrap_or_else(|| panic!("{}: no line to edit", v.name));
+                    assert_ne!(&edited, kernel, "{}", v.name);
+                    mrsl::validate_wgsl(&edited).unwrap_or_else(|e| panic!("{} (block {block}): {e}", v.name));
+                }
+                assert_eq!(v.name.starts_with("tile: "), apply(v, fine).is_none(), "{}", v.name);
             }
             let unlooped = no_refinement_loops(fine).unwrap();
             assert_eq!(unlooped.matches("loop {").count(), 0, "block {block}: a refinement loop is left");

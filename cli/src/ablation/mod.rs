@@ -40,6 +40,8 @@ pub struct AblationArgs {
     pub mode: Mode,
     pub runs: usize,
     pub out_dir: PathBuf,
+    /// The block modes' plan to edit and time (`None`: the device's own).
+    pub plan: Option<Device>,
 }
 
 /// An edit of the kernel's lines (`None` when the kernel has none of
@@ -120,10 +122,11 @@ impl Target {
     }
 
     /// The edited kernel with its mode: "the coarse4x4 fine kernel", "the
-    /// hierarchical kernel" (whose name already says its mode).
-    fn title(self, mode: impl std::fmt::Display) -> String {
+    /// coarse4x4 tile kernel", "the hierarchical kernel" (whose name already
+    /// says its mode).
+    fn title(self, mode: impl std::fmt::Display, device: Device) -> String {
         match self {
-            Target::Block(_) => format!("{mode} {}", self.what()),
+            Target::Block(_) => format!("{mode} {} kernel ({} plan)", self.kernel(device).0.name(), device.name()),
             Target::Hierarchical => self.what().to_string(),
         }
     }
@@ -159,13 +162,18 @@ pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>> {
     let modes = [Mode::Reference, args.mode];
     let DeviceProgram { name, program, gpu } =
         compile_for_device(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &modes)?;
-    let device = match gpu.adapter_info.device_type {
+    let device = args.plan.unwrap_or(match gpu.adapter_info.device_type {
         wgpu::DeviceType::Cpu => Device::Cpu,
         _ => Device::Gpu,
-    };
+    });
     let (programs, skipped) = variants(args, &name, &program, target, device)?;
     let device_name = format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
-    eprintln!("ablation: {name}, {}, on {device_name}, {}x{}", target.title(args.mode), args.size.0, args.size.1);
+    eprintln!(
+        "ablation: {name}, {}, on {device_name}, {}x{}",
+        target.title(args.mode, device),
+        args.size.0,
+        args.size.1
+    );
     let mut scene = bind_scene(&gpu, &args.scene, Some(args.size))?;
     let mut shaders = vec![];
     let mut textures = vec![];
@@ -197,7 +205,7 @@ pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>> {
         _ => None,
     };
     let report = Report { programs: &programs, skipped: &skipped, times: &times, background_tiles };
-    let md = markdown(args, target, &name, &device_name, &report);
+    let md = markdown(args, (target, device), &name, &device_name, &report);
     std::fs::create_dir_all(&args.out_dir).map_err(|e| anyhow!("cannot create {}: {e}", args.out_dir.display()))?;
     let path = args.out_dir.join("ablation.md");
     crate::output::write(&path, &md)?;
@@ -344,7 +352,13 @@ fn time_rounds(
 /// The ablation report: per entry of the times (the reference, then the
 /// programs), its median time and its median ratio to the full kernel's
 /// time in the same round; and the background tiles' share.
-fn markdown(args: &AblationArgs, target: Target, name: &str, device_name: &str, report: &Report) -> String {
+fn markdown(
+    args: &AblationArgs,
+    (target, device): (Target, Device),
+    name: &str,
+    device_name: &str,
+    report: &Report,
+) -> String {
     let (programs, skipped, times) = (report.programs, report.skipped, report.times);
     let rounds = times[1].len();
     let ratio = |at: usize| median((0..rounds).map(|r| times[at][r] / times[1][r]).collect());
@@ -355,7 +369,7 @@ fn markdown(args: &AblationArgs, target: Target, name: &str, device_name: &str, 
         "# Ablation of the {}\n\nProgram `{name}`, scene {}, {}x{}, device {device_name}; {rounds} interleaved \
          rounds (the order rotates each round); `x full` is the median over the rounds of the variant's time / the full \
          kernel's time in the same round. Full kernel: {full_ms:.1} ms (median).\n",
-        target.title(args.mode),
+        target.title(args.mode, device),
         args.scene,
         args.size.0,
         args.size.1
