@@ -477,12 +477,14 @@ pub fn tile_layout(layout: &Layout) -> TileLayout {
 
 /// The workgroup memory of the tile kernel with `tile`, as WebGPU counts it
 /// (each variable rounded up to 16 bytes): the records, the neighbour
-/// values and the statistics counters. A test holds the kernels to it.
+/// values, the statistics counters and, with a background rule, a word per
+/// 8x8 pixels of the 4x4 blocks' tile. A test holds the kernels to it.
 pub fn tile_workgroup_bytes(layout: &Layout, tile: TileLayout) -> u32 {
     let records = layout.interface.stride_words.max(1) * tile.record_side().pow(2);
     let neighbours = layout.neighbours.words * tile.neighbour_side().pow(2);
+    let surface_tiles = if layout.has_background() { (tile.side(4) / geometry::TILE).pow(2) } else { 0 };
     let variable = |words: u32| (4 * words).div_ceil(16) * 16;
-    variable(records) + variable(neighbours) + variable(layout.stats_counters() as u32)
+    variable(records) + variable(neighbours) + variable(layout.stats_counters() as u32) + variable(surface_tiles)
 }
 
 /// The storage textures WebGPU guarantees a shader stage

@@ -228,7 +228,7 @@ fn no_tile_pixels(w: &str) -> Option<String> {
             return Some(String::new());
         }
         // The last group's guarded call.
-        t.starts_with("if (g < ").then(String::new)
+        t.starts_with("if (mrsl_group_tile < ").then(String::new)
     })
 }
 

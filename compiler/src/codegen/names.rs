@@ -367,6 +367,13 @@ pub(super) const TILE_SAMPLE: &str = "mrsl_tile_sample";
 pub(super) const TILE_PIXELS: &str = "mrsl_tile_pixels";
 pub(super) const SLOT: &str = "mrsl_slot";
 pub(super) const OWNED: &str = "mrsl_owned";
+/// With a background rule: per 8x8 tile of the tile kernel's pixels, whether
+/// a pixel of it is not background (`mrsl_wg_surface_tiles`), and the
+/// pixels of one that is wholly background (`mrsl_tile_background`).
+pub(super) const SURFACE_TILES: &str = "mrsl_wg_surface_tiles";
+/// Which of the tile kernel's 8x8 tiles of pixels a group of lanes shades.
+pub(super) const GROUP_TILE: &str = "mrsl_group_tile";
+pub(super) const TILE_BACKGROUND: &str = "mrsl_tile_background";
 
 /// The tile kernel's coarse part is the coarse kernel's functions renamed
 /// into a namespace of their own ([`coarse_part_name`]): in it a position
@@ -504,6 +511,9 @@ pub(super) const FIXED: &[&str] = &[
     TILE_PIXELS,
     SLOT,
     OWNED,
+    SURFACE_TILES,
+    GROUP_TILE,
+    TILE_BACKGROUND,
     STRIDE,
     BLOCK_SIZE,
     BLOCK_STRUCT,

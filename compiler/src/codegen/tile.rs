@@ -25,9 +25,9 @@
 //! declared once by the fine part.
 
 use super::names::{
-    self, BACKGROUND, FIRST, GRID, LANE, NEIGHBOUR_SLOT, NEIGHBOUR_SLOTS, Name, OWNED, POS, RECORD_SLOT, RECORD_SLOTS,
-    REFINE_MASK, SLOT, STATS, TILE_NEIGHBOURS, TILE_PIXEL, TILE_PIXELS, TILE_SAMPLE, WORKGROUP, WORKGROUP_NEIGHBOURS,
-    WORKGROUP_RECORDS, WORKGROUP_STATS,
+    self, BACKGROUND, CONTROL, FIRST, GRID, GROUP_TILE, LANE, NEIGHBOUR_SLOT, NEIGHBOUR_SLOTS, Name, OWNED, POS,
+    RECORD_SLOT, RECORD_SLOTS, REFINE_MASK, SLOT, STATS, SURFACE_TILES, TILE_BACKGROUND, TILE_NEIGHBOURS, TILE_ORIGIN,
+    TILE_PIXEL, TILE_PIXELS, TILE_SAMPLE, WORKGROUP, WORKGROUP_NEIGHBOURS, WORKGROUP_RECORDS, WORKGROUP_STATS,
 };
 use super::writer::cut;
 use super::{Inputs, Writer};
@@ -62,6 +62,15 @@ impl Writer<'_, '_, '_> {
         if words > 0 {
             let ty = format!("array<u32, {}>", words * neighbour_slots);
             self.line(0, format!("var<workgroup> {WORKGROUP_NEIGHBOURS}: {ty};"));
+        }
+        if self.has_background() {
+            let groups = (tile.side(self.block) / TILE).pow(2);
+            self.line(
+                0,
+                format!("// Per {TILE}x{TILE} tile of pixels: nonzero where a pixel is not background (or refinement"),
+            );
+            self.line(0, "// is forced); a tile that is wholly background is shaded as such.");
+            self.line(0, format!("var<workgroup> {SURFACE_TILES}: array<atomic<u32>, {groups}>;"));
         }
         self.template(0, tail, values);
     }
@@ -159,11 +168,12 @@ impl Writer<'_, '_, '_> {
         let what = format!("{TILE}x{TILE} tile `{WORKGROUP}` for lane `{LANE}` of a group of {FINE_WORKGROUP}");
         self.line(0, format!("// The pixels of {what}."));
         pixels(self);
+        self.tile_background_function();
         let tile = self.i.layout.tile;
         let side = tile.side(self.block);
         let per_side = side / TILE;
-        let [head, neighbours, samples, tail] =
-            cut(include_str!("templates/tile_main.wgsl"), &["NEIGHBOURS", "SAMPLES", "PIXELS"]);
+        let [head, neighbours, samples, barrier, tail] =
+            cut(include_str!("templates/tile_main.wgsl"), &["NEIGHBOURS", "SAMPLES", "SURFACE", "PIXELS"]);
         let values: &super::writer::Values = &[
             ("ENTRY", &entry::TILE),
             ("SIDE", &side),
@@ -183,17 +193,20 @@ impl Writer<'_, '_, '_> {
             self.template(0, neighbours, values);
         }
         self.template(0, samples, values);
+        self.surface_tiles(side);
+        self.template(0, barrier, values);
         self.template(0, tail, values);
         // Each group of lanes takes every `groups_at_once`-th tile of TILE² pixels.
         let (groups, groups_at_once) = (per_side * per_side, TILE_LANES / FINE_WORKGROUP);
         for first in (0..groups).step_by(groups_at_once as usize) {
             let group = format!("{LANE} / {FINE_WORKGROUP}u + {first}u");
-            let tile = format!("{WORKGROUP}.xy * {per_side}u + vec2<u32>(g % {per_side}u, g / {per_side}u)");
-            let call = format!("{TILE_PIXELS}({tile}, {LANE} % {FINE_WORKGROUP}u);");
+            let g = GROUP_TILE;
+            let tile = format!("{WORKGROUP}.xy * {per_side}u + vec2<u32>({g} % {per_side}u, {g} / {per_side}u)");
+            let call = format!("{TILE_PIXELS}({tile}, {LANE} % {FINE_WORKGROUP}u, {g});");
             self.line(1, "{");
-            self.line(2, format!("let g = {group};"));
+            self.line(2, format!("let {g} = {group};"));
             if first + groups_at_once > groups {
-                self.line(2, format!("if (g < {groups}u) {{ {call} }}"));
+                self.line(2, format!("if ({g} < {groups}u) {{ {call} }}"));
             } else {
                 self.line(2, call);
             }
@@ -205,10 +218,54 @@ impl Writer<'_, '_, '_> {
         self.line(0, "}");
     }
 
-    /// The opening line of `mrsl_tile_pixels`.
+    /// The opening lines of `mrsl_tile_pixels`: a tile wholly background
+    /// (with a background rule) is shaded as such, the rest resolve.
     pub(super) fn tile_pixels_head(&mut self) {
-        self.line(0, format!("fn {TILE_PIXELS}({WORKGROUP}: vec2<u32>, {LANE}: u32) {{"));
+        self.line(0, format!("fn {TILE_PIXELS}({WORKGROUP}: vec2<u32>, {LANE}: u32, {GROUP_TILE}: u32) {{"));
+        if self.has_background() {
+            self.line(1, format!("if (atomicLoad(&{SURFACE_TILES}[{GROUP_TILE}]) == 0u) {{"));
+            self.line(2, format!("{TILE_BACKGROUND}({WORKGROUP}, {LANE});"));
+            self.line(2, "return;");
+            self.line(1, "}");
+        }
         self.line(1, format!("let {FIRST} = {TILE_PIXEL}({WORKGROUP}, {LANE});"));
+    }
+
+    /// `mrsl_tile_background`: the pixels of a wholly background tile of
+    /// [`TILE`]² pixels for one lane, as the fine kernel's `fine_background`
+    /// shades them (with a background rule).
+    fn tile_background_function(&mut self) {
+        if !self.has_background() {
+            return;
+        }
+        let what = format!("{TILE}x{TILE} tile `{TILE_ORIGIN}`, wholly background, for lane `{LANE}`");
+        self.line(0, format!("// The pixels of {what}: its coarse effects read as zero."));
+        self.line(0, format!("fn {TILE_BACKGROUND}({TILE_ORIGIN}: vec2<u32>, {LANE}: u32) {{"));
+        self.background_pixels();
+        self.line(0, "}");
+        self.line(0, "");
+    }
+
+    /// In `tile_main`, before the barrier after its samples: which of the
+    /// tile's [`TILE`]² tiles have a pixel that is not background (every one
+    /// where refinement is forced).
+    fn surface_tiles(&mut self, side: u32) {
+        if !self.has_background() {
+            return;
+        }
+        let per_side = side / TILE;
+        self.line(1, "// Which of the tile's 8x8 tiles have a pixel that is not background.");
+        self.line(1, format!("for (var p = {LANE}; p < {}u; p += {TILE_LANES}u) {{", side * side));
+        self.line(
+            2,
+            format!("let at = vec2<i32>({WORKGROUP}.xy) * {side} + vec2<i32>(i32(p % {side}u), i32(p / {side}u));"),
+        );
+        let surface = format!("{CONTROL}.force_refine != 0u || !{BACKGROUND}(at)");
+        self.line(2, format!("if (all(at < vec2<i32>({CONTROL}.size)) && ({surface})) {{"));
+        let group = format!("(p / {side}u / {TILE}u) * {per_side}u + (p % {side}u) / {TILE}u");
+        self.line(3, format!("atomicOr(&{SURFACE_TILES}[{group}], 1u);"));
+        self.line(2, "}");
+        self.line(1, "}");
     }
 }
 

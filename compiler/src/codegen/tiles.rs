@@ -102,6 +102,21 @@ impl Writer<'_, '_, '_> {
             ),
         );
         self.listed_tile(1, BACKGROUND_TILE_LIST);
+        self.background_pixels();
+        if self.counts_stats() {
+            self.flush_workgroup_stats(FINE_WORKGROUP);
+        }
+        self.line(0, "}");
+        self.line(0, "");
+    }
+
+    /// The pixels of background tile `mrsl_tile` for lane `mrsl_li` (of
+    /// [`FINE_WORKGROUP`]), each with its coarse effects as zero (the
+    /// background rule) and its fine effects evaluated as the main entry
+    /// point evaluates them, so that its image is the same; the refine mask
+    /// marks it background. The body of `fine_background`, and of the tile
+    /// kernel's `mrsl_tile_background`.
+    pub(super) fn background_pixels(&mut self) {
         let counted = self.counts_stats();
         let order = self.i.graph.order.clone();
         for k in 0..FINE_PIXELS_PER_LANE {
@@ -139,10 +154,5 @@ impl Writer<'_, '_, '_> {
             self.line(2, "}");
             self.line(1, "}");
         }
-        if counted {
-            self.flush_workgroup_stats(FINE_WORKGROUP);
-        }
-        self.line(0, "}");
-        self.line(0, "");
     }
 }

@@ -26,5 +26,6 @@ fn {{ENTRY}}(@builtin(workgroup_id) mrsl_wg: vec3<u32>, @builtin(local_invocatio
             {{TILE_SAMPLE}}(at, k, owned);
         }
     }
+{{#SURFACE}}
     workgroupBarrier();
 {{#PIXELS}}
