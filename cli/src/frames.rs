@@ -12,7 +12,7 @@
 use crate::args::RenderArgs;
 use crate::legend::{self, Legend};
 use crate::output::{save_image, save_output};
-use crate::render::{Session, dispatch_options};
+use crate::render::{Session, dispatch_options, no_path};
 use crate::setup::Resources;
 use crate::timing::{PAIRS, median, paired, time_run};
 use anyhow::{Context, Result, anyhow, bail};
@@ -451,14 +451,6 @@ fn print_summary(summary: &[Summary], n: usize) {
             metric("flicker", s.flicker, 5).unwrap_or_default(),
         );
     }
-}
-
-/// The error for a scene without a camera path.
-pub fn no_path(scene: &str) -> String {
-    format!(
-        "--frames needs a camera path, and scene `{scene}` has none: use --scene sponza (its default walk) or a \
-         scene file with `camera_path = \"walk\"` or [[camera_path]] keyframes (docs/scenes.md)"
-    )
 }
 
 /// Mean and largest length of a velocity texture (`Rg32Float`), in pixels.

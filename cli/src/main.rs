@@ -346,7 +346,13 @@ fn main() -> ExitCode {
 fn run(cli: &Cli) -> Result<ExitCode> {
     match &cli.command {
         Command::Check { file } => check(cli.color, file),
-        Command::Render(r) => Ok(written(render::render(&r.args()))),
+        Command::Render(r) => {
+            let args = r.args();
+            Ok(written(match args.frames {
+                Some(n) => render::open(&args).and_then(|mut session| frames::render_frames(&mut session, &args, n)),
+                None => render::render(&args),
+            }))
+        }
         Command::Bench(b) => bench(b),
         Command::Compile { file, out_dir, emit, mode, block, storage_channels, packed_records } => {
             let options = Options {

@@ -51,21 +51,27 @@ pub struct Session {
     pub resources: Resources,
 }
 
-/// Runs the render; returns the paths written.
+/// The error for a scene without a camera path.
+pub fn no_path(scene: &str) -> String {
+    format!(
+        "--frames needs a camera path, and scene `{scene}` has none: use --scene sponza (its default walk) or a \
+         scene file with `camera_path = \"walk\"` or [[camera_path]] keyframes (docs/scenes.md)"
+    )
+}
+
+/// Renders a still frame of every mode asked for; returns the paths
+/// written. (`--frames` goes to [`crate::frames::render_frames`] over the
+/// same [`Session`].)
 pub fn render(args: &RenderArgs) -> Result<Vec<PathBuf>> {
-    if args.frames.is_some() && (args.output.is_some() || args.heatmap.is_some()) {
-        bail!("--frames names its files OUT/PROGRAM.MODE.fNNN.png: leave out -o and --heatmap");
-    }
-    let mut session = open(args)?;
-    match args.frames {
-        Some(n) => crate::frames::render_frames(&mut session, args, n),
-        None => render_still(&mut session, args),
-    }
+    render_still(&mut open(args)?, args)
 }
 
 /// Compiles the program for the modes that run, makes the device, binds the
 /// scene and the command line's uniforms, and creates the output directory.
-fn open(args: &RenderArgs) -> Result<Session> {
+pub fn open(args: &RenderArgs) -> Result<Session> {
+    if args.frames.is_some() && (args.output.is_some() || args.heatmap.is_some()) {
+        bail!("--frames names its files OUT/PROGRAM.MODE.fNNN.png: leave out -o and --heatmap");
+    }
     let stem = args.program.as_ref().and_then(|p| p.file_stem()).and_then(|s| s.to_str()).unwrap_or("demo").to_string();
     let start = Instant::now();
     // The kernels of the modes that run: those asked for, and the reference to compare with.
@@ -99,7 +105,7 @@ fn open(args: &RenderArgs) -> Result<Session> {
     let size = scene.size;
     progress(&format!("built the {} G-buffer at {}x{}", args.scene, size.0, size.1), start);
     if args.frames.is_some() && scene.path.is_none() {
-        bail!(crate::frames::no_path(&args.scene));
+        bail!(no_path(&args.scene));
     }
     // The scene's uniforms, then the command line's.
     let BoundProgram { mut shader, resources, warnings } =

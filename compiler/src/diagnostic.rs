@@ -1,6 +1,6 @@
 //! The one diagnostic type every stage reports through, and its rendering with codespan-reporting.
 
-use crate::syntax::ast::Span;
+use crate::span::Span;
 use codespan_reporting::diagnostic as cs;
 use codespan_reporting::files::SimpleFile;
 use codespan_reporting::term;

@@ -38,6 +38,7 @@ mod layout;
 mod limits;
 mod plan;
 mod rates;
+mod span;
 mod syntax;
 mod types;
 mod validate;

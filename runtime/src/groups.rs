@@ -3,7 +3,7 @@
 //! group 2 (a kernel's stage group) from a pass of the plan, and group 3
 //! (indirect arguments) for the entry points that write them.
 
-use crate::shader::Bindings;
+use crate::bindings::Bindings;
 use crate::wgpu_format;
 use mrsl_abi::plan::{BindingType, PassBinding};
 use mrsl_abi::{BINDING_ARGS, Channel, ChannelAccess, Layout, SampleType};

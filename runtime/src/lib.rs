@@ -28,6 +28,7 @@
 //! without any backend (the application enables the ones it ships),
 //! bytemuck, thiserror, serde and pollster.
 
+mod bindings;
 pub mod controller;
 mod error;
 pub mod gpu;
@@ -39,11 +40,12 @@ mod stats;
 mod uniforms;
 mod validate;
 
+pub use bindings::Bindings;
 pub use error::Error;
 pub use gpu::wgpu_format;
 pub use mrsl_abi::{CompiledProgram, KernelKind, Layout, Mode, Plan, ReadError, RefineMaskTexel};
 pub use rate_source::{Combiner, ExternalRates, Foveation, Preset, RateInputs, RateOptions, RateSource};
-pub use shader::{Bindings, DispatchOptions, Shader};
+pub use shader::{DispatchOptions, Shader};
 pub use stats::{EffectStats, Stats, Timings};
 
 /// Compiles mrsl source into the kernels and layout [`Shader::new`] takes,

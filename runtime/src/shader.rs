@@ -3,6 +3,7 @@
 //! plan. [`Shader::encode`] interprets the mode's plan
 //! ([`mrsl_abi::plan::ModePlan`]): one loop over its steps.
 
+use crate::bindings::Bindings;
 use crate::error::Error;
 use crate::gpu::{describe, read_buffer};
 use crate::groups;
@@ -13,28 +14,6 @@ use mrsl_abi::plan::{DispatchContext, ModePlan, Pass, SampleCount, Stage, Step, 
 use mrsl_abi::{CompiledProgram, Control, Device, GROUP_ARGS, KernelKind, KernelRef, Layout, Plan, ResourceId, Scalar};
 use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
-
-/// Resources an engine binds for one dispatch. Every name is a declaration of
-/// the program; the layout says which are needed.
-#[derive(Default)]
-pub struct Bindings<'a> {
-    /// Width and height of the shaded image in pixels.
-    pub size: (u32, u32),
-    /// G-buffer channel textures, by `in` name.
-    pub channels: HashMap<String, &'a wgpu::Texture>,
-    /// Sampled textures, by `uniform texture2d` name.
-    pub textures: HashMap<String, &'a wgpu::TextureView>,
-    /// Samplers, by `uniform sampler` name.
-    pub samplers: HashMap<String, &'a wgpu::Sampler>,
-    /// Output storage textures, by `fine out` name.
-    pub outputs: HashMap<String, &'a wgpu::Texture>,
-    /// The rate-image mode's shading-rate image: one texel per
-    /// [`DispatchOptions::rate_tile`]-pixel tile
-    /// ([`mrsl_abi::shading_rate::rate_image_size`]), an unsigned-integer
-    /// texture (R8Uint, R16Uint or R32Uint) holding the codes of
-    /// [`mrsl_abi::ShadingRate`]. Other modes ignore it.
-    pub shading_rate: Option<&'a wgpu::Texture>,
-}
 
 /// Per-dispatch settings.
 #[derive(Debug, Clone, Copy, PartialEq)]

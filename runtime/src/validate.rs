@@ -2,9 +2,9 @@
 //! mode's plan before anything is recorded: every mismatch is a typed
 //! [`Error`] naming the binding at fault.
 
+use crate::bindings::Bindings;
 use crate::error::Error;
 use crate::gpu::{layout_format, wgpu_format};
-use crate::shader::Bindings;
 use mrsl_abi::geometry::MAX_SIDE;
 use mrsl_abi::plan::{MAX_WORKGROUPS_PER_DIMENSION, ModePlan, TooLarge, Workgroups};
 use mrsl_abi::{Channel, ChannelAccess, Decode, Layout, Output, Plan, ResourceId, SampleType, TextureFormat};

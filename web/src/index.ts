@@ -6,7 +6,8 @@
 export type { Mode, Layout, Plan, ModePlan, PlanDevice } from './contract.js';
 export { MODES } from './contract.js';
 export { MrslError, type ErrorKind } from './errors.js';
-export { Shader, DEFAULT_SIMILARITY, DEFAULT_RATE_TILE, type Bindings, type DispatchOptions } from './shader.js';
+export type { Bindings } from './bindings.js';
+export { Shader, DEFAULT_SIMILARITY, DEFAULT_RATE_TILE, type DispatchOptions } from './shader.js';
 export { loadProgram, parseLayout, kernelFileName, type CompiledProgram, type Kernel } from './program.js';
 export type { Stats, EffectStats, Timings } from './stats.js';
 export { loadGBuffer, applyUniforms, GBUFFER_FORMAT, type GBufferManifest, type LoadedGBuffer } from './gbuffer.js';

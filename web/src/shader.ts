@@ -14,22 +14,7 @@ import type { CompiledProgram, Kernel } from './program.js';
 import { makeStats, type Stats, type Timings } from './stats.js';
 import { controlBytes, UniformValues } from './uniforms.js';
 import { checkBindings, checkSize } from './validate.js';
-
-/** What the page binds for one dispatch; every name is a declaration of the program. */
-export interface Bindings {
-  /** Width and height of the shaded image in pixels. */
-  size: Size;
-  /** G-buffer channel textures, by `in` name. */
-  channels: Record<string, GPUTexture>;
-  /** Sampled textures, by `uniform texture2d` name (a texture, or a view of one). */
-  textures?: Record<string, GPUTexture | GPUTextureView>;
-  /** Samplers, by `uniform sampler` name. */
-  samplers?: Record<string, GPUSampler>;
-  /** Output storage textures, by `fine out` name. */
-  outputs: Record<string, GPUTexture>;
-  /** The rate-image mode's shading-rate image: one r8uint/r16uint/r32uint texel per tile. */
-  shadingRate?: GPUTexture;
-}
+import type { Bindings } from './bindings.js';
 
 export interface DispatchOptions {
   mode: Mode;

@@ -7,7 +7,7 @@ import { MrslError } from './errors.js';
 import { formatInfo } from './formats.js';
 import { extentCount, extentGrid, rateImageSize, type Size } from './geometry.js';
 import { planResources } from './plan.js';
-import type { Bindings } from './shader.js';
+import type { Bindings } from './bindings.js';
 
 /** Shading-rate tile sizes the rate-image mode supports. */
 export const RATE_TILE_SIZES: readonly number[] = [8, 16];

@@ -3,7 +3,7 @@
 //! use, one export at a time, on the blocking pool) and keeps the files in
 //! a bounded cache, from which `GET /api/gbuffer/KEY/FILE` serves them.
 
-use super::api::{PROGRAM_NAME, diagnostics};
+use super::diagnostics::{PROGRAM_NAME, diagnostics};
 use super::reply::{ApiError, blocking, read_json};
 use crate::gbuffer::{self, MANIFEST, ProgramRef};
 use axum::Json;

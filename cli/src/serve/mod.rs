@@ -7,6 +7,7 @@
 //! never takes the server down. docs/serve.md describes the endpoints.
 
 mod api;
+mod diagnostics;
 mod export;
 mod reply;
 

@@ -56,6 +56,20 @@ impl Level {
     }
 }
 
+impl Writer<'_, '_, '_> {
+    /// `mrsl_resolve` of the kernel's own (first) level.
+    pub(super) fn own_level_resolver(&self) -> String {
+        Name::Resolve.of(Level::own(self.block).suffix)
+    }
+
+    /// `mrsl_resample<level>_<effect>` of effect `name` at the kernel's own
+    /// level, or (`inner`) at the dynamic mode's inner one.
+    pub(super) fn level_resampler(&self, inner: bool, name: &str) -> String {
+        let level = if inner { &Level::DYNAMIC_INNER } else { &Level::own(self.block) };
+        Name::Resample.within(level.suffix, name)
+    }
+}
+
 /// Where a resolver finds the corners' keys and record words.
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub(super) enum Corners {

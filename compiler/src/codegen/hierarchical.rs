@@ -22,7 +22,6 @@
 
 use super::Writer;
 use super::effects::Evaluation;
-use super::level_derivatives::LEVELS_WITH_PREDICATES;
 use super::names::{
     CONTROL, COUNT, LANE, LEVEL, LOAD_RECORD, LOCAL_ID, NEIGHBOUR_RECORDS, Name, PIXEL_RECORD, POS, PUT_MASKS,
     PUT_RECORD, RECORD_TYPE, SET_WORD, SHADE, SHADE_LAST, TILE_ARGS, TILE_INVOCATION, WORD, WORKGROUP,
@@ -38,6 +37,7 @@ use mrsl_abi::geometry::{
     HIERARCHICAL_TILE_COUNTS, Lattice, QUEUE_WORDS_PER_LEVEL, WORK_LIST_WORKGROUP,
 };
 use std::fmt::Display;
+use std::ops::RangeInclusive;
 
 /// How a classified level (1 to 4, dispatched over [`HIERARCHICAL_LEVELS`])
 /// picks its pixels and the neighbours it interpolates from.
@@ -60,6 +60,10 @@ fn classified_levels() -> [Classified; 4] {
         Classified { what: "the rest, from axis neighbours at distance 1", neighbours: axis_neighbours(1) },
     ]
 }
+
+/// The levels whose shading evaluates predicates (`mrsl_shade`): 0 to 3,
+/// every level but the last, which shades values alone.
+pub(super) const LEVELS_WITH_PREDICATES: RangeInclusive<usize> = 0..=HIERARCHICAL_LEVELS.len() - 1;
 
 /// The neighbours of a pixel of level `level` in opposite pairs (0, 1) and
 /// (2, 3): at level 0 its lattice's neighbours along the axes, at the

@@ -14,18 +14,14 @@
 //! (`mrsl_stored_<effect>`).
 
 use super::Writer;
-use super::hierarchical::level_neighbours;
+use super::hierarchical::{LEVELS_WITH_PREDICATES, level_neighbours};
 use super::names::{LEVEL, LEVEL_NEIGHBOURS, LEVEL_WEIGHTS, LOAD_RECORD, Name, POS};
 use super::records::neighbours;
 use crate::check::EffectId;
 use mrsl_abi::KernelKind;
-use mrsl_abi::geometry::{HIERARCHICAL_LEVEL0, HIERARCHICAL_LEVELS};
+use mrsl_abi::geometry::HIERARCHICAL_LEVEL0;
 use std::collections::BTreeSet;
 use std::ops::RangeInclusive;
-
-/// The levels whose shading evaluates predicates (`mrsl_shade`): 0 to 3,
-/// every level but the last, which shades values alone.
-pub(super) const LEVELS_WITH_PREDICATES: RangeInclusive<usize> = 0..=HIERARCHICAL_LEVELS.len() - 1;
 
 impl Writer<'_, '_, '_> {
     /// Whether some derivative of the kernel is taken from the levels' neighbours.

@@ -4,7 +4,6 @@
 //! stores, and the per-workgroup statistics that must all reach a barrier.
 
 use super::effects::Evaluation;
-use super::fine::Level;
 use super::names::{
     BLOCK, CONTROL, CORNERS, FIRST, GRID, INNER_BLOCK, IS_REFINED, LANE_PIXEL, LEVEL_VALUES, LOAD_CORNERS, Name, POS,
     WORKGROUP_STATS,
@@ -338,7 +337,7 @@ impl Writer<'_, '_, '_> {
     /// then each pixel's `prologue`.
     fn resolve_lane_pixels(&mut self, prologue: &mut impl FnMut(&mut Self, Scope)) {
         let dynamic = self.kind == KernelKind::DynamicFine;
-        let resolve = Name::Resolve.of(Level::own(self.block).suffix);
+        let resolve = self.own_level_resolver();
         // A lane past the image's edge still loads (clamped) corners and
         // resolves; its pixels' statistics and stores are skipped below.
         self.line(1, format!("let {CORNERS} = {LOAD_CORNERS}(min({FIRST}, {GRID}() - vec2<i32>(1)));"));
@@ -379,10 +378,10 @@ impl Writer<'_, '_, '_> {
                 continue;
             }
             let (block, inner) = (Name::LaneBlock.of(k), Name::LaneInner.of(k));
-            let resample = Name::Resample.within(Level::own(self.block).suffix, &info.name);
+            let resample = self.level_resampler(false, &info.name);
             self.line(1, format!("var {} = {resample}({block}, {CORNERS});", value(k)));
             if dynamic {
-                let resample2 = Name::Resample.within(Level::DYNAMIC_INNER.suffix, &info.name);
+                let resample2 = self.level_resampler(true, &info.name);
                 self.line(
                     1,
                     format!(
