@@ -10,7 +10,7 @@ use crate::types::{SampleType, TextureFormat, ValueType};
 use serde::{Deserialize, Serialize};
 
 /// The layout format this crate reads and writes (the `format` field).
-pub const LAYOUT_FORMAT: &str = "mrsl-layout/7";
+pub const LAYOUT_FORMAT: &str = "mrsl-layout/8";
 
 /// The refine mask's texel at a background pixel (x: no effect evaluated per
 /// pixel, y: all ones). A shaded pixel holds it only in a program with at
@@ -263,6 +263,15 @@ impl TileLayout {
 pub struct NeighbourValue {
     pub name: String,
     pub offset: u32,
+    /// In the tile kernel, the step of its neighbour phase (a barrier
+    /// between steps) that evaluates this effect, at every sample the
+    /// workgroup holds: for its value, and at the tile's samples for its
+    /// refine flag too when it refines. A flag whose predicate takes a
+    /// derivative of another neighbour value needs that value at the
+    /// neighbouring samples first: its step is one past that value's.
+    /// The two-pass coarse kernel evaluates every value in one pass.
+    #[serde(default)]
+    pub wave: u32,
 }
 
 /// Counters the fine kernels accumulate (when the program has live coarse effects).
@@ -616,14 +625,20 @@ pub struct EffectLayout {
     /// cannot refine.
     #[serde(default)]
     pub value_operations: Option<u64>,
-    /// For a live coarse effect: how many times the block modes evaluate its
-    /// body per coarse sample (the tile kernel and the coarse kernel alike):
-    /// 1 where every derivative at a sample reads the neighbour values; 2 for
-    /// a neighbour value that refines (evaluated for its value first, then
-    /// again at the sample for its refine flag); more where derivatives
+    /// For a live coarse effect: how many times the block modes' tile kernel
+    /// (their plan on a GPU) evaluates its body per coarse sample: 1 where
+    /// every derivative at a sample reads the neighbour values (a neighbour
+    /// value that refines keeps its flag beside its value, [`NeighbourValue::wave`]);
+    /// more for an effect that is not a neighbour value but is read by one
+    /// (evaluated for it, then again at the sample), or where derivatives
     /// evaluate effects at the neighbouring samples in place
     /// (`neighbours.words` 0). The tile kernel evaluates each of the samples
     /// its workgroup holds ([`TileLayout`]) this often.
     #[serde(default)]
     pub sample_evaluations: Option<u32>,
+    /// The same count for the two-pass coarse kernel (the block modes' plan
+    /// on a CPU), whose neighbour pass stores values alone: a neighbour
+    /// value that refines is evaluated again at the sample for its flag (2).
+    #[serde(default)]
+    pub coarse_kernel_sample_evaluations: Option<u32>,
 }

@@ -13,10 +13,10 @@ use mrsl_abi::geometry;
 use mrsl_abi::{
     BINDING_CONTROL, BINDING_UNIFORMS, CONTROL_FIELDS, Channel, ChannelAccess, Control, ControlBlock, Decode,
     EffectLayout, Field, GROUP_ARGS, GROUP_GBUFFER, GROUP_RESOURCES, GROUP_STAGE, HierarchicalLayout, InterfaceLayout,
-    LAYOUT_FORMAT, Layout, NeighbourLayout, NeighbourValue, Output, Plan, Resample, ResourceBinding, ResourceKind,
-    SampleType, SlotLayout, StatsLayout, TextureFormat, TileLayout, UniformBlock, ValueType,
+    LAYOUT_FORMAT, Layout, Output, Plan, Resample, ResourceBinding, ResourceKind, SampleType, SlotLayout, StatsLayout,
+    TextureFormat, TileLayout, UniformBlock, ValueType,
 };
-use std::collections::{BTreeSet, HashMap};
+use std::collections::HashMap;
 
 /// The layout's type of a checked value type (checked programs only declare value types where the layout has them).
 fn value_type(ty: &Type) -> ValueType {
@@ -90,7 +90,13 @@ pub fn build(
         refine_mask: stage_resource(StageSlot::RefineMask, "mrsl_refine_mask", ResourceKind::RefineMask),
         interface2: stage_resource(StageSlot::Interface2, "mrsl_interface2", ResourceKind::Storage),
         shading_rate: stage_resource(StageSlot::ShadingRate, "mrsl_shading_rate", ResourceKind::ShadingRate),
-        neighbours: neighbours(checked, graph, deriv, stage_binding(checked, StageSlot::Neighbours)),
+        neighbours: crate::neighbours::layout(
+            checked,
+            graph,
+            deriv,
+            interface,
+            stage_binding(checked, StageSlot::Neighbours),
+        ),
         tile: TileLayout { samples: 0, ring: u32::from(pixels_read_coarse_at_neighbours(checked, graph, deriv)) },
         hierarchical: hierarchical_layout(checked, graph, interface),
         outputs: outputs(checked),
@@ -100,75 +106,12 @@ pub fn build(
         // Filled in from the modes by `plan::build`.
         plan: Plan { modes: vec![], resources: vec![], constants: Default::default() },
     };
-    let evaluations = sample_evaluations(checked, graph, deriv, &layout.neighbours);
-    for (effect, count) in layout.effects.iter_mut().zip(evaluations) {
-        effect.sample_evaluations = count;
+    let evaluations = crate::neighbours::sample_evaluations(checked, graph, deriv, &layout.neighbours);
+    for (effect, counts) in layout.effects.iter_mut().zip(evaluations) {
+        effect.sample_evaluations = counts.map(|c| c.tile);
+        effect.coarse_kernel_sample_evaluations = counts.map(|c| c.coarse_kernel);
     }
     layout
-}
-
-/// [`mrsl_abi::EffectLayout::sample_evaluations`] of every effect: how
-/// often the block modes' coarse pass evaluates each live coarse effect's
-/// body per coarse sample, given the neighbour values it stores.
-fn sample_evaluations(
-    checked: &Checked,
-    graph: &EffectGraph,
-    deriv: &DerivInfo,
-    neighbours: &NeighbourLayout,
-) -> Vec<Option<u32>> {
-    let n = checked.effects.len();
-    let mut count = vec![0u32; n];
-    let coarse = |e: EffectId| graph.live[e.index()] && checked.effects[e.index()].rate == Rate::Coarse;
-    let stored: BTreeSet<EffectId> = (0..n as u32)
-        .map(EffectId)
-        .filter(|e| neighbours.effects.iter().any(|v| v.name == checked.effects[e.index()].name))
-        .collect();
-    // The neighbour values' pass evaluates them and what they read, each once.
-    let chain: BTreeSet<EffectId> = stored.iter().flat_map(|&e| graph.closure(e, checked)).collect();
-    for e in &chain {
-        count[e.index()] += 1;
-    }
-    for e in (0..n as u32).map(EffectId).filter(|&e| coarse(e)) {
-        // A stored value is read back at its own sample unless its flag is needed.
-        if !stored.contains(&e) || checked.effects[e.index()].has_refine {
-            count[e.index()] += 1;
-            at_neighbours(checked, graph, deriv, e, false, 1, neighbours.words == 0, &mut count);
-        }
-    }
-    (0..n).map(|i| coarse(EffectId(i as u32)).then_some(count[i])).collect()
-}
-
-/// Adds the evaluations the derivatives in `e`'s body make at neighbouring
-/// samples, `times` over, when they evaluate there (`in_place`): the effects
-/// each operand reads and what those read, at one position per `ddx` or
-/// `ddy`, two per `fwidth` or `sample`; and so on for the derivatives their
-/// values take. With `value_only`, only the derivatives a value needs.
-#[allow(clippy::too_many_arguments, reason = "one recursion over the same facts")]
-fn at_neighbours(
-    checked: &Checked,
-    graph: &EffectGraph,
-    deriv: &DerivInfo,
-    e: EffectId,
-    value_only: bool,
-    times: u32,
-    in_place: bool,
-    count: &mut [u32],
-) {
-    if !in_place {
-        return;
-    }
-    for site in deriv.sites.iter().filter(|s| s.effect == e && !(value_only && s.decides_only)) {
-        let positions = match site.builtin.plain_derivative() {
-            crate::builtins::Builtin::Ddx | crate::builtins::Builtin::Ddy => 1,
-            _ => 2,
-        };
-        for &read in &site.effects {
-            for x in graph.closure(read, checked) {
-                count[x.index()] += times * positions;
-                at_neighbours(checked, graph, deriv, x, true, times * positions, in_place, count);
-            }
-        }
-    }
 }
 
 /// What the stage group binds after the interface record (binding 0) and the
@@ -349,6 +292,7 @@ fn effect_layouts(checked: &Checked, graph: &EffectGraph, interface: &Interface,
                 value_operations: value_operations.get(&id).copied(),
                 // Filled in with the neighbour values, by `build`.
                 sample_evaluations: None,
+                coarse_kernel_sample_evaluations: None,
             }
         })
         .collect()
@@ -420,38 +364,6 @@ pub fn interface_layout(checked: &Checked, interface: &Interface) -> InterfaceLa
     }
 }
 
-/// The coarse effects the block coarse kernel's derivatives read at
-/// neighbouring samples (the operands of derivative sites in live coarse
-/// effects), with their word offsets, when evaluating them reads no effect
-/// at a neighbour in turn: then a first entry point can store them at every
-/// sample and the derivatives read them ([`NeighbourLayout`]). Otherwise none.
-fn neighbours(checked: &Checked, graph: &EffectGraph, deriv: &DerivInfo, binding: u32) -> NeighbourLayout {
-    let coarse_live = |e: EffectId| graph.live[e.index()] && checked.effects[e.index()].rate == Rate::Coarse;
-    let needed: BTreeSet<EffectId> = deriv
-        .sites
-        .iter()
-        .filter(|site| coarse_live(site.effect))
-        .flat_map(|site| site.effects.iter().copied())
-        .filter(|e| graph.live[e.index()])
-        .collect();
-    let evaluated: BTreeSet<EffectId> = needed.iter().flat_map(|&e| graph.closure(e, checked)).collect();
-    // Only the derivatives a value needs run at a neighbour (`DerivSite::decides_only`).
-    let nested = deriv
-        .sites
-        .iter()
-        .any(|site| evaluated.contains(&site.effect) && !site.effects.is_empty() && !site.decides_only);
-    let mut words = 0;
-    let mut effects = vec![];
-    if !nested {
-        for e in graph.order.iter().filter(|e| needed.contains(e)) {
-            let info = &checked.effects[e.index()];
-            effects.push(NeighbourValue { name: info.name.clone(), offset: words });
-            words += info.ty.components();
-        }
-    }
-    NeighbourLayout { binding, words, effects }
-}
-
 /// Whether a per-pixel evaluation (a fine effect, or a refined coarse effect
 /// evaluated for its value) takes a derivative of an operand that reads a
 /// coarse effect: then the value at the neighbouring pixel is resolved from
@@ -477,14 +389,24 @@ pub fn tile_layout(layout: &Layout) -> TileLayout {
 
 /// The workgroup memory of the tile kernel with `tile`, as WebGPU counts it
 /// (each variable rounded up to 16 bytes): the records, the neighbour
-/// values, the statistics counters and, with a background rule, a word per
+/// values and the refine flags kept beside them, the statistics counters
+/// and, with a background rule, a word per
 /// 8x8 pixels of the 4x4 blocks' tile. A test holds the kernels to it.
 pub fn tile_workgroup_bytes(layout: &Layout, tile: TileLayout) -> u32 {
     let records = layout.interface.stride_words.max(1) * tile.record_side().pow(2);
     let neighbours = layout.neighbours.words * tile.neighbour_side().pow(2);
     let surface_tiles = if layout.has_background() { (tile.side(4) / geometry::TILE).pow(2) } else { 0 };
+    let flags = if crate::neighbours::tile_keeps_flags(layout) {
+        layout.interface.flag_words * tile.record_side().pow(2)
+    } else {
+        0
+    };
     let variable = |words: u32| (4 * words).div_ceil(16) * 16;
-    variable(records) + variable(neighbours) + variable(layout.stats_counters() as u32) + variable(surface_tiles)
+    variable(records)
+        + variable(neighbours)
+        + variable(flags)
+        + variable(layout.stats_counters() as u32)
+        + variable(surface_tiles)
 }
 
 /// The storage textures WebGPU guarantees a shader stage
@@ -520,16 +442,19 @@ mod tests {
         crate::compile(source, &crate::Options::for_modes(&[mrsl_abi::Mode::Coarse4x4])).unwrap().layout.clone()
     }
 
-    fn evaluations(layout: &Layout) -> Vec<(&str, Option<u32>)> {
-        layout.effects.iter().map(|e| (e.name.as_str(), e.sample_evaluations)).collect()
+    /// Each effect's evaluations per sample: in the tile kernel, in the two-pass coarse kernel.
+    fn evaluations(layout: &Layout) -> Vec<(&str, Option<(u32, u32)>)> {
+        let counts = |e: &mrsl_abi::EffectLayout| e.sample_evaluations.zip(e.coarse_kernel_sample_evaluations);
+        layout.effects.iter().map(|e| (e.name.as_str(), counts(e))).collect()
     }
 
     /// A derivative of an effect reads the neighbour values: every body runs
     /// once per sample, the stored one in the neighbour pass. A stored effect
-    /// that refines runs again at the sample, for its flag. An effect whose
-    /// neighbour evaluation takes a derivative of another effect in turn is
-    /// evaluated in place: once at the sample and once per position of each
-    /// difference that reads it (`fwidth`: two).
+    /// that refines runs again at the sample, for its flag, in the two-pass
+    /// coarse kernel; the tile kernel keeps its flag beside its value. An
+    /// effect whose neighbour evaluation takes a derivative of another effect
+    /// in turn is evaluated in place: once at the sample and once per
+    /// position of each difference that reads it (`fwidth`: two).
     #[test]
     fn sample_evaluations_count_the_bodies_a_sample_runs() {
         let head = "in float3 normal;\ncoarse effect float a = normal.x * normal.y;\n";
@@ -537,21 +462,41 @@ mod tests {
             "{head}coarse effect float b {{\n    b = a * 2.0;\n    if (fwidth(a) > 0.1) refine;\n}}\n\
              fine out float4 color = float4(b);\n"
         );
-        assert_eq!(evaluations(&layout(&stored)), [("a", Some(1)), ("b", Some(1)), ("color", None)]);
+        assert_eq!(evaluations(&layout(&stored)), [("a", Some((1, 1))), ("b", Some((1, 1))), ("color", None)]);
         let refining = stored.replace(
             "coarse effect float a = normal.x * normal.y;",
             "coarse effect float a {\n    a = normal.x;\n    if (a > 0.5) refine;\n}",
         );
-        assert_eq!(evaluations(&layout(&refining)), [("a", Some(2)), ("b", Some(1)), ("color", None)]);
+        assert_eq!(evaluations(&layout(&refining)), [("a", Some((1, 2))), ("b", Some((1, 1))), ("color", None)]);
         let nested = format!(
             "{head}coarse effect float b = ddx(a);\ncoarse effect float c {{\n    c = b;\n    if (fwidth(b) > 0.1) refine;\n}}\n\
              fine out float4 color = float4(c);\n"
         );
+        // A chain of refining neighbour values: b's flag takes a difference
+        // of a, c's of b: three waves, each body once in the tile kernel.
+        let chain = format!(
+            "{head}coarse effect float b {{\n    b = a * 2.0;\n    if (fwidth(a) > 0.1) refine;\n}}\n\
+             coarse effect float c {{\n    c = b + 1.0;\n    if (fwidth(b) > 0.1) refine;\n}}\n\
+             coarse effect float d {{\n    d = c;\n    if (fwidth(c) > 0.1) refine;\n}}\n\
+             fine out float4 color = float4(d);\n"
+        )
+        .replace(
+            "coarse effect float a = normal.x * normal.y;",
+            "coarse effect float a {\n    a = normal.x;\n    if (a > 0.5) refine;\n}",
+        );
+        let chain = layout(&chain);
+        let waves: Vec<(&str, u32)> = chain.neighbours.effects.iter().map(|v| (v.name.as_str(), v.wave)).collect();
+        assert_eq!(waves, [("a", 0), ("b", 1), ("c", 2)]);
+        let expected = [("a", Some((1, 2))), ("b", Some((1, 2))), ("c", Some((1, 2))), ("d", Some((1, 1)))];
+        assert_eq!(evaluations(&chain)[..4], expected);
         let nested = layout(&nested);
         assert_eq!(nested.neighbours.words, 0, "b's value takes a derivative of a: evaluated in place");
         // c: once. b: once, and at two positions for c's fwidth. a: once for
         // b at the sample, and per evaluation of b elsewhere once for itself
         // and once for b's ddx: 1 + 1 + 2 x 2.
-        assert_eq!(evaluations(&nested), [("a", Some(6)), ("b", Some(3)), ("c", Some(1)), ("color", None)]);
+        assert_eq!(
+            evaluations(&nested),
+            [("a", Some((6, 6))), ("b", Some((3, 3))), ("c", Some((1, 1))), ("color", None)]
+        );
     }
 }

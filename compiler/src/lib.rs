@@ -36,6 +36,7 @@ mod graph;
 mod interface;
 mod layout;
 mod limits;
+mod neighbours;
 mod plan;
 mod rates;
 mod span;

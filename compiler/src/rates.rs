@@ -94,7 +94,7 @@ impl Levels<'_> {
     /// The layout of both levels; the stored values at `binding` of the stage group.
     pub fn layout(&self, checked: &Checked, binding: u32) -> LevelsLayout {
         let name = |e: EffectId| checked.effects[e.index()].name.clone();
-        let values = self.values.iter().map(|&(e, offset)| NeighbourValue { name: name(e), offset }).collect();
+        let values = self.values.iter().map(|&(e, offset)| NeighbourValue { name: name(e), offset, wave: 0 }).collect();
         let block = checked
             .effects
             .iter()

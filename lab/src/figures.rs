@@ -19,8 +19,9 @@
 //!   compiler), against the device's `maxComputeWorkgroupStorageSize`
 //!   (WebGPU's default: 16 KiB).
 //! - **Evaluations per coarse sample**: the most any coarse effect's body
-//!   runs per coarse sample in the block modes (`EffectLayout::sample_evaluations`),
-//!   and for the tile kernel how many samples a workgroup evaluates per
+//!   runs per coarse sample in the block modes (`EffectLayout::sample_evaluations`
+//!   in the tile kernel, `coarse_kernel_sample_evaluations` in the two-pass
+//!   coarse kernel), and for the tile kernel how many samples a workgroup evaluates per
 //!   sample it owns (its tile's border overlaps the next tile's).
 
 use mrsl_abi::plan::{BindingType, ModePlan, ResourceId, Shape, Step, Workgroups};
@@ -81,11 +82,13 @@ impl PlanFigures {
                 }
             }
         }
-        let sample_evaluations = mode
-            .mode
-            .block_size()
-            .filter(|_| mode.mode != mrsl_abi::Mode::Dynamic)
-            .and_then(|_| layout.effects.iter().filter_map(|e| e.sample_evaluations).max());
+        let sample_evaluations =
+            mode.mode.block_size().filter(|_| mode.mode != mrsl_abi::Mode::Dynamic).and_then(|_| {
+                let count = |e: &mrsl_abi::EffectLayout| {
+                    if tile { e.sample_evaluations } else { e.coarse_kernel_sample_evaluations }
+                };
+                layout.effects.iter().filter_map(count).max()
+            });
         let tile_overlap = tile.then(|| {
             let t = layout.tile;
             f64::from(t.record_side().pow(2)) / f64::from(t.samples.pow(2))
@@ -176,5 +179,28 @@ mod tests {
         let coarse = f64::from(nx * ny) * 16.0 / (64.0 * 48.0);
         assert_eq!(cpu.global_bytes_per_pixel, coarse + 16.0 + 16.0 + cpu.interface_bytes_per_pixel);
         assert_eq!(gpu.global_bytes_per_pixel, 16.0 + 16.0);
+    }
+
+    /// A neighbour value that refines runs once per sample in the tile
+    /// kernel, which keeps its flag, and twice in the two-pass coarse
+    /// kernel, whose neighbour pass stores values alone.
+    #[test]
+    fn evaluations_per_sample_are_the_plans_kernels() {
+        let source = "in float3 normal;
+coarse effect float a {
+    a = normal.x;
+    if (a > 0.5) refine;
+}
+                      coarse effect float b {
+    b = a * 2.0;
+    if (fwidth(a) > 0.1) refine;
+}
+                      fine out float4 color = float4(b);
+";
+        let program = mrsl::compile(source, &mrsl::Options::for_modes(&[Mode::Coarse2x2])).unwrap();
+        let layout = &program.layout;
+        let figures = |device| PlanFigures::of(layout, layout.plan.mode_on(Mode::Coarse2x2, device).unwrap(), (64, 48));
+        assert_eq!(figures(Device::Gpu).sample_evaluations, Some(1));
+        assert_eq!(figures(Device::Cpu).sample_evaluations, Some(2));
     }
 }

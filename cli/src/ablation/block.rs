@@ -215,9 +215,12 @@ fn no_tile_samples(w: &str) -> Option<String> {
     without_call(w, "mrsl_c_tile_sample(")
 }
 
-/// The tile kernel's neighbour values not evaluated (the derivatives at the samples read zero).
+/// The tile kernel's neighbour values not evaluated, in every wave (the
+/// derivatives at the samples read zero, and so do the neighbour values
+/// and the flags the samples read back).
 fn no_tile_neighbours(w: &str) -> Option<String> {
-    without_call(w, "mrsl_c_tile_neighbours(")
+    let waves = (0..).map(|wave| format!("mrsl_c_tile_neighbours{wave}(")).take_while(|call| w.contains(call));
+    waves.fold(None, |edited: Option<String>, call| without_call(edited.as_deref().unwrap_or(w), &call).or(edited))
 }
 
 /// The tile kernel's pixels not shaded (left: its coarse phases and the launch).

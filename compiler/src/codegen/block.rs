@@ -218,16 +218,22 @@ impl Writer<'_, '_, '_> {
         let chain: Vec<EffectId> = self.i.graph.order.iter().copied().filter(|e| needed.contains(e)).collect();
         self.effect_chain(&chain, indent, Evaluation::ValueOnly);
         for (e, offset) in stored {
-            let info = &c.effects[e.index()];
-            for (j, word) in pack_words(&self.effect_name(e), &info.ty).iter().enumerate() {
-                let layer = offset + j as u32;
-                let store = if self.writes_coarse_part() {
-                    Self::tile_neighbour_store(layer, word)
-                } else {
-                    format!("textureStore({NEIGHBOURS}, {texel}, {layer}, vec4<u32>({word}, 0u, 0u, 0u));")
-                };
-                self.line(indent, store);
-            }
+            self.store_neighbour_words(indent, texel, e, offset);
+        }
+    }
+
+    /// Neighbour value `e`, computed into its local, stored from word
+    /// `offset` at texel `texel` (in the tile kernel, at its slot).
+    pub(super) fn store_neighbour_words(&mut self, indent: usize, texel: &str, e: EffectId, offset: u32) {
+        let info = &self.checked().effects[e.index()];
+        for (j, word) in pack_words(&self.effect_name(e), &info.ty).iter().enumerate() {
+            let layer = offset + j as u32;
+            let store = if self.writes_coarse_part() {
+                Self::tile_neighbour_store(layer, word)
+            } else {
+                format!("textureStore({NEIGHBOURS}, {texel}, {layer}, vec4<u32>({word}, 0u, 0u, 0u));")
+            };
+            self.line(indent, store);
         }
     }
 
@@ -304,7 +310,10 @@ impl Writer<'_, '_, '_> {
         for e in self.coarse_live() {
             let info = &c.effects[e.index()];
             self.line(1, format!("// coarse effect `{}`", info.name));
-            if stored.contains(&e) && !info.has_refine {
+            if stored.contains(&e) && self.writes_coarse_part() {
+                // The tile's neighbour phase kept its value here, and its flag.
+                self.kept_neighbour_value(e);
+            } else if stored.contains(&e) && !info.has_refine {
                 // Its value here is what `coarse_neighbours` stored here: the same evaluation.
                 let name = self.effect_name(e);
                 self.line(1, format!("let {name} = {}({POS});", Name::At.of(&info.name)));

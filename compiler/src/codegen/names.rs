@@ -363,6 +363,11 @@ pub(super) const ORIGIN: &str = "mrsl_origin";
 pub(super) const RECORD_SLOT: &str = "mrsl_record_slot";
 pub(super) const NEIGHBOUR_SLOT: &str = "mrsl_neighbour_slot";
 pub(super) const TILE_NEIGHBOURS: &str = "mrsl_tile_neighbours";
+/// The refine flags the tile kernel keeps beside its neighbour values (the
+/// record's flag words, per record slot), and whether a sample is one of
+/// the records' (`mrsl_is_record`).
+pub(super) const WORKGROUP_NEIGHBOUR_FLAGS: &str = "mrsl_wg_neighbour_flags";
+pub(super) const IS_RECORD: &str = "mrsl_is_record";
 pub(super) const TILE_SAMPLE: &str = "mrsl_tile_sample";
 pub(super) const TILE_PIXELS: &str = "mrsl_tile_pixels";
 pub(super) const SLOT: &str = "mrsl_slot";
@@ -374,6 +379,11 @@ pub(super) const SURFACE_TILES: &str = "mrsl_wg_surface_tiles";
 /// Which of the tile kernel's 8x8 tiles of pixels a group of lanes shades.
 pub(super) const GROUP_TILE: &str = "mrsl_group_tile";
 pub(super) const TILE_BACKGROUND: &str = "mrsl_tile_background";
+
+/// The tile kernel's neighbour phase in wave `wave` ([`mrsl_abi::NeighbourValue::wave`]).
+pub(super) fn tile_neighbours_wave(wave: u32) -> String {
+    format!("{TILE_NEIGHBOURS}{wave}")
+}
 
 /// The tile kernel's coarse part is the coarse kernel's functions renamed
 /// into a namespace of their own ([`coarse_part_name`]): in it a position
@@ -507,6 +517,8 @@ pub(super) const FIXED: &[&str] = &[
     RECORD_SLOT,
     NEIGHBOUR_SLOT,
     TILE_NEIGHBOURS,
+    WORKGROUP_NEIGHBOUR_FLAGS,
+    IS_RECORD,
     TILE_SAMPLE,
     TILE_PIXELS,
     SLOT,

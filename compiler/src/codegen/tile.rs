@@ -24,16 +24,20 @@
 //! only use (bindings, user functions, constants, workgroup memory) is
 //! declared once by the fine part.
 
+use super::effects::Evaluation;
 use super::names::{
-    self, BACKGROUND, CONTROL, FIRST, GRID, GROUP_TILE, LANE, NEIGHBOUR_SLOT, NEIGHBOUR_SLOTS, Name, OWNED, POS,
-    RECORD_SLOT, RECORD_SLOTS, REFINE_MASK, SLOT, STATS, SURFACE_TILES, TILE_BACKGROUND, TILE_NEIGHBOURS, TILE_ORIGIN,
-    TILE_PIXEL, TILE_PIXELS, TILE_SAMPLE, WORKGROUP, WORKGROUP_NEIGHBOURS, WORKGROUP_RECORDS, WORKGROUP_STATS,
+    self, BACKGROUND, CONTROL, FIRST, GRID, GROUP_TILE, IS_RECORD, LANE, NEIGHBOUR_SLOT, NEIGHBOUR_SLOTS, Name, OWNED,
+    POS, RECORD_SLOT, RECORD_SLOTS, REFINE_MASK, SLOT, STATS, SURFACE_TILES, TILE_BACKGROUND, TILE_ORIGIN, TILE_PIXEL,
+    TILE_PIXELS, TILE_SAMPLE, WORKGROUP, WORKGROUP_NEIGHBOUR_FLAGS, WORKGROUP_NEIGHBOURS, WORKGROUP_RECORDS,
+    WORKGROUP_STATS,
 };
 use super::writer::cut;
 use super::{Inputs, Writer};
+use crate::check::EffectId;
 use mrsl_abi::geometry::{FINE_WORKGROUP, TILE, TILE_LANES};
 use mrsl_abi::plan::{BindingType, ResourceId};
 use mrsl_abi::{GROUP_STAGE, KernelKind, KernelRef, entry};
+use std::collections::BTreeSet;
 
 impl Writer<'_, '_, '_> {
     /// Whether this writer writes the tile kernel's coarse part (the
@@ -63,6 +67,13 @@ impl Writer<'_, '_, '_> {
             let ty = format!("array<u32, {}>", words * neighbour_slots);
             self.line(0, format!("var<workgroup> {WORKGROUP_NEIGHBOURS}: {ty};"));
         }
+        if crate::neighbours::tile_keeps_flags(self.i.layout) {
+            let flag_words = self.i.interface.flag_words * record_slots;
+            self.line(0, "// The refine flags of the neighbour values that refine, as the neighbour phase");
+            let at = format!("`w * {RECORD_SLOTS} + s`");
+            self.line(0, format!("// decided them at the records' samples: word w of record slot s at {at}."));
+            self.line(0, format!("var<workgroup> {WORKGROUP_NEIGHBOUR_FLAGS}: array<u32, {flag_words}>;"));
+        }
         if self.has_background() {
             let groups = (tile.side(self.block) / TILE).pow(2);
             self.line(
@@ -73,6 +84,9 @@ impl Writer<'_, '_, '_> {
             self.line(0, format!("var<workgroup> {SURFACE_TILES}: array<atomic<u32>, {groups}>;"));
         }
         self.template(0, tail, values);
+        if crate::neighbours::tile_keeps_flags(self.i.layout) {
+            self.template(0, include_str!("templates/tile_flags.wgsl"), &[]);
+        }
     }
 
     /// The tile kernel's stage group, declared binding by binding from the
@@ -129,16 +143,95 @@ impl Writer<'_, '_, '_> {
     }
 
     /// The coarse part's entry points, as functions of the sample they
-    /// evaluate: `mrsl_tile_neighbours` (nothing without neighbour values)
-    /// and `mrsl_tile_sample`.
+    /// evaluate: `mrsl_tile_neighbours<wave>` per wave (none without
+    /// neighbour values) and `mrsl_tile_sample`.
     pub(super) fn tile_phases(&mut self) {
         if self.stores_neighbours() {
-            let [head, tail] = cut(include_str!("templates/tile_neighbours.wgsl"), &["BODY"]);
-            self.template(0, head, &[]);
-            self.store_neighbour_values(1, POS);
-            self.template(0, tail, &[]);
+            for wave in 0..self.neighbour_waves() {
+                let [head, tail] = cut(include_str!("templates/tile_neighbours.wgsl"), &["BODY"]);
+                let values: &super::writer::Values = &[("WAVE", &wave), ("NAME", &names::tile_neighbours_wave(wave))];
+                self.template(0, head, values);
+                self.tile_neighbour_wave(wave);
+                self.template(0, tail, values);
+            }
         }
         self.coarse_main(include_str!("templates/tile_sample.wgsl"));
+    }
+
+    /// How many waves the tile kernel's neighbour phase takes ([`mrsl_abi::NeighbourValue::wave`]).
+    pub(super) fn neighbour_waves(&self) -> u32 {
+        self.i.layout.neighbours.effects.iter().map(|v| v.wave + 1).max().unwrap_or(0)
+    }
+
+    /// The body of wave `wave` of the neighbour phase at sample `mrsl_pos`:
+    /// the wave's neighbour values and what they read, in dependency order,
+    /// each evaluated once (an earlier wave's values read back), then
+    /// stored. One that refines is evaluated with its flag at the records'
+    /// samples, where the tile's samples read it back instead of
+    /// evaluating it again, and for its value alone elsewhere.
+    fn tile_neighbour_wave(&mut self, wave: u32) {
+        let c = self.checked();
+        let values = self.neighbour_values();
+        let waves: Vec<u32> = self.i.layout.neighbours.effects.iter().map(|v| v.wave).collect();
+        let wave_of = |e: EffectId| values.iter().position(|&(v, _)| v == e).map(|k| waves[k]);
+        let in_wave: Vec<(EffectId, u32)> =
+            values.iter().zip(&waves).filter(|&(_, &w)| w == wave).map(|(&v, _)| v).collect();
+        let needed: BTreeSet<EffectId> = in_wave.iter().flat_map(|&(e, _)| self.i.graph.closure(e, c)).collect();
+        if wave == 0 && crate::neighbours::tile_keeps_flags(self.i.layout) {
+            self.line(1, format!("if ({IS_RECORD}({POS})) {{"));
+            for w in 0..self.i.interface.flag_words {
+                self.line(2, format!("{} = 0u;", Self::neighbour_flag_word(w, &format!("{RECORD_SLOT}({POS})"))));
+            }
+            self.line(1, "}");
+        }
+        for x in self.i.graph.order.clone().into_iter().filter(|x| needed.contains(x)) {
+            let name = self.effect_name(x);
+            match (wave_of(x), self.i.interface.refine_bit[x.index()]) {
+                (Some(w), _) if w < wave => {
+                    self.line(1, format!("let {name} = {}({POS});", Name::At.of(&c.effects[x.index()].name)));
+                }
+                (Some(_), Some(k)) => self.flagged_neighbour_value(x, k),
+                _ => self.evaluate(x, 1, "let ", Evaluation::ValueOnly),
+            }
+        }
+        for (e, offset) in in_wave {
+            self.store_neighbour_words(1, POS, e, offset);
+        }
+    }
+
+    /// Neighbour value `e`, with refine bit `bit`, at sample `mrsl_pos` of
+    /// the neighbour phase: at a record's sample with its flag, which is
+    /// kept, elsewhere for its value alone.
+    fn flagged_neighbour_value(&mut self, e: EffectId, bit: u32) {
+        let info = &self.checked().effects[e.index()];
+        let (name, flag) = (self.effect_name(e), Name::RefineFlag.of(&info.name));
+        let (word, mask) = super::words::bit(bit);
+        self.line(1, format!("var {name}: {};", info.ty.wgsl()));
+        self.line(1, format!("if ({IS_RECORD}({POS})) {{"));
+        self.evaluate(e, 2, "", Evaluation::Kernel);
+        let kept = Self::neighbour_flag_word(word, &format!("{RECORD_SLOT}({POS})"));
+        self.line(2, format!("if ({flag}) {{ {kept} |= {mask}u; }}"));
+        self.line(1, "} else {");
+        self.evaluate(e, 2, "", Evaluation::ValueOnly);
+        self.line(1, "}");
+    }
+
+    /// Flag word `word` kept beside the neighbour values for record slot `slot` (WGSL).
+    pub(super) fn neighbour_flag_word(word: u32, slot: &str) -> String {
+        format!("{WORKGROUP_NEIGHBOUR_FLAGS}[{word}u * {RECORD_SLOTS} + {slot}]")
+    }
+
+    /// In the tile's sample phase, neighbour value `e` and its refine flag
+    /// (where it has one), read back from the neighbour phase.
+    pub(super) fn kept_neighbour_value(&mut self, e: EffectId) {
+        let info = &self.checked().effects[e.index()];
+        let name = self.effect_name(e);
+        self.line(1, format!("let {name} = {}({POS});", Name::At.of(&info.name)));
+        if let Some(k) = self.i.interface.refine_bit[e.index()] {
+            let (word, mask) = super::words::bit(k);
+            let flag = Name::RefineFlag.of(&info.name);
+            self.line(1, format!("let {flag} = ({} & {mask}u) != 0u;", Self::neighbour_flag_word(word, SLOT)));
+        }
     }
 
     /// The condition under which the coarse part counts a background sample.
@@ -185,12 +278,24 @@ impl Writer<'_, '_, '_> {
             ("GRID", &names::coarse_part_name(GRID)),
             ("NEIGHBOUR_SIDE", &tile.neighbour_side()),
             ("RECORD_SIDE", &tile.record_side()),
-            ("TILE_NEIGHBOURS", &names::coarse_part_name(TILE_NEIGHBOURS)),
             ("TILE_SAMPLE", &names::coarse_part_name(TILE_SAMPLE)),
         ];
         self.template(0, head, values);
         if self.i.layout.neighbours.words > 0 {
-            self.template(0, neighbours, values);
+            let waves = self.neighbour_waves();
+            if waves > 1 {
+                self.line(
+                    1,
+                    format!("// The neighbour values in {waves} waves, a barrier after each: a wave's refine"),
+                );
+                self.line(1, "// flags take differences of an earlier wave's values at the neighbouring samples.");
+            }
+            for wave in 0..waves {
+                let function = names::coarse_part_name(&names::tile_neighbours_wave(wave));
+                let mut values = values.to_vec();
+                values.push(("TILE_NEIGHBOURS", &function));
+                self.template(0, neighbours, &values);
+            }
         }
         self.template(0, samples, values);
         self.surface_tiles(side);

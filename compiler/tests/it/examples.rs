@@ -1,7 +1,8 @@
 //! Every program in the top-level `examples/` folder compiles without
 //! warnings to the full default kernel table, and its layout describes what
 //! its source declares: the channels, uniforms, textures, samplers, effects
-//! (with their rates) and outputs, by name and type, in declaration order.
+//! (with their rates) and outputs, by name and type, in declaration order;
+//! the block modes' tile kernel evaluates each coarse effect once per sample.
 //! The declarations are read from the source by a line scanner that shares
 //! nothing with the compiler's parser.
 
@@ -59,6 +60,10 @@ fn examples_compile_to_layouts_that_match_their_declarations() {
         let effects: Vec<(String, Rate, String)> =
             layout.effects.iter().map(|e| (e.name.clone(), e.rate, e.ty.to_string())).collect();
         assert_eq!(effects, declared.effects, "{name}: layout effects (name, rate, type) against their declarations");
+        // The block modes' tile kernel evaluates every coarse effect once per sample.
+        for e in layout.effects.iter().filter(|e| e.live && e.rate == Rate::Coarse) {
+            assert_eq!(e.sample_evaluations, Some(1), "{name}: `{}` evaluations per sample in the tile kernel", e.name);
+        }
     }
 }
 
