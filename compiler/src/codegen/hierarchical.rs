@@ -577,10 +577,13 @@ impl Writer<'_, '_, '_> {
 
     /// `mrsl_classify(p, n, level)`: per coarse effect, interpolate pixel `p`
     /// from its neighbours `n` or mark it to be shaded; queue it if any is.
+    /// Each effect's test is a function of its own (`mrsl_classify_<effect>`,
+    /// written first), which `mrsl_classify` calls in effect order.
     fn classify_function(&mut self) {
-        let c = self.checked();
-        let iface = self.i.interface;
-        let (fw, mw) = (self.i.layout.hierarchical.flag_words, self.i.layout.hierarchical.mask_words);
+        let mw = self.i.layout.hierarchical.mask_words;
+        let fw = self.i.layout.hierarchical.flag_words;
+        self.template(0, include_str!("templates/classify_effects.wgsl"), &[]);
+        let calls: Vec<String> = self.coarse_live().into_iter().map(|e| self.classify_effect(e)).collect();
         let [head, keys, effects, end] =
             cut(include_str!("templates/classify.wgsl"), &["BACKGROUND", "KEYS", "EFFECTS"]);
         self.template(0, head, &[]);
@@ -602,44 +605,73 @@ impl Writer<'_, '_, '_> {
             self.line(1, format!("let {NEIGHBOUR_RECORDS} = {records};"));
         }
         self.neighbour_flag_words();
-        let from = if self.packed() { NEIGHBOUR_RECORDS } else { "q" };
-        let [head_effect, tests_effect, tail_effect] =
-            cut(include_str!("templates/classify_effect.wgsl"), &["TESTS", "PUT"]);
-        for e in self.coarse_live() {
-            let info = &c.effects[e.index()];
-            let (word, mask) = bit(self.coarse_index[&e]);
-            let on_side: String = self.i.graph.keys[e.index()]
-                .iter()
-                .map(|i| format!(" && !across_{}[k]", c.inputs[i.index()].name))
-                .collect();
-            self.template(0, head_effect, &[("NAME", &info.name), ("ON_SIDE", &on_side), ("FROM", &from)]);
-            // `disc` first: the ablation's edits find the test by it.
-            let mut need = vec!["disc".to_string()];
-            if let Some(b) = iface.refine_bit[e.index()] {
-                // The program's own predicate, as evaluated at the neighbours.
-                let (word, mask) = bit(b);
-                self.template(0, include_str!("templates/classify_flagged.wgsl"), &[("WORD", &word), ("MASK", &mask)]);
-                need.push("flagged".into());
-            }
-            let value = self.value_test(&info.ty, &mut need);
-            let values: &super::writer::Values = &[
-                ("NEED", &need.join(" || ")),
-                ("WORD", &word),
-                ("MASK", &mask),
-                ("NAME", &info.name),
-                ("VALUE", &value),
-            ];
-            self.template(0, tests_effect, values);
-            if !self.packed() {
-                self.line(3, format!("{}(p, {value});", Name::RecordPut.of(&info.name)));
-            }
-            self.template(0, tail_effect, values);
+        for call in &calls {
+            self.line(1, call);
         }
         let flags = vec!["0u".to_string(); fw as usize];
         let masks: Vec<String> = (0..mw).map(|w| format!("mask{w}")).collect();
         self.store_record("p", &flags, &masks);
         let any: Vec<String> = (0..mw).map(|w| format!("mask{w}")).collect();
         self.template(0, end, &[("ANY_MASK", &any.join(" | ")), ("QUEUE_WORDS", &QUEUE_WORDS_PER_LEVEL)]);
+    }
+
+    /// Writes `mrsl_classify_<effect>` for coarse effect `e` and returns the
+    /// line of `mrsl_classify` that calls it. Its parameters are what the
+    /// test reads of `mrsl_classify`'s locals: the pixel, the neighbours (or
+    /// their packed records), which are inside the image and across each key
+    /// the effect reads, whether refinement is forced, the neighbours' flag
+    /// word holding its refine bit, and the mask word its bit is set in.
+    fn classify_effect(&mut self, e: EffectId) -> String {
+        let c = self.checked();
+        let info = &c.effects[e.index()];
+        let (word, mask) = bit(self.coarse_index[&e]);
+        let from = if self.packed() { NEIGHBOUR_RECORDS } else { "q" };
+        let from_type = if self.packed() { RECORD_TYPE } else { "vec2<i32>" };
+        let mut params = vec![("p", "vec2<i32>".to_string()), (from, format!("array<{from_type}, 4>"))];
+        params.push(("inside", "array<bool, 4>".into()));
+        let mut args: Vec<String> = params.iter().map(|(name, _)| name.to_string()).collect();
+        let keys: Vec<String> =
+            self.i.graph.keys[e.index()].iter().map(|i| format!("across_{}", c.inputs[i.index()].name)).collect();
+        let on_side: String = keys.iter().map(|across| format!(" && !{across}[k]")).collect();
+        let flag = self.i.interface.refine_bit[e.index()].map(bit);
+        let flags = flag.map(|(w, _)| Name::NeighbourFlags.of(w));
+        let mask_word = format!("mask{word}");
+        let mut typed: Vec<String> = params.iter().map(|(name, ty)| format!("{name}: {ty}")).collect();
+        for across in &keys {
+            typed.push(format!("{across}: array<bool, 4>"));
+            args.push(across.clone());
+        }
+        typed.push("force: bool".into());
+        args.push("force".into());
+        if let Some(flags) = &flags {
+            typed.push(format!("{flags}: array<u32, 4>"));
+            args.push(flags.clone());
+        }
+        typed.push(format!("{mask_word}: ptr<function, u32>"));
+        args.push(format!("&{mask_word}"));
+        let [head_effect, tests_effect, tail_effect] =
+            cut(include_str!("templates/classify_effect.wgsl"), &["TESTS", "PUT"]);
+        let params = typed.join(", ");
+        let head: &super::writer::Values =
+            &[("NAME", &info.name), ("ON_SIDE", &on_side), ("FROM", &from), ("PARAMS", &params), ("WORD", &word)];
+        self.template(0, head_effect, head);
+        // `disc` first: the ablation's edits find the test by it.
+        let mut need = vec!["disc".to_string()];
+        if let Some((word, mask)) = flag {
+            // The program's own predicate, as evaluated at the neighbours.
+            self.template(0, include_str!("templates/classify_flagged.wgsl"), &[("WORD", &word), ("MASK", &mask)]);
+            need.push("flagged".into());
+        }
+        let value = self.value_test(&info.ty, &mut need);
+        let values: &super::writer::Values =
+            &[("NEED", &need.join(" || ")), ("WORD", &word), ("MASK", &mask), ("NAME", &info.name), ("VALUE", &value)];
+        self.template(0, tests_effect, values);
+        if !self.packed() {
+            self.line(2, format!("{}(p, {value});", Name::RecordPut.of(&info.name)));
+        }
+        self.template(0, tail_effect, values);
+        self.line(0, "");
+        format!("{}({});", Name::Classify.of(&info.name), args.join(", "))
     }
 
     /// The classification's test of an effect of type `ty` beyond `disc`
@@ -650,14 +682,14 @@ impl Writer<'_, '_, '_> {
         if interpolable {
             let zero = format!("{}(0.0)", ty.wgsl());
             let w = |j: usize| format!("select({zero}, v{j}, ok[{j}])");
-            self.line(2, format!("let mean = ({} + {} + {} + {}) / total;", w(0), w(1), w(2), w(3)));
+            self.line(1, format!("let mean = ({} + {} + {} + {}) / total;", w(0), w(1), w(2), w(3)));
             let dev = |j: usize| format!("select({zero}, (v{j} - mean) * (v{j} - mean), ok[{j}])");
-            self.line(2, format!("let variance = ({} + {} + {} + {}) / total;", dev(0), dev(1), dev(2), dev(3)));
+            self.line(1, format!("let variance = ({} + {} + {} + {}) / total;", dev(0), dev(1), dev(2), dev(3)));
             // The variance relative to the values' size (the largest
             // square among the neighbours), so one similarity holds for
             // a distance of hundreds of units and a colour of 0.01.
             let sq = |j: usize| format!("select({zero}, v{j} * v{j}, ok[{j}])");
-            self.line(2, format!("let scale = max(max({}, {}), max({}, {}));", sq(0), sq(1), sq(2), sq(3)));
+            self.line(1, format!("let scale = max(max({}, {}), max({}, {}));", sq(0), sq(1), sq(2), sq(3)));
             let spread = |v: &str| match ty.components() {
                 1 => v.to_string(),
                 2 => format!("max({v}.x, {v}.y)"),
@@ -676,7 +708,7 @@ impl Writer<'_, '_, '_> {
                 need.push("true".into());
                 "v0"
             } else {
-                self.line(2, "let first = select(v2, v0, ok[0]);");
+                self.line(1, "let first = select(v2, v0, ok[0]);");
                 let eq = |j: usize| {
                     if ty.components() == 1 {
                         format!("(!ok[{j}] || v{j} == first)")

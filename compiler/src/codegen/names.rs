@@ -108,12 +108,14 @@ pub(super) enum Name {
     SurfaceEdge,
     /// `mrsl_apart_<effect>`: whether two positions lie across one of an effect's keys.
     Apart,
+    /// `mrsl_classify_<effect>`: the hierarchical classification of one coarse effect.
+    Classify,
 }
 
 impl Name {
     /// Every family, for the tests that check names against this module.
     #[cfg_attr(not(test), expect(dead_code, reason = "read by the tests"))]
-    pub(super) const ALL: [Name; 40] = [
+    pub(super) const ALL: [Name; 41] = [
         Name::Eval,
         Name::Val,
         Name::At,
@@ -154,6 +156,7 @@ impl Name {
         Name::SurfaceKey,
         Name::SurfaceEdge,
         Name::Apart,
+        Name::Classify,
     ];
 
     /// What every member's name starts with.
@@ -199,6 +202,7 @@ impl Name {
             Name::SurfaceKey => "mrsl_surface_key_",
             Name::SurfaceEdge => "mrsl_surface_edge_",
             Name::Apart => "mrsl_apart_",
+            Name::Classify => "mrsl_classify_",
         }
     }
 

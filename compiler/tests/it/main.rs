@@ -10,6 +10,7 @@ mod interface;
 #[path = "../../fuzz/fuzz_targets/kernels.rs"]
 mod kernels;
 mod limits;
+mod scaling;
 mod wellformed;
 
 use mrsl::KernelKind;
