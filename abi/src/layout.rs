@@ -630,7 +630,9 @@ pub struct EffectLayout {
     /// every derivative at a sample reads the neighbour values (a neighbour
     /// value that refines keeps its flag beside its value, [`NeighbourValue::wave`]);
     /// more for an effect that is not a neighbour value but is read by one
-    /// (evaluated for it, then again at the sample), or where derivatives
+    /// (evaluated for it, then again at the sample), for each position of a
+    /// derivative whose operand is taken by running the body's statements
+    /// before it there (a local built by a loop), or where derivatives
     /// evaluate effects at the neighbouring samples in place
     /// (`neighbours.words` 0). The tile kernel evaluates each of the samples
     /// its workgroup holds ([`TileLayout`]) this often.

@@ -437,12 +437,19 @@ impl Counter<'_, '_> {
         cost
     }
 
-    /// One evaluation of derivative site `k`'s operand at a neighbour.
+    /// One evaluation of derivative site `k`'s operand at a neighbour: for
+    /// a site with a prefix, the body's statements before it (`mrsl_prefix<k>`)
+    /// and the effects they read there, then the operand.
     fn site(&mut self, k: usize) -> u64 {
-        let deriv = self.deriv;
+        let (deriv, checked) = (self.deriv, self.checked);
         self.memo(Key::Site(k), |c| {
             let site = &deriv.sites[k];
-            c.expr(site.operand, At::Neighbour(&site.params))
+            let Some(statement) = site.prefix else {
+                return c.expr(site.operand, At::Neighbour(&site.params));
+            };
+            let EffectBody::Block(b) = &checked.effect_decl(site.effect).body else { return 0 };
+            let effects = site.effects.iter().fold(0u64, |sum, &d| sum.saturating_add(c.at(d)));
+            c.stmts(&b.stmts[..statement], None).saturating_add(effects).saturating_add(c.expr(site.operand, At::Body))
         })
     }
 

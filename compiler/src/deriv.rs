@@ -46,6 +46,12 @@ pub struct DerivSite<'a> {
     /// refine flag ([`DerivInfo::value_skips`]): an evaluation for the value
     /// alone never runs it.
     pub decides_only: bool,
+    /// For an operand that reads a local built by a loop, a branch or
+    /// several assignments: the index of the top-level statement holding
+    /// the call. At a neighbour the operand is the body's statements before
+    /// it, run there, then the operand ([`liftable`]); `params` is then
+    /// empty and `effects` holds what those statements read.
+    pub prefix: Option<usize>,
 }
 
 /// Per-program derivative information.
@@ -119,10 +125,29 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
                 path: vec![],
                 walked: HashSet::new(),
                 reported: HashSet::new(),
+                touched: BTreeSet::new(),
+                unstable: vec![],
+                other_errors: false,
                 diagnostics: &mut diagnostics,
             };
             walk.expr(operand);
-            let (params, effects) = (walk.params, walk.effects);
+            let unstable = std::mem::take(&mut walk.unstable);
+            let lift = !unstable.is_empty()
+                && !walk.other_errors
+                && liftable(checked, &body, statement, &walk.touched, &effect.body);
+            let (mut params, mut effects) = (walk.params, walk.effects);
+            let prefix = if lift {
+                // The statements before the call are run at the neighbour: they
+                // need no parameters, and the effects they read.
+                params.clear();
+                for s in &body[..statement] {
+                    visit_stmt_exprs(s, &mut |e| effects.extend(effects_read(e, checked)));
+                }
+                Some(statement)
+            } else {
+                diagnostics.extend(unstable);
+                None
+            };
             info.effects_at_neighbours.extend(effects.iter().copied());
             info.site_of.insert(call.id, info.sites.len());
             info.sites.push(DerivSite {
@@ -134,6 +159,7 @@ pub fn analyse<'a>(checked: &Checked<'a>) -> (DerivInfo<'a>, Vec<Diagnostic>) {
                 call: call.span,
                 builtin: *builtin,
                 decides_only: false,
+                prefix,
             });
         }
     }
@@ -217,6 +243,71 @@ pub fn plain_surface_derivatives(
                 ),
         );
     }
+    out
+}
+
+/// Whether a derivative at top-level statement `statement` of a block body,
+/// whose operand reads the locals `touched`, can take its operand at the
+/// neighbouring sample by running the statements before it there: they
+/// hold no `return` (which would end the body with its value) and no
+/// derivative (which would differentiate at a neighbour of the neighbour),
+/// and the statement itself declares and assigns none of `touched`, so the
+/// operand reads at the call what it reads after them. Their `refine`s are
+/// left out there: a neighbour evaluation discards the flag.
+fn liftable(
+    checked: &Checked,
+    body: &[&Stmt],
+    statement: usize,
+    touched: &BTreeSet<LocalId>,
+    effect_body: &EffectBody,
+) -> bool {
+    if !matches!(effect_body, EffectBody::Block(_)) {
+        return false;
+    }
+    let mut derivatives = false;
+    for s in &body[..statement] {
+        visit_stmt_exprs(s, &mut |e| collect_derivative_calls(e, checked, &mut |_| derivatives = true));
+    }
+    !derivatives && !body[..statement].iter().any(|s| returns(s)) && !touches(body[statement], checked, touched)
+}
+
+/// Whether `s` holds a `return`.
+fn returns(s: &Stmt) -> bool {
+    match &s.kind {
+        StmtKind::Return(_) => true,
+        StmtKind::If { then, otherwise, .. } => returns(then) || otherwise.as_deref().is_some_and(returns),
+        StmtKind::For { body, .. } => returns(body),
+        StmtKind::Block(b) => b.stmts.iter().any(returns),
+        _ => false,
+    }
+}
+
+/// Whether `s` declares or assigns one of `locals`, at any depth.
+fn touches(s: &Stmt, checked: &Checked, locals: &BTreeSet<LocalId>) -> bool {
+    let hit = |l: Option<LocalId>| l.is_some_and(|l| locals.contains(&l));
+    match &s.kind {
+        StmtKind::Local { .. } => hit(checked.local_decls.get(&s.id).copied()),
+        StmtKind::Assign { target, .. } | StmtKind::Step { target, .. } => hit(root_local(target, checked)),
+        StmtKind::If { then, otherwise, .. } => {
+            touches(then, checked, locals) || otherwise.as_deref().is_some_and(|o| touches(o, checked, locals))
+        }
+        StmtKind::For { init, step, body, .. } => [init.as_deref(), step.as_deref(), Some(body.as_ref())]
+            .into_iter()
+            .flatten()
+            .any(|sub| touches(sub, checked, locals)),
+        StmtKind::Block(b) => b.stmts.iter().any(|sub| touches(sub, checked, locals)),
+        _ => false,
+    }
+}
+
+/// The effects expression `e` reads.
+fn effects_read(e: &Expr, checked: &Checked) -> Vec<EffectId> {
+    let mut out = vec![];
+    visit_expr(e, &mut |x| {
+        if let (ExprKind::Name(_), Some(Symbol::Effect(id))) = (&x.kind, checked.symbols.get(&x.id)) {
+            out.push(*id);
+        }
+    });
     out
 }
 
@@ -515,6 +606,14 @@ struct OperandWalk<'w, 'a> {
     /// Single-definition locals whose definition has been walked.
     walked: HashSet<LocalId>,
     reported: HashSet<LocalId>,
+    /// Every local the operand reads, directly or through definitions.
+    touched: BTreeSet<LocalId>,
+    /// E0503 for the locals that cannot be rebuilt at the neighbour by
+    /// inlining (built by a loop, a branch or several assignments): reported
+    /// unless the body's statements before the call can be run there instead.
+    unstable: Vec<Diagnostic>,
+    /// Whether an error other than those was reported.
+    other_errors: bool,
     diagnostics: &'w mut Vec<Diagnostic>,
 }
 
@@ -571,6 +670,7 @@ impl<'a> OperandWalk<'_, 'a> {
     /// must be walked next.
     fn local(&mut self, local: LocalId, span: Span, name: &str, through: Option<LocalId>) -> Option<&'a Expr> {
         let facts = self.facts;
+        self.touched.insert(local);
         // Where the read happens: at the derivative, or where the definition
         // that reads the local stands (it is inlined, but reads the values
         // of that point of the body).
@@ -619,8 +719,21 @@ impl<'a> OperandWalk<'_, 'a> {
         if !self.reported.insert(local) {
             return;
         }
+        let before = self.diagnostics.len();
+        self.report(local, span, name, why);
+        if why == Why::Unstable {
+            self.unstable.extend(self.diagnostics.drain(before..));
+        } else {
+            self.other_errors = true;
+        }
+    }
+
+    fn report(&mut self, local: LocalId, span: Span, name: &str, why: Why) {
         const NOTE: &str = "a derivative re-evaluates its operand at the neighbouring sample: differentiate locals \
-                            that are assigned exactly once, where they are declared, or the expression they are built from";
+                            that are assigned exactly once, where they are declared, or the expression they are built \
+                            from; a local built by a loop, a branch or several assignments can be differentiated in a \
+                            later top-level statement that does not assign it, with no derivative or `return` before \
+                            that statement (they run again at the neighbouring sample)";
         let decl = self.checked.locals[local.index()].span;
         let unstable = format!(
             "`{name}` is assigned more than once or inside a branch or loop, so it cannot be recomputed at the neighbouring sample"
@@ -844,7 +957,7 @@ fn collect_skipped(s: &Stmt, checked: &Checked, needed: &HashSet<LocalId>, skipp
 }
 
 /// Why a local in a derivative operand cannot be recomputed at a neighbour.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, PartialEq, Eq)]
 enum Why {
     /// Invariant, but assigned again: an inlined definition may have read another value.
     Stale,

@@ -115,9 +115,10 @@ pub fn sample_evaluations(
     let stored: BTreeSet<EffectId> = waves.iter().map(|&(e, _)| e).collect();
     let mut tile = vec![0u32; n];
     let mut two_pass = vec![0u32; n];
+    let once = |e: EffectId, value_only: bool| 1 + prefix_runs(deriv, e, value_only);
     // The two-pass kernel's neighbour pass evaluates the values and what they read, each once.
     for e in stored.iter().flat_map(|&e| graph.closure(e, checked)).collect::<BTreeSet<_>>() {
-        two_pass[e.index()] += 1;
+        two_pass[e.index()] += once(e, true);
     }
     // Each of the tile's waves evaluates its values and what they read,
     // except the values of earlier waves, which it reads back.
@@ -126,7 +127,9 @@ pub fn sample_evaluations(
         let needed: BTreeSet<EffectId> = in_wave.flat_map(|e| graph.closure(e, checked)).collect();
         for x in needed {
             if !waves.iter().any(|&(s, w)| s == x && w < wave) {
-                tile[x.index()] += 1;
+                // A value that refines runs whole, with its flag, at the tile's samples.
+                let with_flag = waves.contains(&(x, wave)) && checked.effects[x.index()].has_refine;
+                tile[x.index()] += once(x, !with_flag);
             }
         }
     }
@@ -135,18 +138,40 @@ pub fn sample_evaluations(
         let info = &checked.effects[e.index()];
         // The two-pass kernel reads a stored value back unless its flag is needed.
         if !stored.contains(&e) || info.has_refine {
-            two_pass[e.index()] += 1;
+            two_pass[e.index()] += once(e, false);
             at_neighbours(checked, graph, deriv, e, false, 1, in_place, &mut two_pass);
         }
         // The tile kernel reads a stored value and its flag back.
         if !stored.contains(&e) {
-            tile[e.index()] += 1;
+            tile[e.index()] += once(e, false);
             at_neighbours(checked, graph, deriv, e, false, 1, in_place, &mut tile);
         }
     }
     (0..n)
         .map(|i| coarse(EffectId(i as u32)).then_some(SampleEvaluations { tile: tile[i], coarse_kernel: two_pass[i] }))
         .collect()
+}
+
+/// The partial evaluations of `e`'s body that one evaluation of it makes at
+/// neighbouring samples: per derivative site with a prefix
+/// ([`crate::deriv::DerivSite::prefix`]), one per position of its difference
+/// (`ddx`, `ddy`: one; `fwidth`, `sample`: two). With `value_only`, only
+/// the sites a value needs.
+fn prefix_runs(deriv: &DerivInfo, e: EffectId, value_only: bool) -> u32 {
+    deriv
+        .sites
+        .iter()
+        .filter(|s| s.effect == e && s.prefix.is_some() && !(value_only && s.decides_only))
+        .map(|s| positions(s.builtin))
+        .sum()
+}
+
+/// The positions a derivative evaluates its operand at, besides its own.
+fn positions(builtin: crate::builtins::Builtin) -> u32 {
+    match builtin.plain_derivative() {
+        crate::builtins::Builtin::Ddx | crate::builtins::Builtin::Ddy => 1,
+        _ => 2,
+    }
 }
 
 /// Adds the evaluations the derivatives in `e`'s body make at neighbouring
@@ -169,13 +194,10 @@ fn at_neighbours(
         return;
     }
     for site in deriv.sites.iter().filter(|s| s.effect == e && !(value_only && s.decides_only)) {
-        let positions = match site.builtin.plain_derivative() {
-            crate::builtins::Builtin::Ddx | crate::builtins::Builtin::Ddy => 1,
-            _ => 2,
-        };
+        let positions = positions(site.builtin);
         for &read in &site.effects {
             for x in graph.closure(read, checked) {
-                count[x.index()] += times * positions;
+                count[x.index()] += times * positions * (1 + prefix_runs(deriv, x, true));
                 at_neighbours(checked, graph, deriv, x, true, times * positions, in_place, count);
             }
         }

@@ -15,6 +15,7 @@ mod engine_formats;
 mod errors;
 mod frames;
 mod generated;
+mod lifted_derivatives;
 mod modes;
 mod packed_records;
 mod rate_image;
@@ -104,6 +105,14 @@ const GPU_TESTS: &[GpuTest] = &[
         modes::gradient_is_reconstructed_at_one_sixteenth_of_the_cost,
     ),
     ("modes::derivative_chains_render_in_every_mode", modes::derivative_chains_render_in_every_mode),
+    (
+        "lifted_derivatives::loop_built_derivatives_force_to_the_reference",
+        lifted_derivatives::loop_built_derivatives_force_to_the_reference,
+    ),
+    (
+        "lifted_derivatives::loop_built_predicates_refine_as_an_effect_of_their_own",
+        lifted_derivatives::loop_built_predicates_refine_as_an_effect_of_their_own,
+    ),
     ("modes::steps_keep_their_edges", modes::steps_keep_their_edges),
     ("modes::surface_derivatives_do_not_refine_at_keys", modes::surface_derivatives_do_not_refine_at_keys),
     (

@@ -762,7 +762,10 @@ impl<'b> Writer<'_, '_, 'b> {
             let args: String = site.params.iter().map(|p| format!(", {}", local_name(c, *p))).collect();
             let text = &self.i.source[site.operand.span.range()];
             let text: String = text.split_whitespace().collect::<Vec<_>>().join(" ");
-            let operand = self.expr(site.operand, Mode::Neighbour(site));
+            if site.prefix.is_some() {
+                self.prefix_function(k, &ty);
+            }
+            let operand = self.operand_at_neighbour(k, Mode::Neighbour(site));
             let values: &super::writer::Values = &[
                 ("SITE", &k),
                 ("EFFECT", &c.effects[site.effect.index()].name),
@@ -775,7 +778,7 @@ impl<'b> Writer<'_, '_, 'b> {
             let [operand_helper, ddx_head, ddx_rest, ddy_rest] =
                 cut(include_str!("templates/derivative.wgsl"), &["DIFFERENCES", "LEVELS_X", "LEVELS_Y"]);
             let level_differences = |w: &mut Self| {
-                let stored = w.expr(site.operand, Mode::Stored(site));
+                let stored = w.operand_at_neighbour(k, Mode::Stored(site));
                 let extra: &super::writer::Values = &[("STORED", &stored)];
                 w.template(0, include_str!("templates/derivative_levels.wgsl"), &[values, extra].concat());
             };
@@ -817,6 +820,73 @@ impl<'b> Writer<'_, '_, 'b> {
                 self.template(0, include_str!("templates/derivative_both.wgsl"), values);
             }
         }
+    }
+
+    /// Derivative site `k`'s operand at another position `mrsl_pos` (WGSL),
+    /// rebuilt as `mode` says: inlined, or for a site with a prefix
+    /// ([`crate::deriv::DerivSite::prefix`]) its prefix function run there,
+    /// given the effects it reads there.
+    fn operand_at_neighbour(&self, k: usize, mode: Mode) -> String {
+        let site = &self.i.deriv.sites[k];
+        if site.prefix.is_none() {
+            return self.expr(site.operand, mode);
+        }
+        let c = self.checked();
+        let read = match mode {
+            Mode::Stored(_) => Name::Stored,
+            _ => Name::At,
+        };
+        let args: String =
+            site.effects.iter().map(|e| format!(", {}({POS})", read.of(&c.effects[e.index()].name))).collect();
+        format!("{}({POS}{args})", Name::Prefix.of(k))
+    }
+
+    /// `mrsl_prefix<k>`: the statements of the effect's body before
+    /// derivative site `k` (its `refine`s left out) at position `mrsl_pos`,
+    /// given the effects they read there, and the site's operand after them.
+    fn prefix_function(&mut self, k: usize, ty: &crate::types::Type) {
+        let c = self.checked();
+        let site = &self.i.deriv.sites[k];
+        let statement = site.prefix.expect("a site with a prefix");
+        let info = &c.effects[site.effect.index()];
+        let EffectBody::Block(b) = &c.effect_decl(site.effect).body else {
+            unreachable!("prefixes are of block bodies")
+        };
+        let prefix = &b.stmts[..statement];
+        let mut params = vec![format!("{POS}: vec2<i32>")];
+        params.extend(
+            site.effects.iter().map(|e| format!("{}: {}", self.effect_name(*e), c.effects[e.index()].ty.wgsl())),
+        );
+        let line = self.line_of(b.stmts[statement].span);
+        self.line(
+            0,
+            format!("// `{}`'s body before line {line}, at another position, for derivative #{k}.", info.name),
+        );
+        self.line(0, format!("fn {}({}) -> {} {{", Name::Prefix.of(k), params.join(", "), ty.wgsl()));
+        let mut inputs = BTreeSet::new();
+        let mut refines = HashSet::new();
+        let mut visit = |e: &Expr| {
+            visit_expr(e, &mut |x| {
+                if let Some(Symbol::Input(i)) = c.symbols.get(&x.id) {
+                    inputs.insert(i.index());
+                }
+            })
+        };
+        prefix.iter().for_each(|s| visit_stmt_exprs(s, &mut visit));
+        visit(site.operand);
+        prefix.iter().for_each(|s| refine_statements(s, &mut refines));
+        for i in inputs {
+            let name = &c.inputs[i].name;
+            self.line(1, format!("let {} = {}({POS});", wgsl_ident(name), Name::Load.of(name)));
+        }
+        let result = info.result.expect("block effects have a result local");
+        self.line(1, format!("var {}: {};", local_name(c, result), info.ty.wgsl()));
+        for s in prefix {
+            self.stmt(s, 1, Some(&refines));
+        }
+        self.line(1, format!("return {};", self.expr(site.operand, Mode::Body)));
+        self.line(0, "}");
+        self.line(0, "");
     }
 
     /// Whether derivative site `k`'s helpers take the operand's value at
@@ -1010,6 +1080,24 @@ impl<'b> Writer<'_, '_, 'b> {
             let (flag, word) = (Name::RefineFlag.of(name), Name::FlagWord.of(word));
             self.line(indent, format!("if ({flag} || {FORCE}) {{ {word} |= {mask}u; }}"));
         }
+    }
+}
+
+/// The `refine;` statements in `s`, at any depth.
+fn refine_statements(s: &Stmt, out: &mut HashSet<NodeId>) {
+    match &s.kind {
+        StmtKind::Refine => {
+            out.insert(s.id);
+        }
+        StmtKind::If { then, otherwise, .. } => {
+            refine_statements(then, out);
+            if let Some(o) = otherwise {
+                refine_statements(o, out);
+            }
+        }
+        StmtKind::For { body, .. } => refine_statements(body, out),
+        StmtKind::Block(b) => b.stmts.iter().for_each(|sub| refine_statements(sub, out)),
+        _ => {}
     }
 }
 

@@ -26,6 +26,9 @@ use std::fmt::Display;
 pub(super) enum Name {
     /// `mrsl_eval_<effect>`: an effect's function, shared by every kernel.
     Eval,
+    /// `mrsl_prefix<k>`: the statements of an effect's body before derivative
+    /// site `k`, run at a position, then the site's operand there.
+    Prefix,
     /// `mrsl_val_<effect>`: an effect's value alone, without what only decides its refine flag.
     Val,
     /// `mrsl_at_<effect>`: an effect's value at another position (derivatives).
@@ -115,7 +118,7 @@ pub(super) enum Name {
 impl Name {
     /// Every family, for the tests that check names against this module.
     #[cfg_attr(not(test), expect(dead_code, reason = "read by the tests"))]
-    pub(super) const ALL: [Name; 41] = [
+    pub(super) const ALL: [Name; 42] = [
         Name::Eval,
         Name::Val,
         Name::At,
@@ -157,6 +160,7 @@ impl Name {
         Name::SurfaceEdge,
         Name::Apart,
         Name::Classify,
+        Name::Prefix,
     ];
 
     /// What every member's name starts with.
@@ -203,6 +207,7 @@ impl Name {
             Name::SurfaceEdge => "mrsl_surface_edge_",
             Name::Apart => "mrsl_apart_",
             Name::Classify => "mrsl_classify_",
+            Name::Prefix => "mrsl_prefix",
         }
     }
 
