@@ -74,9 +74,12 @@ pub fn open(args: &RenderArgs) -> Result<Session> {
     }
     let stem = args.program.as_ref().and_then(|p| p.file_stem()).and_then(|s| s.to_str()).unwrap_or("demo").to_string();
     let start = Instant::now();
-    // The kernels of the modes that run: those asked for, and the reference to compare with.
+    // The kernels of the modes that run: those asked for, and the reference to
+    // compare with and to settle the rate-image mode's rates from (its first
+    // frame, `rates::settle`) unless one rate is given everywhere.
     let mut modes = args.modes.clone();
-    if args.compare && !modes.contains(&Mode::Reference) {
+    let settles_rates = modes.contains(&Mode::RateImage) && args.uniform_rate.is_none();
+    if (args.compare || settles_rates) && !modes.contains(&Mode::Reference) {
         modes.push(Mode::Reference);
     }
     if args.program.is_none() {

@@ -28,11 +28,30 @@ const TESTS: &[(&str, fn())] = &[
         gbuffer_exports_the_rig_and_the_shadow_map_of_a_mesh_scene,
     ),
     ("render_raw_writes_the_texels_the_png_was_made_from", render_raw_writes_the_texels_the_png_was_made_from),
+    ("every_mode_renders_alone", every_mode_renders_alone),
     (
         "gbuffer_exports_a_scene_files_images_with_every_mip_level",
         gbuffer_exports_a_scene_files_images_with_every_mip_level,
     ),
 ];
+
+/// Each mode renders asked for alone (the rate-image mode's rates settle
+/// from a first frame of the reference, whose kernel it compiles too): the
+/// built-in demo, each mode's image and statistics written.
+fn every_mode_renders_alone() {
+    let dir = scratch("alone");
+    let out = dir.to_str().unwrap();
+    for mode in mrsl_abi::Mode::ALL {
+        let name = mode.to_string();
+        let run = mrslc(&["render", "--mode", &name, "--size", "24x16", "--out", out]);
+        assert!(run.status.success(), "{name} alone:\n{}", stderr(&run));
+        assert!(dir.join(format!("demo.{name}.png")).is_file(), "{name}'s image");
+        let runs = read_json(&dir.join("demo.stats.json"));
+        let modes: Vec<&str> = runs.as_array().unwrap().iter().map(|r| r["mode"].as_str().unwrap()).collect();
+        assert_eq!(modes, [name.as_str()], "the statistics of the mode asked for, alone");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
 
 fn main() {
     let args = Arguments::from_args();

@@ -401,18 +401,18 @@ fn kernel_resources(layout: &Layout, kernel: KernelRef) -> Vec<PassBinding> {
         KernelKind::MultiCoarse => {
             let mut coarse = vec![at(interface, R::LevelRecords { block }, T::RecordStorageTexture)];
             if block == DYNAMIC_INNER_BLOCK {
-                coarse.extend(level_values(layout));
+                coarse.extend(level_values(layout, false));
             }
             coarse
         }
         KernelKind::MultiResolve => {
             let mut resolve = vec![at(interface, R::LevelRecords { block }, T::RecordTexture)];
-            resolve.extend(level_values(layout));
+            resolve.extend(level_values(layout, true));
             resolve
         }
         KernelKind::MultiFine => {
             let mut fine = vec![at(interface, R::LevelRecords { block }, T::RecordTexture)];
-            fine.extend(level_values(layout));
+            fine.extend(level_values(layout, true));
             fine
         }
     }
@@ -474,11 +474,25 @@ fn has_outer_effects(layout: &Layout) -> bool {
     layout.stats.counters.iter().any(|name| block_of(name) == Some(DYNAMIC_OUTER_BLOCK))
 }
 
-/// The multi-rate mode's stored values, where the program stores any.
-fn level_values(layout: &Layout) -> Option<PassBinding> {
+/// The multi-rate mode's stored values, where the kernel reads any: the
+/// values (`with_mask` false: the 2x2 level's coarse pass), or the values
+/// and the resolve pass's refine-mask word ([`level_values_layers`]).
+fn level_values(layout: &Layout, with_mask: bool) -> Option<PassBinding> {
     let values = &layout.levels.as_ref()?.values;
     let ty = BindingType::WordTexture;
-    (values.words > 0).then_some(PassBinding { binding: values.binding, resource: ResourceId::LevelValues, ty })
+    let layers = if with_mask { level_values_layers(layout) } else { values.words };
+    (layers > 0).then_some(PassBinding { binding: values.binding, resource: ResourceId::LevelValues, ty })
+}
+
+/// The layers of the multi-rate mode's stored values: a layer per word of
+/// the values (layout `levels.values`), then, where the 4x4 level has live
+/// coarse effects, the refine-mask word the resolve pass wrote for them at
+/// the pixel, which the fine pass's refine mask takes their bits from (the
+/// fine pass reads their values as stored; the mask must say where the
+/// resolve pass evaluated them).
+pub fn level_values_layers(layout: &Layout) -> u32 {
+    let words = layout.levels.as_ref().map_or(0, |l| l.values.words);
+    words + u32::from(has_outer_effects(layout))
 }
 
 /// The descriptor of a runtime-owned resource.
@@ -551,7 +565,7 @@ fn resource(layout: &Layout, id: ResourceId) -> ResourceDesc {
             ("a multi-rate level's records", Shape::TextureArray { texels, layers: level.layers(), format })
         }
         R::LevelValues => {
-            let layers = layout.levels.as_ref().map_or(1, |l| l.values.words.max(1));
+            let layers = level_values_layers(layout).max(1);
             let (texels, format) = (Extent::Pixels, TextureFormat::R32Uint);
             ("the multi-rate mode's stored values", Shape::TextureArray { texels, layers, format })
         }

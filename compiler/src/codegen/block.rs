@@ -85,16 +85,35 @@ impl Writer<'_, '_, '_> {
     /// `InterfaceLayout` gives: llvmpipe loads a buffer word lane by lane.
     fn level_values_binding(&mut self) {
         let (ViewLevel::Outer { words, .. } | ViewLevel::Inner { words, .. }) = self.i.level else { return };
-        if words == 0 || self.file == KernelKind::MultiCoarse && matches!(self.i.level, ViewLevel::Outer { .. }) {
+        // The resolve and fine passes hold the refine-mask word too (`plan::level_values_layers`).
+        let layers = if self.file == KernelKind::MultiCoarse { words } else { self.level_values_layers() };
+        if layers == 0 || self.file == KernelKind::MultiCoarse && matches!(self.i.level, ViewLevel::Outer { .. }) {
             return;
         }
         let binding = self.i.layout.levels.as_ref().expect("the multi-rate mode has levels").values.binding;
         let outer = mrsl_abi::geometry::DYNAMIC_OUTER_BLOCK;
-        self.line(0, format!("// The coarse({outer}) values per pixel, a layer per word ({words})."));
+        let mask = if layers > words { ", then the resolve pass's refine-mask word" } else { "" };
+        self.line(0, format!("// The coarse({outer}) values per pixel, a layer per word ({words}){mask}."));
         let group = self.i.layout.interface.group;
         let ty = "texture_storage_2d_array<r32uint, read_write>";
         self.line(0, format!("@group({group}) @binding({binding}) var {LEVEL_VALUES}: {ty};"));
         self.line(0, "");
+    }
+
+    /// The layers of the multi-rate mode's stored values ([`crate::plan::level_values_layers`]).
+    pub(super) fn level_values_layers(&self) -> u32 {
+        crate::plan::level_values_layers(self.i.layout)
+    }
+
+    /// The refine-mask bits of the multi-rate mode's 4x4 level's effects
+    /// (the live `coarse(4)` effects among the first 32 counters).
+    pub(super) fn outer_effect_bits(&self) -> u32 {
+        let Some(levels) = &self.i.layout.levels else { return 0 };
+        let c = self.checked();
+        let outer = |e: &EffectId| levels.block[e.index()] == mrsl_abi::geometry::DYNAMIC_OUTER_BLOCK;
+        let bits =
+            self.i.counters.iter().enumerate().filter(|(k, e)| *k < 32 && outer(e) && c.effects.len() > e.index());
+        bits.fold(0u32, |mask, (k, _)| mask | (1u32 << k))
     }
 
     /// `mrsl_eval_<effect>` of an effect the inner view reads from the

@@ -103,7 +103,12 @@ impl Writer<'_, '_, '_> {
         self.line(2, format!("{COMPACT_BLOCKS}[{LANE}] = {BLOCK};"));
         self.statistics_on(2);
         let mask_y = self.mask_y(BLOCK, "0u");
-        self.template(3, include_str!("templates/rate.wgsl"), &[("LAST", &BLOCK), ("FROM_INNER", &mask_y)]);
+        let mask_x = format!("{BLOCK}.refined0");
+        self.template(
+            3,
+            include_str!("templates/rate.wgsl"),
+            &[("LAST", &BLOCK), ("MASK_X", &mask_x), ("FROM_INNER", &mask_y)],
+        );
         for j in 0..k {
             self.count_refined(j, &format!("{IS_REFINED}({LAST_BLOCK}, {j}u)"));
         }

@@ -11,7 +11,8 @@
 use super::Writer;
 use super::effects::Evaluation;
 use super::names::{
-    BACKGROUND, BLOCK, CONTROL, CORNERS, INNER_BLOCK, INTERFACE, IS_REFINED, LAST_BLOCK, LOAD_CORNERS, Name, POS,
+    BACKGROUND, BLOCK, CONTROL, CORNERS, INNER_BLOCK, INTERFACE, IS_REFINED, LAST_BLOCK, LEVEL_VALUES, LOAD_CORNERS,
+    Name, POS,
 };
 use super::pixel::Scope;
 use super::words::{bit, test_bit, unpack_words};
@@ -469,6 +470,24 @@ impl<'b> Writer<'_, '_, 'b> {
         self.pixel_lanes(&mut |w, scope| w.fine_prologue(scope), &mut |w, e, indent| w.fine_coarse_value(e, indent));
     }
 
+    /// The refine mask's `.x` word at the pixel, from block `last`. In the
+    /// multi-rate mode the resolve pass keeps its word (the 4x4 level's
+    /// effects) in the stored values' last layer, and the fine pass takes
+    /// those effects' bits from it: its own block only says they were loaded.
+    fn level_mask_word(&mut self, last: &str) -> String {
+        let refined = format!("{last}.refined0");
+        if !matches!(self.file, KernelKind::MultiResolve | KernelKind::MultiFine) || self.level_values_layers() == 0 {
+            return refined;
+        }
+        let layer = self.level_values_layers() - 1;
+        if self.file == KernelKind::MultiResolve {
+            self.line(3, format!("textureStore({LEVEL_VALUES}, {POS}, {layer}, vec4<u32>({refined}, 0u, 0u, 0u));"));
+            return refined;
+        }
+        let outer = self.outer_effect_bits();
+        format!("(({refined} & ~{outer}u) | (textureLoad({LEVEL_VALUES}, {POS}, {layer}).x & {outer}u))")
+    }
+
     fn fine_coarse_value(&mut self, e: EffectId, indent: usize) {
         self.effect_chain(&[e], indent, Evaluation::Kernel);
     }
@@ -490,7 +509,9 @@ impl<'b> Writer<'_, '_, 'b> {
         };
         w.statistics_on(2);
         let mask_y = w.mask_y(last, &from_inner);
-        w.template(3, include_str!("templates/rate.wgsl"), &[("LAST", &last), ("FROM_INNER", &mask_y)]);
+        let mask_x = w.level_mask_word(last);
+        let values: &super::writer::Values = &[("LAST", &last), ("MASK_X", &mask_x), ("FROM_INNER", &mask_y)];
+        w.template(3, include_str!("templates/rate.wgsl"), values);
         // (A loaded effect is counted where the resolve pass evaluated it.)
         let counted: Vec<EffectId> = w.coarse_live().into_iter().filter(|&e| !w.is_loaded(e)).collect();
         for e in counted {
