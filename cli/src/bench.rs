@@ -178,7 +178,7 @@ pub fn bench(args: &BenchArgs) -> Result<Vec<PathBuf>> {
     // The kernels of the modes measured, and of the reference every point is compared with.
     let mut modes = vec![Mode::Reference];
     modes.extend(args.modes.iter().copied().filter(|m| *m != Mode::Reference));
-    let DeviceProgram { name, program, gpu } =
+    let DeviceProgram { name, program, gpu, .. } =
         compile_for_device(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &modes)?;
     let device_name = format!("{} ({:?})", gpu.adapter_info.name, gpu.adapter_info.backend);
     eprintln!("bench: {name} on {device_name}, {}x{}, {} runs per point (median)", args.size.0, args.size.1, args.runs);

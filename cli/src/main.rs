@@ -18,6 +18,7 @@ mod output;
 mod rates;
 mod render;
 mod report;
+mod scene_check;
 mod serve;
 mod setup;
 mod suite;

@@ -88,7 +88,7 @@ pub fn open(args: &RenderArgs) -> Result<Session> {
              examples/sponza_lights.mrsl uses the light rig of mesh scenes)"
         );
     }
-    let DeviceProgram { name, program, gpu } =
+    let DeviceProgram { name, source, program, gpu } =
         compile_for_device(args.program.as_deref(), ("demo.mrsl", DEMO_PROGRAM), &modes)?;
     let access = match program.layout.channels.iter().any(|c| c.access == ChannelAccess::Storage) {
         true => "storage",
@@ -107,6 +107,8 @@ pub fn open(args: &RenderArgs) -> Result<Session> {
     let mut scene = bind_scene(&gpu, &args.scene, args.size)?;
     let size = scene.size;
     progress(&format!("built the {} G-buffer at {}x{}", args.scene, size.0, size.1), start);
+    crate::scene_check::check_channels(&name, &source, &program.layout, &args.scene, &scene.channels)
+        .map_err(|diagnostics| anyhow!(diagnostics))?;
     if args.frames.is_some() && scene.path.is_none() {
         bail!(no_path(&args.scene));
     }

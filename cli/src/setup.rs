@@ -36,6 +36,8 @@ pub fn compile_program(path: Option<&Path>, builtin: (&str, &str), modes: &[Mode
 pub struct DeviceProgram {
     /// The program's name, for messages.
     pub name: String,
+    /// Its source, for diagnostics found when binding it.
+    pub source: String,
     pub program: mrsl::Program,
     pub gpu: Gpu,
 }
@@ -76,10 +78,10 @@ pub fn compile_for_device(path: Option<&Path>, builtin: (&str, &str), modes: &[M
         );
     }
     if options.storage_channels && options.packed_records {
-        return Ok(DeviceProgram { name, program, gpu });
+        return Ok(DeviceProgram { name, source, program, gpu });
     }
     let program = compile(&name, &source, options)?;
-    Ok(DeviceProgram { name, program, gpu })
+    Ok(DeviceProgram { name, source, program, gpu })
 }
 
 /// The program at `path`, or the built-in `(name, source)`: its name for messages and its source.

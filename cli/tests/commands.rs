@@ -29,6 +29,7 @@ const TESTS: &[(&str, fn())] = &[
     ),
     ("render_raw_writes_the_texels_the_png_was_made_from", render_raw_writes_the_texels_the_png_was_made_from),
     ("every_mode_renders_alone", every_mode_renders_alone),
+    ("scene_channels_are_checked_at_their_declarations", scene_channels_are_checked_at_their_declarations),
     (
         "gbuffer_exports_a_scene_files_images_with_every_mip_level",
         gbuffer_exports_a_scene_files_images_with_every_mip_level,
@@ -49,6 +50,44 @@ fn every_mode_renders_alone() {
         let runs = read_json(&dir.join("demo.stats.json"));
         let modes: Vec<&str> = runs.as_array().unwrap().iter().map(|r| r["mode"].as_str().unwrap()).collect();
         assert_eq!(modes, [name.as_str()], "the statistics of the mode asked for, alone");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A channel the scene lacks, or declared with a scalar type its texture
+/// cannot give, is an error at the program's `in` declaration before
+/// anything renders or is written: with the scene's channels and a "did you
+/// mean", or the declaration to write instead.
+fn scene_channels_are_checked_at_their_declarations() {
+    let dir = scratch("channels");
+    let cases = [
+        (
+            "typo.mrsl",
+            "in float3 abledo;\n",
+            "abledo",
+            &["error[E0801]", "typo.mrsl:1:11", "did you mean `albedo`?", "material (uint)"][..],
+        ),
+        (
+            "kind.mrsl",
+            "in float material;\n",
+            "float3(material)",
+            &["error[E0802]", "kind.mrsl:1:10", "help: declare `in uint material;`"][..],
+        ),
+    ];
+    for (file, declaration, read, expected) in cases {
+        let program = dir.join(file);
+        let source = format!(
+            "{declaration}in float3 normal;\ncoarse effect float3 lit = {read} * max(normal.y, 0.0);\nfine out float4 color = float4(lit, 1.0);\n"
+        );
+        std::fs::write(&program, source).unwrap();
+        let out = dir.join("out");
+        let run = mrslc(&["render", program.to_str().unwrap(), "--size", "24x16", "--out", out.to_str().unwrap()]);
+        let said = stderr(&run);
+        assert!(!run.status.success(), "{file}: {said}");
+        for text in expected {
+            assert!(said.contains(text), "{file}: no `{text}` in:\n{said}");
+        }
+        assert!(!out.exists(), "{file}: nothing is written when the program cannot be bound");
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -46,6 +46,7 @@ mod validate;
 
 pub use diagnostic::{Diagnostic, Label, Severity, emit_colored, render_all};
 pub use mrsl_abi::{CompiledProgram, Kernel, KernelKind, KernelRef, Layout, Mode, Plan};
+pub use span::Span;
 use validate::{NagaFailure, generated_context, join_validation, naga_validate, spawn_validation, with_stack};
 
 /// The stages behind [`compile`], for the compiler's own benchmarks and tests
@@ -201,6 +202,16 @@ pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnosti
             generate(source, options, checked, graph, deriv, diagnostics)
         })?
     })
+}
+
+/// The span of the name of the top-level declaration `name` in `source`
+/// (an `in` channel, a uniform, a constant, a function or an effect): where
+/// a diagnostic about it points when the problem is found at the edge,
+/// binding a compiled program to a scene or an engine. `None` when `source`
+/// does not parse or declares no such name.
+pub fn declaration_span(source: &str, name: &str) -> Option<Span> {
+    let program = syntax::parse(source).ok()?;
+    program.items.iter().map(|item| item.name()).find(|ident| ident.name == name).map(|ident| ident.span)
 }
 
 /// Parses and validates WGSL with naga, as WebGPU requires (no optional

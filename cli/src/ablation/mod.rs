@@ -160,7 +160,7 @@ type Programs = Vec<(&'static str, &'static str, CompiledProgram)>;
 pub fn ablation(args: &AblationArgs) -> Result<Vec<PathBuf>> {
     let target = Target::of(args.mode)?;
     let modes = [Mode::Reference, args.mode];
-    let DeviceProgram { name, program, gpu } =
+    let DeviceProgram { name, program, gpu, .. } =
         compile_for_device(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &modes)?;
     let device = args.plan.unwrap_or(match gpu.adapter_info.device_type {
         wgpu::DeviceType::Cpu => Device::Cpu,

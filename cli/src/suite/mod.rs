@@ -134,7 +134,7 @@ pub fn suite(args: &SuiteArgs) -> Result<Vec<PathBuf>> {
         }
     }
     let start = Instant::now();
-    let DeviceProgram { name, program, gpu } =
+    let DeviceProgram { name, program, gpu, .. } =
         compile_for_device(args.program.as_deref(), ("sponza_lights.mrsl", WORKLOAD_PROGRAM), &Mode::ALL)?;
     let device = Device::of(&gpu.adapter_info);
     let adapters: Vec<Device> = mrsl_lab::gpu::adapters().iter().map(Device::of).collect();
