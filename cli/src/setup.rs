@@ -103,6 +103,8 @@ fn compile(name: &str, source: &str, options: Options) -> Result<mrsl::Program> 
 /// the scene file, if any (its uniforms and images).
 pub struct BoundScene {
     pub channels: Vec<(String, wgpu::Texture)>,
+    /// The light rig of a scene made on the CPU (`Scene::cpu_rig`: the demo's).
+    pub rig: Option<mrsl_lab::rig::LightRig>,
     pub size: (u32, u32),
     pub mesh: Option<MeshScene>,
     /// The camera path of `--frames`, if the scene has one.
@@ -125,6 +127,9 @@ impl BoundScene {
                 textures.push(("shadow_map".to_string(), mesh.shadow_map(gpu)?.clone()));
             }
             warnings.extend(applied.warnings);
+        }
+        if let Some(rig) = &self.rig {
+            warnings.extend(rig.apply_point_lights(shader)?.warnings);
         }
         if let Some(file) = &self.file {
             let bound = file.bind(gpu, shader)?;
@@ -200,7 +205,8 @@ pub fn bind_scene_quietly(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> R
             Some(m) => m.gbuffer(gpu, &m.camera, size)?,
             None => builtin.textures_on(gpu, size.0, size.1)?,
         };
-        return Ok(BoundScene { channels, size, mesh, path: builtin.camera_path(), file: None });
+        let rig = if mesh.is_none() { builtin.cpu_rig() } else { None };
+        return Ok(BoundScene { channels, size, mesh, rig, path: builtin.camera_path(), file: None });
     }
     let path = Path::new(scene);
     if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
@@ -209,7 +215,7 @@ pub fn bind_scene_quietly(gpu: &Gpu, scene: &str, size: Option<(u32, u32)>) -> R
         let size = size.or(file.size).unwrap_or(DEFAULT_SIZE);
         let mesh = file.mesh_scene(gpu, size)?;
         let channels = mesh.gbuffer(gpu, &mesh.camera, size).map_err(|e| anyhow!("{scene}: {e}"))?;
-        return Ok(BoundScene { channels, size, mesh: Some(mesh), path: file.path(), file: Some(file) });
+        return Ok(BoundScene { channels, size, mesh: Some(mesh), rig: None, path: file.path(), file: Some(file) });
     }
     bail!("unknown scene `{scene}` (expected {}, or a .toml scene file)", Scene::NAMES.join(", "))
 }

@@ -29,6 +29,7 @@ const TESTS: &[(&str, fn())] = &[
     ),
     ("render_raw_writes_the_texels_the_png_was_made_from", render_raw_writes_the_texels_the_png_was_made_from),
     ("every_mode_renders_alone", every_mode_renders_alone),
+    ("the_demo_lights_a_program_written_for_the_rig", the_demo_lights_a_program_written_for_the_rig),
     ("scene_channels_are_checked_at_their_declarations", scene_channels_are_checked_at_their_declarations),
     (
         "gbuffer_exports_a_scene_files_images_with_every_mip_level",
@@ -89,6 +90,27 @@ fn scene_channels_are_checked_at_their_declarations() {
         }
         assert!(!out.exists(), "{file}: nothing is written when the program cannot be bound");
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A many-light program written for the mesh scenes' rig (uniform arrays,
+/// which take no defaults) renders on the built-in demo the first time: the
+/// demo carries a light rig too.
+fn the_demo_lights_a_program_written_for_the_rig() {
+    let dir = scratch("rig");
+    let program = dir.join("lights.mrsl");
+    let source = "in float3 position;\nin float3 normal;\nuniform float4 light_pos[8];\nuniform float4 light_color[8];\n\
+        uniform int light_count;\ncoarse effect float3 lights {\n    float3 sum = float3(0.0);\n\
+        for (int i = 0; i < 8; i++) {\n        if (i >= light_count) break;\n        float3 d = light_pos[i].xyz - position;\n\
+        sum += light_color[i].rgb * max(dot(normalize(normal), normalize(d)), 0.0) * saturate(1.0 - length(d) / light_pos[i].w);\n\
+        }\n    lights = sum;\n}\nfine out float4 color = float4(lights, 1.0);\n";
+    std::fs::write(&program, source).unwrap();
+    let out = dir.to_str().unwrap();
+    let run = mrslc(&["render", program.to_str().unwrap(), "--size", "48x27", "--mode", "reference", "--out", out]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let image = image::open(dir.join("lights.reference.png")).unwrap().to_rgb8();
+    let lit = image.pixels().filter(|p| p.0.iter().any(|&c| c > 16)).count();
+    assert!(lit > image.pixels().len() / 4, "the rig lights the demo: {lit} lit pixels of {}", image.pixels().len());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

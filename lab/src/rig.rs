@@ -146,29 +146,7 @@ impl LightRig {
         let lights = self.lights.len();
         let float = Offered::scalar(Scalar::Float);
         // The arrays first: light_count counts the lights they hold.
-        let mut capacity: Option<usize> = None;
-        for name in ["light_pos", "light_color"] {
-            if !applied.admit(&layout, SOURCE, name, &Offered::Float4Array(lights))? {
-                continue;
-            }
-            let components = declared_components(&layout, name);
-            let held = components / 4;
-            capacity = Some(capacity.map_or(held, |c| c.min(held)));
-            let mut values: Vec<f64> = self
-                .lights
-                .iter()
-                .take(held)
-                .flat_map(|l| match name {
-                    "light_pos" => [l.position[0], l.position[1], l.position[2], l.range],
-                    _ => [l.color[0], l.color[1], l.color[2], l.intensity],
-                })
-                .map(f64::from)
-                .collect();
-            // Arrays larger than the rig: the rest stays zero (lights past light_count).
-            values.resize(components, 0.0);
-            shader.set_uniform(name, &values)?;
-            applied.record(name);
-        }
+        let capacity = self.apply_arrays(shader, &layout, &mut applied, |_| true)?;
         let focal = 0.5 / (self.sun.camera.fov_y_degrees.to_radians() / 2.0).tan();
         let view_proj = self.sun_view_proj()?;
         let singles: [(&str, Offered, Vec<f32>); 6] = [
@@ -189,6 +167,68 @@ impl LightRig {
             applied.record("shadow_map");
         }
         Ok(applied)
+    }
+
+    /// The point lights alone, for a scene whose rig has no shadow map (the
+    /// ray-cast demo): `light_pos` and `light_color` where the program
+    /// declares them as `float4` arrays, which take no defaults, and
+    /// `light_count` where it declares an `int` without one. A program's own
+    /// sun and lights, and names of other types, keep their defaults without
+    /// a warning: the scene only supplies what the program could not run without.
+    pub fn apply_point_lights(&self, shader: &mut Shader) -> Result<Applied, RigError> {
+        let mut applied = Applied::default();
+        let layout = shader.layout().clone();
+        let field =
+            |name: &str| layout.uniforms.as_ref().and_then(|u| u.fields.iter().find(|f| f.name == name)).cloned();
+        let float4_array = |name: &str| {
+            field(name).is_some_and(
+                |f| matches!(f.ty, ValueType::Array(ref t, _) if **t == ValueType::Vector(Scalar::Float, 4)),
+            )
+        };
+        let capacity = self.apply_arrays(shader, &layout, &mut applied, float4_array)?;
+        let count = field("light_count");
+        if count.is_some_and(|f| f.default.is_none() && f.ty == ValueType::Scalar(Scalar::Int)) {
+            let lights = self.lights.len().min(capacity.unwrap_or(self.lights.len()));
+            shader.set_uniform("light_count", &[lights as f64])?;
+            applied.record("light_count");
+        }
+        Ok(applied)
+    }
+
+    /// `light_pos` and `light_color`, each where `wanted` and the program
+    /// declares it (admitted by type); returns the fewest lights an array
+    /// set holds, which `light_count` must not exceed.
+    fn apply_arrays(
+        &self,
+        shader: &mut Shader,
+        layout: &mrsl_abi::Layout,
+        applied: &mut Applied,
+        wanted: impl Fn(&str) -> bool,
+    ) -> Result<Option<usize>, RigError> {
+        let mut capacity: Option<usize> = None;
+        for name in ["light_pos", "light_color"] {
+            if !wanted(name) || !applied.admit(layout, SOURCE, name, &Offered::Float4Array(self.lights.len()))? {
+                continue;
+            }
+            let components = declared_components(layout, name);
+            let held = components / 4;
+            capacity = Some(capacity.map_or(held, |c| c.min(held)));
+            let mut values: Vec<f64> = self
+                .lights
+                .iter()
+                .take(held)
+                .flat_map(|l| match name {
+                    "light_pos" => [l.position[0], l.position[1], l.position[2], l.range],
+                    _ => [l.color[0], l.color[1], l.color[2], l.intensity],
+                })
+                .map(f64::from)
+                .collect();
+            // Arrays larger than the rig: the rest stays zero (lights past light_count).
+            values.resize(components, 0.0);
+            shader.set_uniform(name, &values)?;
+            applied.record(name);
+        }
+        Ok(capacity)
     }
 
     /// Renders the sun's shadow map (`size` x `size`, `Rg16Float`, distance

@@ -238,6 +238,17 @@ impl Scene {
         }
     }
 
+    /// The light rig of a scene made on the CPU, whose point lights a
+    /// program written for the mesh scenes' rig (`light_pos`, `light_color`,
+    /// `light_count`) gets there too ([`LightRig::apply_point_lights`]): the
+    /// demo's, scaled to its ground and spheres ([`DEMO_BOUNDS`]) and lit
+    /// around them; `None` for the flat test scenes and the mesh scenes
+    /// (whose rig is their mesh scene's). The demo is ray-cast, not a mesh:
+    /// no shadow map, and its sun stays the program's.
+    pub fn cpu_rig(self) -> Option<LightRig> {
+        (self == Scene::Demo).then(|| LightRig::scaled(&DEMO_BOUNDS, DEFAULT_LIGHTS, Layout::Around))
+    }
+
     /// The mesh scenes' mesh on `gpu`, with camera and light rig; `None` for
     /// the scenes made on the CPU.
     pub fn mesh_scene(self, gpu: &Gpu) -> Result<Option<MeshScene>, SceneError> {
@@ -425,6 +436,10 @@ impl Builder {
 
 /// Ray-casts spheres on a ground plane from the demo program's default camera
 /// (at (0, 1.5, 5), looking at (0, 0.5, 0), 50 degree vertical field of view).
+/// The demo's world: its ground (y = 0, |x| and |z| below 6) and its
+/// spheres, the tallest reaching y = 1.8.
+pub const DEMO_BOUNDS: crate::mesh::Bounds = crate::mesh::Bounds { min: [-6.0, 0.0, -6.0], max: [6.0, 1.8, 6.0] };
+
 fn demo(width: u32, height: u32) -> GBuffer {
     let camera = Scene::demo_camera();
     let (eye, target) = (Vec3::from(camera.eye), Vec3::from(camera.target));
