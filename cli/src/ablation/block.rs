@@ -39,7 +39,9 @@ fn nothing_refined_at_run_time(w: &str) -> Option<String> {
         let t = l.trim_start();
         if let Some((todo, pixels)) = t.strip_prefix("var mrsl_todo_").and_then(|r| r.split_once(" = ")) {
             let pixels = pixels.strip_suffix(';')?;
-            return Some(format!("{}var mrsl_todo_{todo} = ({pixels}) & select(0u, 3u, mrsl_first.x < 0);", indent(l)));
+            // `mrsl_pos0`, the lane's first pixel: the loop is in the effect's
+            // `mrsl_lane_<effect>`, which takes it (and not `mrsl_first`).
+            return Some(format!("{}var mrsl_todo_{todo} = ({pixels}) & select(0u, 3u, mrsl_pos0.x < 0);", indent(l)));
         }
         let cond = t.strip_prefix("if (mrsl_is_refined(mrsl_b, ")?.strip_suffix(")) {")?;
         Some(format!("{}if (mrsl_is_refined(mrsl_b, {cond}) && mrsl_pos.x < 0) {{", indent(l)))

@@ -653,6 +653,7 @@ impl Writer<'_, '_, '_> {
     /// Entry point of the block and dynamic fine kernels and of the reference kernel.
     pub(super) fn pixel_entry(&mut self) {
         if self.file == KernelKind::Tile {
+            self.lane_functions();
             self.tile_pixel_blocks(self.block, FINE_PIXELS_PER_LANE);
             return self.tile_entry(|w| {
                 w.tile_pixels_head();
@@ -667,7 +668,10 @@ impl Writer<'_, '_, '_> {
             return self.compacted_fine_entry();
         }
         match self.kind {
-            KernelKind::Fine | KernelKind::DynamicFine => self.tile_pixel_blocks(self.block, FINE_PIXELS_PER_LANE),
+            KernelKind::Fine | KernelKind::DynamicFine => {
+                self.lane_functions();
+                self.tile_pixel_blocks(self.block, FINE_PIXELS_PER_LANE);
+            }
             // The reference kernel has no blocks; it lays its tiles out in 2x2 ones.
             _ => self.tile_pixel_blocks(2, 1),
         }

@@ -113,12 +113,14 @@ pub(super) enum Name {
     Apart,
     /// `mrsl_classify_<effect>`: the hierarchical classification of one coarse effect.
     Classify,
+    /// `mrsl_lane_<effect>`: a coarse effect at the pixels of a fine kernel's lane.
+    Lane,
 }
 
 impl Name {
     /// Every family, for the tests that check names against this module.
     #[cfg_attr(not(test), expect(dead_code, reason = "read by the tests"))]
-    pub(super) const ALL: [Name; 42] = [
+    pub(super) const ALL: [Name; 43] = [
         Name::Eval,
         Name::Val,
         Name::At,
@@ -161,6 +163,7 @@ impl Name {
         Name::Apart,
         Name::Classify,
         Name::Prefix,
+        Name::Lane,
     ];
 
     /// What every member's name starts with.
@@ -208,6 +211,7 @@ impl Name {
             Name::Apart => "mrsl_apart_",
             Name::Classify => "mrsl_classify_",
             Name::Prefix => "mrsl_prefix",
+            Name::Lane => "mrsl_lane_",
         }
     }
 

@@ -5,13 +5,14 @@
 
 use super::effects::Evaluation;
 use super::names::{
-    BLOCK, CONTROL, CORNERS, FIRST, GRID, INNER_BLOCK, IS_REFINED, LANE_PIXEL, LEVEL_VALUES, LOAD_CORNERS, Name, POS,
-    WORKGROUP_STATS,
+    BLOCK, BLOCK_STRUCT, CONTROL, CORNERS, CORNERS_STRUCT, FIRST, GRID, INNER_BLOCK, IS_REFINED, LANE_PIXEL,
+    LEVEL_VALUES, LOAD_CORNERS, Name, POS, WORKGROUP_STATS,
 };
 use super::words::pack_words;
 use super::writer::cut;
 use super::{ViewLevel, Writer};
 use crate::check::EffectId;
+use crate::limits::MAX_PARAMETERS;
 use crate::syntax::ast::Rate;
 use crate::types::{Scalar, Type};
 use mrsl_abi::KernelKind;
@@ -362,24 +363,100 @@ impl Writer<'_, '_, '_> {
         }
     }
 
+    /// Whether the kernel's lanes shade their pixels effect by effect
+    /// ([`Self::effect_major_pixels`]): the block and dynamic fine kernels
+    /// (and the tile kernel's pixels) of a program with coarse effects.
+    fn effect_major(&self) -> bool {
+        matches!(self.kind, KernelKind::Fine | KernelKind::DynamicFine) && !self.coarse_live().is_empty()
+    }
+
+    /// `mrsl_lane_<effect>` of every coarse effect that has one
+    /// ([`Self::lane_params`]), before the function whose lanes call them.
+    pub(super) fn lane_functions(&mut self) {
+        if !self.effect_major() {
+            return;
+        }
+        self.template(0, include_str!("templates/lane_effects.wgsl"), &[]);
+        for e in self.coarse_live() {
+            let Some(params) = self.lane_params(e) else { continue };
+            let info = &self.checked().effects[e.index()];
+            let typed: Vec<String> = params.iter().map(|(name, ty)| format!("{name}: {ty}")).collect();
+            self.line(0, format!("// `{}` at the lane's pixels.", info.name));
+            self.line(0, format!("fn {}({}) {{", Name::Lane.of(&info.name), typed.join(", ")));
+            self.lane_coarse_body(e, true);
+            self.line(0, "}");
+            self.line(0, "");
+        }
+    }
+
+    /// The parameters of `mrsl_lane_<effect>`, which computes coarse effect
+    /// `e` at the lane's pixels: what its part of the lane's work reads (the
+    /// corners, each pixel's position, whether it is inside the image, its
+    /// resolved blocks, its values of `e`'s dependencies) and, through
+    /// pointers, each pixel's value of `e`. None where they would be more
+    /// than WGSL allows: that effect's part stays in the lane's function.
+    fn lane_params(&self, e: EffectId) -> Option<Vec<(String, String)>> {
+        let c = self.checked();
+        let pixels = 0..FINE_PIXELS_PER_LANE;
+        let deps = self.deps_params(e);
+        let mut params = vec![(CORNERS.to_string(), CORNERS_STRUCT.to_string())];
+        for k in pixels.clone() {
+            params.push((Name::LanePos.of(k), "vec2<i32>".into()));
+            params.push((Name::LaneIn.of(k), "bool".into()));
+            params.push((Name::LaneBlock.of(k), BLOCK_STRUCT.into()));
+            if self.kind == KernelKind::DynamicFine {
+                params.push((Name::LaneInner.of(k), BLOCK_STRUCT.into()));
+            }
+        }
+        for d in &deps {
+            let ty = c.effects[d.index()].ty.wgsl();
+            params.extend(pixels.clone().map(|k| (Name::LaneValue.within(k, self.effect_name(*d)), ty.clone())));
+        }
+        let ty = format!("ptr<function, {}>", c.effects[e.index()].ty.wgsl());
+        params.extend(pixels.map(|k| (Name::LaneValue.within(k, self.effect_name(e)), ty.clone())));
+        (params.len() <= MAX_PARAMETERS).then_some(params)
+    }
+
     /// Coarse effect `e` at the lane's pixels in [`Self::effect_major_pixels`]:
-    /// resampled at each (when passed), then re-evaluated in a loop at the
-    /// pixels that refine it at their innermost level (`mrsl_b<k>`, or in
-    /// the dynamic mode `mrsl_inner<k>`).
+    /// a call of its `mrsl_lane_<effect>` (into the pixels' values, declared
+    /// here), or where it has none, its work written here.
     fn lane_coarse_value(&mut self, e: EffectId) {
+        let Some(params) = self.lane_params(e) else {
+            return self.lane_coarse_body(e, false);
+        };
+        let info = &self.checked().effects[e.index()];
+        for k in 0..FINE_PIXELS_PER_LANE {
+            self.line(1, format!("var {}: {};", Name::LaneValue.within(k, self.effect_name(e)), info.ty.wgsl()));
+        }
+        let args: Vec<String> = params
+            .iter()
+            .map(|(name, ty)| if ty.starts_with("ptr<") { format!("&{name}") } else { name.clone() })
+            .collect();
+        self.line(1, format!("{}({});", Name::Lane.of(&info.name), args.join(", ")));
+    }
+
+    /// The work of coarse effect `e` at the lane's pixels: resampled at each
+    /// (when passed), then re-evaluated in a loop at the pixels that refine
+    /// it at their innermost level (`mrsl_b<k>`, or in the dynamic mode
+    /// `mrsl_inner<k>`). In `mrsl_lane_<effect>` (`through`) the values are
+    /// pointers the caller declared; in the lane's function, its variables.
+    fn lane_coarse_body(&mut self, e: EffectId, through: bool) {
         let pixels: Vec<u32> = (0..FINE_PIXELS_PER_LANE).collect();
         let dynamic = self.kind == KernelKind::DynamicFine;
         let info = &self.checked().effects[e.index()];
         let (index, name) = (self.coarse_index[&e], self.effect_name(e));
-        let value = |k: u32| Name::LaneValue.within(k, &name);
+        let value = |k: u32| format!("{}{}", if through { "*" } else { "" }, Name::LaneValue.within(k, &name));
         for &k in &pixels {
             if !self.i.interface.is_passed(e) {
-                self.line(1, format!("var {}: {};", value(k), info.ty.wgsl()));
+                if !through {
+                    self.line(1, format!("var {}: {};", value(k), info.ty.wgsl()));
+                }
                 continue;
             }
             let (block, inner) = (Name::LaneBlock.of(k), Name::LaneInner.of(k));
             let resample = self.level_resampler(false, &info.name);
-            self.line(1, format!("var {} = {resample}({block}, {CORNERS});", value(k)));
+            let declare = if through { "" } else { "var " };
+            self.line(1, format!("{declare}{} = {resample}({block}, {CORNERS});", value(k)));
             if dynamic {
                 let resample2 = self.level_resampler(true, &info.name);
                 self.line(
