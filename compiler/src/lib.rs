@@ -47,7 +47,7 @@ mod validate;
 pub use diagnostic::{Diagnostic, Label, Severity, emit_colored, render_all};
 pub use mrsl_abi::{CompiledProgram, Kernel, KernelKind, KernelRef, Layout, Mode, Plan};
 pub use span::Span;
-use validate::{NagaFailure, generated_context, join_validation, naga_validate, spawn_validation, with_stack};
+use validate::{NagaFailure, generated_context, naga_validate, validate_all, with_stack};
 
 /// The stages behind [`compile`], for the compiler's own benchmarks and tests
 /// only: not part of the API, and free to change with the stages.
@@ -287,11 +287,9 @@ fn generate(
         })
         .collect();
     // naga validation dominates compile time; the kernels are independent, so
-    // they are validated on as many threads as there are kernels.
-    let verdicts: Vec<Result<u32, NagaFailure>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = texts.iter().map(|(_, _, wgsl)| spawn_validation(scope, wgsl)).collect();
-        handles.into_iter().map(join_validation).collect()
-    });
+    // they are validated in parallel, on as many threads as the machine runs.
+    let wgsl: Vec<&str> = texts.iter().map(|(_, _, wgsl)| wgsl.as_str()).collect();
+    let verdicts: Vec<Result<u32, NagaFailure>> = validate_all(&wgsl);
     for ((kind, block, wgsl), verdict) in texts.into_iter().zip(verdicts) {
         let workgroup_bytes = match verdict {
             Ok(bytes) => bytes,
