@@ -7,6 +7,7 @@
 use crate::wellformed::{self, SplitMix};
 use mrsl::{Mode, Options, Severity};
 use proptest::prelude::*;
+use std::collections::BTreeSet;
 
 fn options() -> Options {
     // One block size keeps each case fast; the kernels are the same code shape.
@@ -178,11 +179,7 @@ proptest! {
 /// A generated program passes every check and compiles (the kernels of
 /// `options`), with no diagnostic at all; the failure message holds the program.
 fn assert_well_formed(source: &str, options: &Options) {
-    // W0002 (a key no coarse effect reads) and W0003 (a surface derivative
-    // that is its plain form) are the diagnostics allowed: the generator
-    // draws `@key` attributes and surface derivatives independently of what
-    // its effects read and of their rates.
-    let allowed_warning = |d: &mrsl::Diagnostic| d.code == "W0002" || d.code == "W0003";
+    let allowed_warning = |d: &mrsl::Diagnostic| wellformed::ALLOWED_WARNINGS.contains(&d.code);
     let mut diagnostics = mrsl::check(source);
     diagnostics.retain(|d| !allowed_warning(d));
     assert!(
@@ -217,6 +214,33 @@ proptest! {
         let options = crate::kernels::options((seed % crate::kernels::CHOICES as u64) as usize);
         assert_well_formed(&wellformed::program(&mut SplitMix(seed)).source, &options);
     }
+}
+
+/// Every warning the compiler can give (each `Diagnostic::warning("W...")`
+/// in its source) is one the generator's programs may draw or one it avoids
+/// ([`wellformed::ALLOWED_WARNINGS`], [`wellformed::AVOIDED_WARNINGS`]): a
+/// warning added to the compiler fails here until the generator and the
+/// `wellformed` fuzz target know it, instead of stopping a campaign.
+#[test]
+fn the_generator_knows_every_warning() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut codes = BTreeSet::new();
+    let mut stack = vec![dir];
+    while let Some(path) = stack.pop() {
+        if path.is_dir() {
+            stack.extend(std::fs::read_dir(&path).unwrap().map(|e| e.unwrap().path()));
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            let text = std::fs::read_to_string(&path).unwrap();
+            for (at, _) in text.match_indices("Diagnostic::warning(\"") {
+                let code = &text[at + "Diagnostic::warning(\"".len()..];
+                codes.insert(code[..code.find('"').unwrap()].to_string());
+            }
+        }
+    }
+    assert!(codes.contains("W0001"), "the scan found the compiler's warnings: {codes:?}");
+    let known: BTreeSet<String> =
+        wellformed::ALLOWED_WARNINGS.iter().chain(wellformed::AVOIDED_WARNINGS).map(|c| c.to_string()).collect();
+    assert_eq!(codes, known, "the compiler's warnings against those the generator allows or avoids");
 }
 
 /// What the generator must keep producing: a change that loses a feature
