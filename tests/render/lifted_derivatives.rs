@@ -10,11 +10,13 @@ use mrsl_runtime::{DispatchOptions, Mode};
 
 /// The corpus programs whose derivative operands read such locals: in a
 /// refine predicate (0084, 0086) and in a value (0085, whose loop breaks
-/// per pixel).
-const PROGRAMS: [(&str, &str); 3] = [
+/// per pixel), and reading effects at the neighbour (0087: a coarse
+/// predicate over a coarse effect, a fine value over a coarse effect).
+const PROGRAMS: [(&str, &str); 4] = [
     ("0084", include_str!("../../compiler/tests/data/ok/0084_derivative_of_reassigned_local.mrsl")),
     ("0085", include_str!("../../compiler/tests/data/ok/0085_derivative_after_varying_break.mrsl")),
     ("0086", include_str!("../../compiler/tests/data/ok/0086_derivative_of_loop_built_effect.mrsl")),
+    ("0087", include_str!("../../compiler/tests/data/ok/0087_loop_built_derivatives_that_read_effects.mrsl")),
 ];
 
 /// Forced refinement evaluates every effect per pixel with the reference's
