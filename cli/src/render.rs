@@ -118,6 +118,8 @@ pub fn open(args: &RenderArgs) -> Result<Session> {
     for warning in &warnings {
         eprintln!("warning: {warning}");
     }
+    crate::scene_check::check_uniforms(&name, &source, &shader, &args.scene)
+        .map_err(|diagnostics| anyhow!(diagnostics))?;
     shader.set_timestamp_period(&gpu.queue);
     let channels = std::mem::take(&mut scene.channels);
     resources.note_fallbacks();

@@ -1,8 +1,10 @@
 //! Binding a program to a scene, checked before anything renders: a
 //! channel the scene lacks, or one whose scalar type the scene's texture
 //! cannot give, is a diagnostic at the program's `in` declaration (E0801,
-//! E0802), with what the scene provides. The runtime refuses the same
-//! bindings later with a typed error; this says it in the program's terms.
+//! E0802), with what the scene provides; a uniform without a default that
+//! neither the scene nor `--set` gives is one at its `uniform` declaration
+//! (E0803). The runtime refuses the same bindings later with a typed error;
+//! this says it in the program's terms.
 
 use mrsl::{Diagnostic, Label};
 use mrsl_abi::{Layout, Scalar};
@@ -53,6 +55,29 @@ pub fn check_channels(
             Some(_) => continue,
         };
         diagnostics.push(d);
+    }
+    if diagnostics.is_empty() { Ok(()) } else { Err(mrsl::render_all(&diagnostics, file, source)) }
+}
+
+/// The program's uniforms that have no default and were not set (by the
+/// scene or `--set`), as rendered diagnostics (`Err`).
+pub fn check_uniforms(file: &str, source: &str, shader: &mrsl_runtime::Shader, scene: &str) -> Result<(), String> {
+    let fields = shader.layout().uniforms.iter().flat_map(|block| &block.fields);
+    let unset = fields.filter(|f| f.default.is_none() && shader.uniform(&f.name).is_none());
+    let mut diagnostics = vec![];
+    for field in unset {
+        let Some(span) = mrsl::declaration_span(source, &field.name) else { continue };
+        let (name, ty, count) = (&field.name, &field.ty, field.ty.components());
+        let default = if matches!(ty, mrsl_abi::ValueType::Array(..)) {
+            "an array takes no default".to_string()
+        } else {
+            format!("or give it one: `uniform {ty} {name} = ...;`")
+        };
+        diagnostics.push(
+            Diagnostic::error("E0803", format!("uniform `{name}` has no value"))
+                .with_label(Label::primary(span, format!("no default, and the scene `{scene}` does not set it")))
+                .with_note(format!("help: pass `--set {name}=V1,V2,...` ({count} numbers for a {ty}); {default}")),
+        );
     }
     if diagnostics.is_empty() { Ok(()) } else { Err(mrsl::render_all(&diagnostics, file, source)) }
 }

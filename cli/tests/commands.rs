@@ -58,7 +58,8 @@ fn every_mode_renders_alone() {
 /// A channel the scene lacks, or declared with a scalar type its texture
 /// cannot give, is an error at the program's `in` declaration before
 /// anything renders or is written: with the scene's channels and a "did you
-/// mean", or the declaration to write instead.
+/// mean", or the declaration to write instead; a uniform without a value,
+/// at its `uniform` declaration with the `--set` to pass.
 fn scene_channels_are_checked_at_their_declarations() {
     let dir = scratch("channels");
     let cases = [
@@ -90,6 +91,31 @@ fn scene_channels_are_checked_at_their_declarations() {
         }
         assert!(!out.exists(), "{file}: nothing is written when the program cannot be bound");
     }
+    // A uniform without a default (an array takes none) that neither the scene nor --set gives.
+    let program = dir.join("unset.mrsl");
+    let source = "in float3 normal;\nuniform float4 tint[2];\ncoarse effect float3 lit = tint[0].rgb * max(normal.y, 0.0);\n\
+        fine out float4 color = float4(lit, 1.0);\n";
+    std::fs::write(&program, source).unwrap();
+    let out = dir.join("out");
+    let run = mrslc(&["render", program.to_str().unwrap(), "--size", "24x16", "--out", out.to_str().unwrap()]);
+    let said = stderr(&run);
+    assert!(!run.status.success(), "{said}");
+    for text in ["error[E0803]", "unset.mrsl:2:16", "--set tint=V1,V2,...` (8 numbers for a float4[2])"] {
+        assert!(said.contains(text), "no `{text}` in:\n{said}");
+    }
+    assert!(!out.exists(), "nothing is written when a uniform has no value");
+    let set = ["--set", "tint=1,0.5,0.25,1,0,0,0,0"];
+    let run = mrslc(&[
+        "render",
+        program.to_str().unwrap(),
+        "--size",
+        "24x16",
+        "--out",
+        out.to_str().unwrap(),
+        set[0],
+        set[1],
+    ]);
+    assert!(run.status.success(), "with --set: {}", stderr(&run));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
