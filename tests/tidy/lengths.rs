@@ -55,29 +55,22 @@ impl Lengths {
     }
 }
 
-fn is_test(attrs: &[syn::Attribute]) -> bool {
-    attrs.iter().any(|a| {
-        a.path().is_ident("test")
-            || (a.path().is_ident("cfg") && a.parse_args::<syn::Ident>().is_ok_and(|i| i == "test"))
-    })
-}
-
 impl<'ast> Visit<'ast> for Lengths {
     fn visit_item_mod(&mut self, m: &'ast syn::ItemMod) {
-        if !is_test(&m.attrs) {
+        if !crate::is_test(&m.attrs) {
             syn::visit::visit_item_mod(self, m);
         }
     }
 
     fn visit_item_fn(&mut self, f: &'ast syn::ItemFn) {
-        if !is_test(&f.attrs) {
+        if !crate::is_test(&f.attrs) {
             self.record(&f.sig.ident, &f.sig.fn_token, &f.block);
             syn::visit::visit_item_fn(self, f);
         }
     }
 
     fn visit_impl_item_fn(&mut self, f: &'ast syn::ImplItemFn) {
-        if !is_test(&f.attrs) {
+        if !crate::is_test(&f.attrs) {
             self.record(&f.sig.ident, &f.sig.fn_token, &f.block);
             syn::visit::visit_impl_item_fn(self, f);
         }

@@ -62,6 +62,15 @@ fn main() {
 }
 
 /// The docs checked.
+/// Whether an item is test code (`#[test]`, `#[cfg(test)]`), which the
+/// module and length checks leave out.
+fn is_test(attrs: &[syn::Attribute]) -> bool {
+    attrs.iter().any(|a| {
+        a.path().is_ident("test")
+            || (a.path().is_ident("cfg") && a.parse_args::<syn::Ident>().is_ok_and(|i| i == "test"))
+    })
+}
+
 fn docs(root: &Path) -> Vec<PathBuf> {
     let mut docs = vec![root.join("ARCHITECTURE.md"), root.join("README.md")];
     let mut under: Vec<PathBuf> =
