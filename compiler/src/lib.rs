@@ -32,6 +32,7 @@ mod check;
 mod codegen;
 mod deriv;
 mod diagnostic;
+mod foreign;
 mod graph;
 mod interface;
 mod layout;
@@ -55,6 +56,7 @@ use validate::{NagaFailure, generated_context, naga_validate, validate_all, with
 pub mod internals {
     pub use crate::budget::{MAX_EFFECT_OPERATIONS, MAX_PROGRAM_OPERATIONS};
     pub use crate::check::{EffectId, check as check_ast};
+    pub use crate::foreign::{Kind as ForeignKind, TABLE as FOREIGN_WORDS, rows as foreign_rows};
     pub use crate::graph::build as build_graph;
     pub use crate::interface::{EXACT_LIMIT, allocate as allocate_interface, colour};
     pub use crate::syntax::lexer::Lexer;

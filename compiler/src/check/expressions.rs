@@ -8,6 +8,7 @@ use super::typing::{binary_type, construct_check, unify};
 use super::{Callee, Checker, Ctx, FunctionId, Global, LocalId, Symbol, err};
 use crate::builtins::Builtin;
 use crate::diagnostic::{Diagnostic, Label};
+use crate::foreign;
 use crate::syntax::ast::*;
 use crate::types::{self, Scalar, Type};
 
@@ -300,7 +301,7 @@ impl Checker<'_> {
         if arg_types.iter().any(|t| t.is_error()) {
             // Still resolve the callee so unknown functions are reported.
             if Type::from_name(name).is_none() && builtin.is_none() && !self.globals.contains_key(name) {
-                self.error(err("E0100", format!("unknown function `{name}`"), callee.span, "not found"));
+                self.unknown_function(name, callee);
             }
             return Type::Error;
         }
@@ -438,7 +439,9 @@ impl Checker<'_> {
             .filter(|(_, (g, _))| matches!(g, Global::Function(_)))
             .map(|(k, _)| k.clone())
             .collect();
-        if let Some(s) = suggest(
+        if let Some(help) = foreign::help(name) {
+            d = d.with_note(help);
+        } else if let Some(s) = suggest(
             name,
             Builtin::ALL
                 .iter()

@@ -14,6 +14,7 @@
 
 use crate::builtins::Builtin;
 use crate::diagnostic::{Diagnostic, Label};
+use crate::foreign;
 use crate::syntax::ast::*;
 use crate::types::Type;
 use mrsl_abi::TextureFormat;
@@ -312,8 +313,15 @@ impl<'a> Checker<'a> {
         match Type::from_name(&name.name) {
             Some(t) => t,
             None => {
+                if let Some(d) = foreign::keyword_diagnostic(&name.name, name.span) {
+                    // `let x = n;` parses as a declaration of type `let`.
+                    self.error(d);
+                    return Type::Error;
+                }
                 let mut d = err("E0102", format!("unknown type `{}`", name.name), name.span, "not a type");
-                if let Some(s) = suggest(&name.name, TYPE_NAMES.iter().copied()) {
+                if let Some(help) = foreign::help(&name.name) {
+                    d = d.with_note(help);
+                } else if let Some(s) = suggest(&name.name, TYPE_NAMES.iter().copied()) {
                     d = d.with_note(format!("did you mean `{s}`?"));
                 }
                 self.error(d);

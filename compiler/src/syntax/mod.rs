@@ -7,6 +7,7 @@ mod visit;
 pub use visit::{visit_expr, visit_stmt_exprs};
 
 use crate::diagnostic::{Diagnostic, Label};
+use crate::foreign;
 use ast::{IdGen, Program, Span};
 use lexer::{LexError, LexErrorAt, Lexer, Token};
 
@@ -29,14 +30,74 @@ fn syntax_diagnostic(source: &str, error: ParseError<'_>) -> Diagnostic {
     match error {
         InvalidToken { location } => Diagnostic::error("E0001", "invalid token")
             .with_label(Label::primary(Span::new(location, location + 1), "not a token of mrsl")),
-        UnrecognizedEof { location, expected } => unexpected(source, location, None, &expected),
+        UnrecognizedEof { location, expected } => {
+            foreign_construct(source, location, None).unwrap_or_else(|| unexpected(source, location, None, &expected))
+        }
         UnrecognizedToken { token: (start, token, end), expected } => {
-            unexpected(source, start, Some((start, token, end)), &expected)
+            let found = Some((start, token, end));
+            foreign_construct(source, start, found.as_ref())
+                .unwrap_or_else(|| unexpected(source, start, found, &expected))
         }
         ExtraToken { token: (start, token, end) } => Diagnostic::error("E0002", format!("unexpected {token}"))
             .with_label(Label::primary(Span::new(start, end), "extra token")),
         User { error } => lexical_diagnostic(source, error),
     }
+}
+
+/// Where the parser stopped on a construct of another shading language
+/// (`while (c) {`, `discard;`, `struct S {`, `static const`, `vec3<f32>`, a
+/// local array `float w[3]`): E0003 with what mrsl writes instead, in place
+/// of the list of expected tokens. The foreign word is looked for where such
+/// constructs start: the statement or declaration, the parameter, the token
+/// the parser stopped at and the one before it. A word used as a name
+/// (`loop = 2.0;`, `case.x`) is not taken for the construct.
+fn foreign_construct(source: &str, location: usize, found: Option<&(usize, Token<'_>, usize)>) -> Option<Diagnostic> {
+    let mut tokens = Before::scan(source, location).tokens;
+    let stopped_at = tokens.len();
+    tokens.extend(found.cloned());
+    if let (Some((start, Token::LBracket, end)), [.., (_, Token::Ident(_), _), (_, Token::Ident(_), _)]) =
+        (found, &tokens[..stopped_at])
+    {
+        return Some(foreign::array_diagnostic(Span::new(*start, *end)));
+    }
+    let starts_after = |delimiters: &[Token<'_>]| {
+        tokens[..stopped_at].iter().rposition(|(_, t, _)| delimiters.contains(t)).map_or(0, |i| i + 1)
+    };
+    let statement = starts_after(&[Token::Semi, Token::LBrace, Token::RBrace]);
+    let parameter = starts_after(&[Token::LParen, Token::Comma]).max(statement);
+    let mut candidates = vec![statement, parameter, stopped_at.saturating_sub(1), stopped_at];
+    candidates.dedup();
+    candidates.into_iter().filter(|&i| i < tokens.len()).find_map(|i| {
+        let (start, Token::Ident(word), end) = tokens[i] else { return None };
+        let next = tokens.get(i + 1).map(|t| &t.1);
+        let used_as_name = matches!(
+            next,
+            Some(
+                Token::Assign
+                    | Token::PlusAssign
+                    | Token::MinusAssign
+                    | Token::StarAssign
+                    | Token::SlashAssign
+                    | Token::Dot
+                    | Token::LBracket
+                    | Token::PlusPlus
+                    | Token::MinusMinus
+            )
+        );
+        if used_as_name {
+            return None;
+        }
+        let span = Span::new(start, end);
+        foreign::keyword_diagnostic(word, span).or_else(|| {
+            // A type of another language with parameters: `vec3<f32>`, `texture_2d<f32>`.
+            let help = foreign::help(word).filter(|_| next == Some(&Token::Lt))?;
+            Some(
+                Diagnostic::error("E0003", format!("`{word}<...>` is not an mrsl type"))
+                    .with_label(Label::primary(span, "a generic type"))
+                    .with_note(help),
+            )
+        })
+    })
 }
 
 /// The tokens that end a construct, in the order they are preferred when
@@ -236,6 +297,7 @@ fn expected_note(names: &[&str]) -> String {
 fn lexical_diagnostic(source: &str, error: LexErrorAt) -> Diagnostic {
     let end = error.end.max(error.start + 1).min(source.len().max(error.start));
     match error.error {
+        LexError::InvalidToken if source[error.start..].starts_with('#') => directive(source, error.start),
         LexError::InvalidToken => invalid_character(source, error.start, "not a token of mrsl"),
         LexError::BadIdentifierChar(offset) => {
             let at = error.start + offset;
@@ -254,6 +316,18 @@ fn lexical_diagnostic(source: &str, error: LexErrorAt) -> Diagnostic {
         LexError::BadNumber => Diagnostic::error("E0001", "number out of range")
             .with_label(Label::primary(Span::new(error.start, end), "does not fit in 32 bits")),
     }
+}
+
+/// A preprocessor line (`#include "brdf.hlsl"`, `#define PI 3.14`): E0003.
+fn directive(source: &str, at: usize) -> Diagnostic {
+    let rest = &source[at + 1..];
+    let len = 1 + rest.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).unwrap_or(rest.len());
+    let span = Span::new(at, at + len);
+    foreign::keyword_diagnostic(&source[at..at + len], span).unwrap_or_else(|| {
+        Diagnostic::error("E0003", format!("`{}` is not mrsl", &source[at..at + len]))
+            .with_label(Label::primary(span, "a preprocessor directive"))
+            .with_note("help: mrsl has no preprocessor: delete the line")
+    })
 }
 
 /// "invalid character `$` (U+0024)", or for a character that does not show,
