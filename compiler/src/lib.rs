@@ -31,6 +31,7 @@ mod builtins;
 mod check;
 mod codegen;
 mod deriv;
+mod deriv_warnings;
 mod diagnostic;
 mod foreign;
 mod graph;
@@ -343,6 +344,10 @@ fn front_end<R>(
     // operands are within the limits (which bound how deep it recurses).
     if !diagnostics.iter().any(|d| d.is_error()) {
         diagnostics.extend(budget::check(&checked, &graph, &deriv));
+    }
+    // Like W0001, said only of a program without errors.
+    if !diagnostics.iter().any(|d| d.is_error()) {
+        diagnostics.extend(deriv_warnings::warnings(&checked, &deriv));
     }
     sort(&mut diagnostics);
     if diagnostics.iter().any(|d| d.is_error()) {

@@ -330,7 +330,22 @@ impl Checker<'_> {
     fn derivative_call(&mut self, e: &Expr, name: &str, builtin: Option<Builtin>) {
         match self.ctx {
             Ctx::Effect(id) => {
-                if self.in_derivative {
+                if self.in_derivative && builtin == Some(Builtin::Sample) {
+                    // `fwidth(sample(t, s, uv))` differentiates a texture lookup, whose
+                    // derivative of `uv` (for the mip level) is then taken at the neighbour.
+                    self.error(
+                        err(
+                            "E0502",
+                            "`sample` inside the operand of a derivative",
+                            e.span,
+                            "picks its mip level from derivatives of its uv",
+                        )
+                        .with_note(
+                            "help: differentiate `sample_level(t, s, uv, 0.0)`, which takes no derivative, or \
+                                 sample in an effect of its own and differentiate that effect",
+                        ),
+                    );
+                } else if self.in_derivative {
                     self.error(err("E0502", format!("`{name}` inside the operand of another derivative"), e.span, "nested derivative").with_note(
                         "second derivatives are not supported; compute the first derivative as an effect and differentiate that",
                     ));

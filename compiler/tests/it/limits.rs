@@ -110,7 +110,7 @@ fn derivative_chain(n: usize, step: &str) -> String {
     let locals: String =
         (1..=n).map(|k| format!("    float a{k} = {};\n", step.replace("{prev}", &format!("a{}", k - 1)))).collect();
     format!(
-        "{HEADER}coarse effect float slope {{\n    float a0 = normal.x;\n{locals}    slope = ddx(a{n});\n}}\n\
+        "{HEADER}coarse effect float slope {{\n    float a0 = normal.x;\n{locals}    if (ddx(a{n}) > 0.0) refine;\n    slope = a0;\n}}\n\
          fine out float4 color = float4(slope);\n"
     )
 }

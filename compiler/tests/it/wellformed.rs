@@ -37,11 +37,13 @@ use std::collections::BTreeSet;
 use std::fmt::Write;
 
 /// The warnings a generated program may draw: W0002 (a key no coarse
-/// effect reads) and W0003 (a surface derivative that is its plain form),
-/// since the generator draws `@key` attributes and surface derivatives
-/// independently of what its effects read and of their rates. The
+/// effect reads), W0003 (a surface derivative that is its plain form),
+/// W0004 (a coarse value built on derivatives) and W0005 (a derivative of
+/// uniforms and constants), since the generator draws `@key` attributes,
+/// derivatives and their operands independently of what its effects read
+/// and of their rates. The
 /// `wellformed` fuzz target and the proptest smoke both take this list.
-pub const ALLOWED_WARNINGS: &[&str] = &["W0002", "W0003"];
+pub const ALLOWED_WARNINGS: &[&str] = &["W0002", "W0003", "W0004", "W0005"];
 
 /// The warnings the generator avoids by construction: W0001 (an effect no
 /// output needs: every effect it writes is read). With [`ALLOWED_WARNINGS`]
