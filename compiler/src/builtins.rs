@@ -9,9 +9,10 @@
 
 use crate::types::{self, Scalar, Type};
 
-/// Declares [`Builtin`] with its mrsl names, so that the two cannot disagree.
+/// Declares [`Builtin`] with its mrsl names and one-line docs, so that they
+/// cannot disagree.
 macro_rules! builtins {
-    ($($variant:ident = $name:literal,)*) => {
+    ($($variant:ident = $name:literal: $doc:literal,)*) => {
         /// A builtin function.
         #[derive(Debug, Clone, Copy, PartialEq, Eq)]
         pub enum Builtin {
@@ -32,68 +33,75 @@ impl Builtin {
                     $(Builtin::$variant => $name,)*
                 }
             }
+
+            /// What it computes, in a line (for an editor's hover and completion).
+            pub fn doc(self) -> &'static str {
+                match self {
+                    $(Builtin::$variant => $doc,)*
+                }
+            }
         }
     };
 }
 
 builtins! {
-    Sin = "sin",
-    Cos = "cos",
-    Tan = "tan",
-    Asin = "asin",
-    Acos = "acos",
-    Atan = "atan",
-    Sinh = "sinh",
-    Cosh = "cosh",
-    Tanh = "tanh",
-    Exp = "exp",
-    Exp2 = "exp2",
-    Log = "log",
-    Log2 = "log2",
-    Sqrt = "sqrt",
-    InverseSqrt = "inversesqrt",
-    Floor = "floor",
-    Ceil = "ceil",
-    Fract = "fract",
-    Round = "round",
-    Trunc = "trunc",
-    Saturate = "saturate",
-    Radians = "radians",
-    Degrees = "degrees",
-    Abs = "abs",
-    Sign = "sign",
-    Pow = "pow",
-    Atan2 = "atan2",
-    Step = "step",
-    Min = "min",
-    Max = "max",
-    Clamp = "clamp",
-    Mix = "mix",
-    Lerp = "lerp",
-    Smoothstep = "smoothstep",
-    Dot = "dot",
-    Cross = "cross",
-    Normalize = "normalize",
-    Length = "length",
-    Distance = "distance",
-    Reflect = "reflect",
-    Refract = "refract",
-    FaceForward = "faceforward",
-    Determinant = "determinant",
-    Transpose = "transpose",
-    Any = "any",
-    All = "all",
-    Ddx = "ddx",
-    Ddy = "ddy",
-    Fwidth = "fwidth",
-    DdxSurface = "ddx_surface",
-    DdySurface = "ddy_surface",
-    FwidthSurface = "fwidth_surface",
-    Sample = "sample",
-    SampleLevel = "sample_level",
-    SampleGrad = "sample_grad",
-    Load = "load",
-    TextureSize = "texture_size",
+    Sin = "sin": "The sine of an angle in radians.",
+    Cos = "cos": "The cosine of an angle in radians.",
+    Tan = "tan": "The tangent of an angle in radians.",
+    Asin = "asin": "The arc sine, in radians; x from -1 to 1.",
+    Acos = "acos": "The arc cosine, in radians; x from -1 to 1.",
+    Atan = "atan": "The arc tangent, in radians.",
+    Sinh = "sinh": "The hyperbolic sine.",
+    Cosh = "cosh": "The hyperbolic cosine.",
+    Tanh = "tanh": "The hyperbolic tangent.",
+    Exp = "exp": "e raised to the power x.",
+    Exp2 = "exp2": "2 raised to the power x.",
+    Log = "log": "The natural logarithm; x > 0.",
+    Log2 = "log2": "The base-2 logarithm; x > 0.",
+    Sqrt = "sqrt": "The square root; x >= 0.",
+    InverseSqrt = "inversesqrt": "1 / sqrt(x); x > 0.",
+    Floor = "floor": "The largest integer not above x.",
+    Ceil = "ceil": "The smallest integer not below x.",
+    Fract = "fract": "x - floor(x).",
+    Round = "round": "x rounded to the nearest integer, halves to even.",
+    Trunc = "trunc": "x rounded towards zero.",
+    Saturate = "saturate": "x clamped to 0 to 1.",
+    Radians = "radians": "Degrees converted to radians.",
+    Degrees = "degrees": "Radians converted to degrees.",
+    Abs = "abs": "The absolute value (int, uint, float or a vector of one).",
+    Sign = "sign": "-1, 0 or 1 by the sign of x (not uint).",
+    Pow = "pow": "x raised to the power y; x >= 0.",
+    Atan2 = "atan2": "The angle of the point (x, y) from the x axis, atan2(y, x), in radians.",
+    Step = "step": "0 where x < edge, else 1: step(edge, x); edge may be a scalar.",
+    Min = "min": "The smaller of two values; either may be a scalar.",
+    Max = "max": "The larger of two values; either may be a scalar.",
+    Clamp = "clamp": "x clamped to lo to hi: clamp(x, lo, hi); lo and hi may be scalars.",
+    Mix = "mix": "The linear blend a + (b - a) t: mix(a, b, t); t may be a scalar.",
+    Lerp = "lerp": "The same as mix: lerp(a, b, t).",
+    Smoothstep = "smoothstep": "The Hermite step from 0 at e0 to 1 at e1: smoothstep(e0, e1, x).",
+    Dot = "dot": "The dot product of two vectors of one type.",
+    Cross = "cross": "The cross product of two float3s.",
+    Normalize = "normalize": "The vector scaled to length 1.",
+    Length = "length": "The length of a vector (the absolute value of a scalar).",
+    Distance = "distance": "The distance between two points.",
+    Reflect = "reflect": "The incident direction i reflected about the normal n: reflect(i, n).",
+    Refract = "refract": "The incident direction refracted through the normal with ratio eta: refract(i, n, eta).",
+    FaceForward = "faceforward": "n, or -n where dot(nref, i) >= 0: faceforward(n, i, nref).",
+    Determinant = "determinant": "The determinant of a square matrix.",
+    Transpose = "transpose": "The transpose of a square matrix.",
+    Any = "any": "Whether any component is true.",
+    All = "all": "Whether every component is true.",
+    Ddx = "ddx": "The difference of x to the neighbouring sample in x (effect bodies only).",
+    Ddy = "ddy": "The difference of x to the neighbouring sample in y (effect bodies only).",
+    Fwidth = "fwidth": "abs(ddx(x)) + abs(ddy(x)) (effect bodies only).",
+    DdxSurface = "ddx_surface": "ddx, taken on this side of the effect's keys at coarse rate (effect bodies only).",
+    DdySurface = "ddy_surface": "ddy, taken on this side of the effect's keys at coarse rate (effect bodies only).",
+    FwidthSurface = "fwidth_surface": "fwidth, taken on this side of the effect's keys at coarse rate (effect bodies only).",
+    Sample = "sample": "Samples a texture at uv with the gradients of uv: sample(texture, sampler, uv) (effect bodies only).",
+    SampleLevel = "sample_level": "Samples a texture at uv at mip level lod: sample_level(texture, sampler, uv, lod).",
+    SampleGrad = "sample_grad": "Samples a texture at uv with explicit gradients: sample_grad(texture, sampler, uv, ddx, ddy).",
+    Load = "load": "Reads one texel without filtering: load(texture, int2 texel [, int level]).",
+    TextureSize = "texture_size": "The size of a texture's level 0 in texels, as an int2.",
 }
 
 /// How a call to a builtin is typed: how many arguments it takes, what their

@@ -26,6 +26,7 @@
 //!
 //! The crate does no I/O and touches no GPU: everything here runs anywhere.
 
+mod attributes;
 mod budget;
 mod builtins;
 mod check;
@@ -45,6 +46,7 @@ mod span;
 mod syntax;
 mod types;
 mod validate;
+pub mod vocabulary;
 
 pub use diagnostic::{Diagnostic, Label, Severity, emit_colored, render_all};
 pub use mrsl_abi::{CompiledProgram, Kernel, KernelKind, KernelRef, Layout, Mode, Plan};

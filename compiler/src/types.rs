@@ -26,33 +26,40 @@ pub const INT: Type = Type::Scalar(Scalar::Int);
 pub const UINT: Type = Type::Scalar(Scalar::Uint);
 pub const BOOL: Type = Type::Scalar(Scalar::Bool);
 
+/// Every type a program can name, by its name: the table [`Type::from_name`]
+/// reads and the vocabulary lists (type names lex as identifiers, so no
+/// lexer table holds them).
+pub static NAMED_TYPES: [(&str, Type); 21] = {
+    use Scalar::{Bool, Float, Int, Uint};
+    [
+        ("bool", Type::Scalar(Bool)),
+        ("int", Type::Scalar(Int)),
+        ("uint", Type::Scalar(Uint)),
+        ("float", Type::Scalar(Float)),
+        ("bool2", Type::Vector(Bool, 2)),
+        ("bool3", Type::Vector(Bool, 3)),
+        ("bool4", Type::Vector(Bool, 4)),
+        ("int2", Type::Vector(Int, 2)),
+        ("int3", Type::Vector(Int, 3)),
+        ("int4", Type::Vector(Int, 4)),
+        ("uint2", Type::Vector(Uint, 2)),
+        ("uint3", Type::Vector(Uint, 3)),
+        ("uint4", Type::Vector(Uint, 4)),
+        ("float2", Type::Vector(Float, 2)),
+        ("float3", Type::Vector(Float, 3)),
+        ("float4", Type::Vector(Float, 4)),
+        ("float2x2", Type::Matrix(2)),
+        ("float3x3", Type::Matrix(3)),
+        ("float4x4", Type::Matrix(4)),
+        ("texture2d", Type::Texture2d),
+        ("sampler", Type::Sampler),
+    ]
+};
+
 impl Type {
-    /// Parses a type name as written in mrsl.
+    /// Parses a type name as written in mrsl (one of [`NAMED_TYPES`]).
     pub fn from_name(name: &str) -> Option<Type> {
-        let scalar = |s: &str| match s {
-            "bool" => Some(Scalar::Bool),
-            "int" => Some(Scalar::Int),
-            "uint" => Some(Scalar::Uint),
-            "float" => Some(Scalar::Float),
-            _ => None,
-        };
-        match name {
-            "texture2d" => return Some(Type::Texture2d),
-            "sampler" => return Some(Type::Sampler),
-            "float2x2" => return Some(Type::Matrix(2)),
-            "float3x3" => return Some(Type::Matrix(3)),
-            "float4x4" => return Some(Type::Matrix(4)),
-            _ => {}
-        }
-        if let Some(s) = scalar(name) {
-            return Some(Type::Scalar(s));
-        }
-        let (base, n) = name.split_at_checked(name.len().checked_sub(1)?)?;
-        let n: u8 = n.parse().ok()?;
-        if (2..=4).contains(&n) {
-            return scalar(base).map(|s| Type::Vector(s, n));
-        }
-        None
+        NAMED_TYPES.iter().find(|(n, _)| *n == name).map(|(_, ty)| ty.clone())
     }
 
     pub fn scalar(&self) -> Option<Scalar> {
@@ -208,5 +215,21 @@ pub fn round_up(value: u32, align: u32) -> u32 {
 impl std::fmt::Display for Type {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(&self.name())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each named type is spelt back as it is named, so the table holds each
+    /// type once and under the name diagnostics use.
+    #[test]
+    fn named_types_round_trip() {
+        for (name, ty) in &NAMED_TYPES {
+            assert_eq!(ty.name(), *name);
+        }
+        assert_eq!(Type::from_name("float1"), None);
+        assert_eq!(Type::from_name("int2x2"), None);
     }
 }

@@ -8,6 +8,7 @@ use super::{
     Background, COARSE_BLOCKS, Checker, ConstId, ConstInfo, ConstValue, EffectId, EffectInfo, FunctionId, FunctionInfo,
     Global, InputId, InputInfo, KeyCompare, UniformId, UniformInfo, UniformKind, err,
 };
+use crate::attributes::{self, Target};
 use crate::builtins::Builtin;
 use crate::diagnostic::{Diagnostic, Label};
 use crate::syntax::ast::*;
@@ -205,11 +206,7 @@ impl Checker<'_> {
                     self.out.inputs[id.index()].background = rule;
                 }
                 "depth" | "encoded" | "packed" => self.channel_decode(id, attr, &ty),
-                other => self.unknown_attribute(
-                    attr,
-                    other,
-                    &["key", "surface_key", "background", "foreground", "depth", "encoded", "packed"],
-                ),
+                other => self.unknown_attribute(attr, other, &attributes::names_on(Target::Input)),
             }
         }
     }
@@ -469,8 +466,10 @@ impl Checker<'_> {
                         )),
                     }
                 }
-                (other, Rate::Coarse) => self.unknown_attribute(attr, other, &["nearest"]),
-                (other, Rate::Out) => self.unknown_attribute(attr, other, &["format"]),
+                (other, Rate::Coarse) => {
+                    self.unknown_attribute(attr, other, &attributes::names_on(Target::CoarseEffect))
+                }
+                (other, Rate::Out) => self.unknown_attribute(attr, other, &attributes::names_on(Target::Output)),
                 (other, Rate::Fine) => self.unknown_attribute(attr, other, &[]),
             }
         }

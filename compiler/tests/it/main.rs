@@ -5,6 +5,7 @@ mod corpus;
 mod examples;
 mod foreign;
 mod fuzz;
+mod highlight;
 mod interface;
 // The modes the `compile` and `wellformed` fuzz targets build, one per
 // execution; the proptest smoke of generated programs builds them the same way.
@@ -12,6 +13,7 @@ mod interface;
 mod kernels;
 mod limits;
 mod scaling;
+mod sourcegen;
 mod wellformed;
 
 use mrsl::KernelKind;

@@ -1,52 +1,83 @@
 // Syntax colouring of mrsl in CodeMirror: a stream tokenizer over the
-// language's keywords, types, attributes, numbers and comments (the
-// tokens of compiler/src/syntax). Hand-written because CodeMirror has no
-// mrsl mode, and a stream parser is what it offers for a small language.
+// language's words. The words come from vocabulary.generated.ts, which the
+// compiler's tests write from the compiler's own tables (mrsl::vocabulary,
+// as the editors' TextMate grammar is), so the playground colours what the
+// compiler reads. CodeMirror has no mrsl mode, and a stream parser is what
+// it offers for a small language.
 
 import { StreamLanguage, type StreamParser } from '@codemirror/language';
+import {
+  ATTRIBUTES,
+  BLOCK_COMMENT,
+  BOOLEANS,
+  BUILTINS,
+  CONTROL_KEYWORDS,
+  DECLARATION_KEYWORDS,
+  LINE_COMMENT,
+  NUMBER_PATTERNS,
+  OPERATORS,
+  PUNCTUATION,
+  RATE_KEYWORDS,
+  TYPES,
+} from './vocabulary.generated.js';
 
-const KEYWORDS = new Set(['in', 'uniform', 'const', 'coarse', 'fine', 'effect', 'out', 'refine', 'if', 'else', 'for', 'break', 'continue', 'return']);
-const ATOMS = new Set(['true', 'false']);
-const TYPE = /^(?:float|int|uint|bool)(?:[234](?:x[234])?)?$|^(?:texture2d|sampler)$/;
+// Each name's token type (CodeMirror's highlighting tags, `.`-joined). The
+// builtins are `special` names: the default style colours those, not `standard`.
+const WORDS = new Map<string, string>([
+  ...DECLARATION_KEYWORDS.map((w) => [w, 'definitionKeyword'] as const),
+  ...RATE_KEYWORDS.map((w) => [w, 'modifier'] as const),
+  ...CONTROL_KEYWORDS.map((w) => [w, 'controlKeyword'] as const),
+  ...BOOLEANS.map((w) => [w, 'bool'] as const),
+  ...TYPES.map((w) => [w, 'typeName'] as const),
+  ...BUILTINS.map((w) => [w, 'variableName.special'] as const),
+]);
+const ATTRIBUTE_NAMES = new Set(ATTRIBUTES);
+const NUMBERS = NUMBER_PATTERNS.map((p) => new RegExp(`^(?:${p})`));
+const [BLOCK_OPEN, BLOCK_CLOSE] = BLOCK_COMMENT;
 
 interface State {
   inComment: boolean;
 }
 
-const parser: StreamParser<State> = {
+export const mrslParser: StreamParser<State> = {
   name: 'mrsl',
   startState: () => ({ inComment: false }),
   token(stream, state) {
     if (state.inComment) {
-      if (stream.skipTo('*/')) {
-        stream.pos += 2;
+      if (stream.skipTo(BLOCK_CLOSE)) {
+        stream.pos += BLOCK_CLOSE.length;
         state.inComment = false;
       } else stream.skipToEnd();
       return 'comment';
     }
     if (stream.eatSpace()) return null;
-    if (stream.match('//')) {
+    if (stream.match(LINE_COMMENT)) {
       stream.skipToEnd();
       return 'comment';
     }
-    if (stream.match('/*')) {
+    if (stream.match(BLOCK_OPEN)) {
       state.inComment = true;
       return 'comment';
     }
-    if (stream.match(/^0[xX][0-9a-fA-F]+[uU]?/) || stream.match(/^(?:\d+\.\d*|\.\d+|\d+)(?:[eE][+-]?\d+)?[fFuUi]?/)) return 'number';
-    if (stream.match(/^@[A-Za-z_]\w*/)) return 'meta';
-    const word = stream.match(/^[A-Za-z_]\w*/);
+    // In order: a float's digits would also match as a decimal.
+    if (NUMBERS.some((n) => stream.match(n))) return 'number';
+    const attribute = stream.match(/^@\s*([\p{XID_Start}_]\p{XID_Continue}*)/u, false) as RegExpMatchArray | null;
+    if (attribute && ATTRIBUTE_NAMES.has(attribute[1] ?? '')) {
+      stream.pos += attribute[0].length;
+      return 'meta';
+    }
+    const word = stream.match(/^[\p{XID_Start}_]\p{XID_Continue}*/u) as RegExpMatchArray | null;
     if (word) {
-      const text = (word as RegExpMatchArray)[0];
-      if (KEYWORDS.has(text)) return 'keyword';
-      if (ATOMS.has(text)) return 'atom';
-      if (TYPE.test(text)) return 'typeName';
+      const type = WORDS.get(word[0]);
+      if (type) return type;
       return stream.match(/^\s*\(/, false) ? 'variableName.function' : 'variableName';
     }
+    if (OPERATORS.some((op) => stream.match(op))) return 'operator';
+    if (PUNCTUATION.some((p) => stream.match(p))) return 'punctuation';
     stream.next();
-    return /[-+*/%=<>!&|^~?:]/.test(stream.current()) ? 'operator' : null;
+    return null;
   },
-  languageData: { commentTokens: { line: '//', block: { open: '/*', close: '*/' } } },
+  languageData: { commentTokens: { line: LINE_COMMENT, block: { open: BLOCK_OPEN, close: BLOCK_CLOSE } } },
 };
 
-export const mrsl = StreamLanguage.define(parser);
+export const mrsl = StreamLanguage.define(mrslParser);
