@@ -231,9 +231,12 @@ fn the_generator_knows_every_warning() {
             stack.extend(std::fs::read_dir(&path).unwrap().map(|e| e.unwrap().path()));
         } else if path.extension().is_some_and(|e| e == "rs") {
             let text = std::fs::read_to_string(&path).unwrap();
-            for (at, _) in text.match_indices("Diagnostic::warning(\"") {
-                let code = &text[at + "Diagnostic::warning(\"".len()..];
-                codes.insert(code[..code.find('"').unwrap()].to_string());
+            // rustfmt may break the line after the opening parenthesis.
+            for (at, _) in text.match_indices("Diagnostic::warning(") {
+                let code = text[at + "Diagnostic::warning(".len()..].trim_start();
+                if let Some(code) = code.strip_prefix('"') {
+                    codes.insert(code[..code.find('"').unwrap()].to_string());
+                }
             }
         }
     }
