@@ -59,7 +59,8 @@ fn every_mode_renders_alone() {
 /// cannot give, is an error at the program's `in` declaration before
 /// anything renders or is written: with the scene's channels and a "did you
 /// mean", or the declaration to write instead; a uniform without a value,
-/// at its `uniform` declaration with the `--set` to pass.
+/// at its `uniform` declaration with the `--set` to pass. `check --scene`
+/// reports the same without rendering.
 fn scene_channels_are_checked_at_their_declarations() {
     let dir = scratch("channels");
     let cases = [
@@ -90,6 +91,13 @@ fn scene_channels_are_checked_at_their_declarations() {
             assert!(said.contains(text), "{file}: no `{text}` in:\n{said}");
         }
         assert!(!out.exists(), "{file}: nothing is written when the program cannot be bound");
+        // `check --scene` says the same without rendering.
+        let checked = mrslc(&["check", program.to_str().unwrap(), "--scene", "demo"]);
+        let said = stderr(&checked);
+        assert_eq!(checked.status.code(), Some(1), "{file}: {said}");
+        for text in expected {
+            assert!(said.contains(text), "{file}, check --scene: no `{text}` in:\n{said}");
+        }
     }
     // A uniform without a default (an array takes none) that neither the scene nor --set gives.
     let program = dir.join("unset.mrsl");
@@ -105,6 +113,10 @@ fn scene_channels_are_checked_at_their_declarations() {
     }
     assert!(!out.exists(), "nothing is written when a uniform has no value");
     let set = ["--set", "tint=1,0.5,0.25,1,0,0,0,0"];
+    let checked = mrslc(&["check", program.to_str().unwrap(), "--scene", "demo"]);
+    assert!(checked.status.code() == Some(1) && stderr(&checked).contains("error[E0803]"), "{}", stderr(&checked));
+    let checked = mrslc(&["check", program.to_str().unwrap(), "--scene", "demo", set[0], set[1]]);
+    assert!(checked.status.success() && stderr(&checked).contains("ok on scene `demo`"), "{}", stderr(&checked));
     let run = mrslc(&[
         "render",
         program.to_str().unwrap(),
