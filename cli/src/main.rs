@@ -23,6 +23,7 @@ mod serve;
 mod setup;
 mod suite;
 mod timing;
+mod why;
 
 #[derive(Parser)]
 #[command(name = "mrslc", version, about = "Compiler for mrsl, a multi-rate shading language", long_about = None)]
