@@ -109,10 +109,11 @@ fn uniform_diagnostics(source: &str, shader: &mrsl_runtime::Shader, scene: &str)
     for field in unset {
         let Some(span) = mrsl::declaration_span(source, &field.name) else { continue };
         let (name, ty, count) = (&field.name, &field.ty, field.ty.components());
-        let default = if matches!(ty, mrsl_abi::ValueType::Array(..)) {
-            "an array takes no default".to_string()
-        } else {
-            format!("or give it one: `uniform {ty} {name} = ...;`")
+        let default = match ty {
+            mrsl_abi::ValueType::Array(element, n) => {
+                format!("or give it one: `uniform {element} {name}[{n}] = {{ ... }};` ({n} elements)")
+            }
+            _ => format!("or give it one: `uniform {ty} {name} = ...;`"),
         };
         diagnostics.push(
             Diagnostic::error("E0803", format!("uniform `{name}` has no value"))

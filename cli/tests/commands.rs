@@ -128,12 +128,21 @@ fn scene_channels_are_checked_at_their_declarations() {
         set[1],
     ]);
     assert!(run.status.success(), "with --set: {}", stderr(&run));
+    // The same values as the array's default, `= { ... }`: no --set needed,
+    // and the image is the one --set gave.
+    let defaulted = dir.join("defaulted.mrsl");
+    let source = source.replace("tint[2];", "tint[2] = { float4(1.0, 0.5, 0.25, 1.0), float4(0.0) };");
+    std::fs::write(&defaulted, source).unwrap();
+    let run = mrslc(&["render", defaulted.to_str().unwrap(), "--size", "24x16", "--out", out.to_str().unwrap()]);
+    assert!(run.status.success(), "with a default: {}", stderr(&run));
+    let read = |stem: &str| std::fs::read(out.join(format!("{stem}.coarse4x4.png"))).unwrap();
+    assert!(read("defaulted") == read("unset"), "the default renders as the values set");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// A many-light program written for the mesh scenes' rig (uniform arrays,
-/// which take no defaults) renders on the built-in demo the first time: the
-/// demo carries a light rig too.
+/// A many-light program written for the mesh scenes' rig (uniform arrays
+/// without defaults) renders on the built-in demo the first time: the demo
+/// carries a light rig too.
 fn the_demo_lights_a_program_written_for_the_rig() {
     let dir = scratch("rig");
     let program = dir.join("lights.mrsl");
