@@ -356,11 +356,11 @@ impl Checker<'_> {
         let texture = matches!(self.out.uniforms[id.index()].kind, UniformKind::Texture | UniformKind::Sampler);
         if let (Some(default), true) = (&d.default, texture) {
             self.error(err("E0114", "textures and samplers cannot have a default", default.span, "remove this"));
-        } else if let Some(default) = &d.default {
-            if let Some(values) = self.uniform_default(default, &ty) {
-                self.out.uniforms[id.index()].kind =
-                    UniformKind::Value { default: Some(ConstValue { ty: ty.clone(), values }) };
-            }
+        } else if let Some(default) = &d.default
+            && let Some(values) = self.uniform_default(default, &ty)
+        {
+            self.out.uniforms[id.index()].kind =
+                UniformKind::Value { default: Some(ConstValue { ty: ty.clone(), values }) };
         }
         if let (Some(elements), Type::Array(element, n)) = (&d.elements, &ty)
             && !element.is_error()
