@@ -3,6 +3,7 @@
 mod contract;
 mod corpus;
 mod examples;
+mod format;
 mod fuzz;
 mod interface;
 // The modes the `compile` and `wellformed` fuzz targets build, one per
