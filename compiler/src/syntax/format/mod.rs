@@ -6,7 +6,7 @@
 //! from the source ([`trivia`]), and the tree is printed as a Wadler-style
 //! document by the `pretty` crate, which chooses the line breaks: a group
 //! stays on one line when it fits in [`WIDTH`] columns and breaks otherwise.
-//! The layout, in short (`docs/language.md` has the reference):
+//! The layout, in short (docs/language.md, section 1, says it for users):
 //!
 //! - four spaces a level; one declaration or statement a line; at most one
 //!   blank line where the author left any between declarations, statements

@@ -68,14 +68,14 @@ fn long_lines_break_at_operators_and_between_arguments() {
         "fine out float4 color = float4(\n    normal.x * gain + normal.y * gain + normal.z * gain,\n    \
          saturate(dot(normal, light)),\n    0.5);\n",
     );
-    let sum = format!("const float s = {};\n", vec!["alpha_value"; 12].join(" + "));
+    let sum = format!("const float s = {};\n", ["alpha_value"; 12].join(" + "));
     formats_to(
         &sum,
         "const float s = alpha_value + alpha_value + alpha_value + alpha_value + alpha_value + alpha_value\n    \
          + alpha_value + alpha_value + alpha_value + alpha_value + alpha_value + alpha_value;\n",
     );
     // A call's only argument, itself a call, breaks inside: no staircase.
-    let nested = format!("const float n = a(b(c({})));\n", vec!["long_argument_name"; 6].join(", "));
+    let nested = format!("const float n = a(b(c({})));\n", ["long_argument_name"; 6].join(", "));
     formats_to(
         &nested,
         "const float n = a(b(c(\n    long_argument_name,\n    long_argument_name,\n    long_argument_name,\n    \
