@@ -516,7 +516,8 @@ impl<'a> LocalFacts<'a> {
     }
 }
 
-fn root_local(e: &Expr, checked: &Checked) -> Option<LocalId> {
+/// The local an assignment target writes (`x`, `x.y`, `x[i]`), if it is one.
+pub(crate) fn root_local(e: &Expr, checked: &Checked) -> Option<LocalId> {
     match &e.kind {
         ExprKind::Name(_) => match checked.symbols.get(&e.id) {
             Some(Symbol::Local(l)) => Some(*l),

@@ -165,7 +165,7 @@ impl Powers<'_> {
                 }
             }
             StmtKind::Assign { target, op, value } => {
-                let Some(local) = assigned_local(checked, target) else { return };
+                let Some(local) = crate::deriv::root_local(target, checked) else { return };
                 let value = self.of(checked, value);
                 let old = self.locals.get(&local).copied().unwrap_or(Power::Free);
                 let new = match op {
@@ -222,18 +222,6 @@ impl Powers<'_> {
                 call_power(checked.callees.get(&e.id), &args)
             }
         }
-    }
-}
-
-/// The local a statement assigns (`x`, `x.y`, `x[i]`), if it is one.
-fn assigned_local(checked: &Checked, target: &Expr) -> Option<LocalId> {
-    match &target.kind {
-        ExprKind::Name(_) => match checked.symbols.get(&target.id) {
-            Some(Symbol::Local(local)) => Some(*local),
-            _ => None,
-        },
-        ExprKind::Field { base, .. } | ExprKind::Index { base, .. } => assigned_local(checked, base),
-        _ => None,
     }
 }
 
