@@ -258,6 +258,7 @@ const GENERATOR_FEATURES: &[&str] = &[
     "uniform",
     "uniform default",
     "uniform array",
+    "uniform array default",
     "texture2d",
     "sampler",
     "const",
@@ -351,11 +352,11 @@ const GENERATOR_FEATURES: &[&str] = &[
 #[test]
 fn the_generator_covers_the_language() {
     let mut seen = std::collections::BTreeSet::new();
-    for seed in 0..400 {
+    for seed in 0..1000 {
         seen.extend(wellformed::program(&mut SplitMix(seed)).features);
     }
     let missing: Vec<&&str> = GENERATOR_FEATURES.iter().filter(|f| !seen.contains(**f)).collect();
-    assert!(missing.is_empty(), "400 generated programs never use {missing:?}");
+    assert!(missing.is_empty(), "1,000 generated programs never use {missing:?}");
     if let Ok(dir) = std::env::var("MRSL_WELLFORMED_DUMP") {
         // Writes a few programs to look at: MRSL_WELLFORMED_DUMP=/tmp/gen.
         std::fs::create_dir_all(&dir).unwrap();

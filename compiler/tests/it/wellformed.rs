@@ -566,7 +566,13 @@ impl<'c> Gen<'c> {
                 self.feat("uniform array");
                 let ty = self.pick(&[V(S::F, 4), V(S::I, 4), V(S::U, 4), M(4)]);
                 let len = 1 + self.below(16) as u32;
-                let _ = writeln!(self.out, "uniform {} {name}[{len}];", ty.name());
+                if self.chance(1, 3) {
+                    self.feat("uniform array default");
+                    let elements: Vec<String> = (0..len).map(|_| self.const_expr(ty).text).collect();
+                    let _ = writeln!(self.out, "uniform {} {name}[{len}] = {{ {} }};", ty.name(), elements.join(", "));
+                } else {
+                    let _ = writeln!(self.out, "uniform {} {name}[{len}];", ty.name());
+                }
                 self.arrays.push(Array { name, ty, len });
             }
             _ => {
