@@ -171,6 +171,11 @@ fn a_scripted_session() {
     let edit = &actions[0]["edit"]["changes"][URI][0];
     assert_eq!((&edit["newText"], &edit["range"]), (&json!("float3"), &d["range"]));
 
+    // While the error stands, an effect's hover shows its facts from before the edit.
+    let stale = client.ask("textDocument/hover", at(&broken, "diffuse", 0, 0));
+    let stale = stale["contents"]["value"].as_str().unwrap();
+    assert!(stale.contains("operations per evaluation") && stale.contains("last version without errors"), "{stale}");
+
     assert!(client.set_text(PROGRAM, 3).is_empty());
     let hover = client.ask("textDocument/hover", at(PROGRAM, "diffuse", 3, 2));
     let markdown = hover["contents"]["value"].as_str().unwrap();

@@ -2,7 +2,7 @@
 //! arrives so that every request after it reads the same facts.
 
 use super::text::{Encoding, Text};
-use mrsl::{Analysis, Declaration};
+use mrsl::{Analysis, Declaration, EffectFacts};
 use std::sync::Arc;
 
 /// A document and what the compiler found in it.
@@ -13,6 +13,10 @@ pub struct Document {
     /// program being typed rarely parses, and completion still offers the
     /// names it declared (at that version's offsets).
     pub parsed: Arc<(Text, Analysis)>,
+    /// The effects of the last version without errors: while an edit is
+    /// being typed, hover and inlay hints show the costs and slots the
+    /// effects had then (and say so) rather than none.
+    pub settled: Arc<Vec<EffectFacts>>,
 }
 
 impl Document {
@@ -21,12 +25,30 @@ impl Document {
     pub fn new(text: String, encoding: Encoding, previous: Option<Document>) -> Document {
         let text = Text::new(text, encoding);
         let analysis = mrsl::analyze(&text.text);
-        let parsed = if !analysis.declarations.is_empty() || previous.is_none() {
-            Arc::new((text.clone(), analysis.clone()))
-        } else {
-            previous.map(|p| p.parsed).expect("checked above")
+        let parsed = match &previous {
+            Some(previous) if analysis.declarations.is_empty() => previous.parsed.clone(),
+            _ => Arc::new((text.clone(), analysis.clone())),
         };
-        Document { text, analysis, parsed }
+        let errors = analysis.diagnostics.iter().any(|d| d.is_error());
+        let settled = match previous.map(|p| p.settled) {
+            Some(settled) if errors => settled,
+            _ => Arc::new(analysis.effects.clone()),
+        };
+        Document { text, analysis, parsed, settled }
+    }
+
+    /// The facts of effect `index`, and whether they come from the last
+    /// version without errors (its layout facts, by name) rather than this one.
+    pub fn effect(&self, index: usize) -> Option<(EffectFacts, bool)> {
+        let facts = self.analysis.effects.get(index)?;
+        if facts.layout.is_some() {
+            return Some((facts.clone(), false));
+        }
+        let settled = self.settled.iter().find(|e| e.name == facts.name && e.layout.is_some());
+        Some(match settled {
+            Some(old) => (EffectFacts { layout: old.layout.clone(), ..facts.clone() }, true),
+            None => (facts.clone(), false),
+        })
     }
 
     /// The declaration of the name at `offset`: the one a reference there

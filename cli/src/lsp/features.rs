@@ -105,9 +105,12 @@ pub fn hover(document: &Document, params: HoverParams) -> Option<Hover> {
 /// A declaration's signature, and for an effect what the compiler decided about it.
 fn declaration_markdown(document: &Document, declaration: &Declaration) -> String {
     let mut out = format!("```mrsl\n{}\n```\n{}", declaration.signature, declaration.kind.word());
-    if let Some(facts) = declaration.effect.and_then(|e| document.analysis.effects.get(e)) {
+    if let Some((facts, settled)) = declaration.effect.and_then(|e| document.effect(e)) {
         out.push_str(&format!(" at rate `{}`\n\n", facts.rate));
-        out.push_str(&effect_markdown(facts));
+        out.push_str(&effect_markdown(&facts));
+        if settled {
+            out.push_str("\n\n*(cost and slot as of the last version without errors)*");
+        }
     } else {
         out.push_str(&format!(" · `{}`", declaration.ty));
     }
@@ -276,7 +279,7 @@ pub fn inlay_hints(document: &Document, params: InlayHintParams) -> Vec<InlayHin
         .iter()
         .filter(|d| wanted.start <= d.name_span.end && d.name_span.start <= wanted.end)
         .filter_map(|d| {
-            let facts = analysis.effects.get(d.effect?)?;
+            let (facts, _) = document.effect(d.effect?)?;
             let layout = facts.layout.as_ref()?;
             let mut label = format!("{} ops", thousands(layout.operations?));
             if let Some(n) = layout.sample_evaluations.filter(|&n| n > 1) {
@@ -289,7 +292,7 @@ pub fn inlay_hints(document: &Document, params: InlayHintParams) -> Vec<InlayHin
                 text_edits: None,
                 tooltip: Some(InlayHintTooltip::MarkupContent(MarkupContent {
                     kind: MarkupKind::Markdown,
-                    value: effect_markdown(facts),
+                    value: effect_markdown(&facts),
                 })),
                 padding_left: Some(true),
                 padding_right: None,
