@@ -490,8 +490,13 @@ pub struct Fix {
 /// where applying it is mechanical: a "did you mean `x`?" suggestion, or a
 /// foreign word's "help: mrsl writes `x` (`vec3` is GLSL, WGSL)", when `x`
 /// is one word. Notes that describe a rewrite in prose (`help: mrsl writes
-/// a function declared C-style: ...`) name no fix.
+/// a function declared C-style: ...`) name no fix, and neither do syntax
+/// errors (E0003): there the word is one part of a construct to rewrite
+/// (`vec3<f32>`'s fix is not `float3<f32>`).
 pub fn quick_fix(diagnostic: &Diagnostic) -> Option<Fix> {
+    if diagnostic.code == "E0003" {
+        return None;
+    }
     let span = diagnostic.span()?;
     diagnostic.notes.iter().find_map(|note| {
         let rest = note.strip_prefix("did you mean `").or_else(|| note.strip_prefix("help: mrsl writes `"))?;

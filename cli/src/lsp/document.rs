@@ -24,7 +24,7 @@ impl Document {
     /// parsed version is kept when this one does not parse.
     pub fn new(text: String, encoding: Encoding, previous: Option<Document>) -> Document {
         let text = Text::new(text, encoding);
-        let analysis = mrsl::analyze(&text.text);
+        let analysis = analyze(&text.text);
         let parsed = match &previous {
             Some(previous) if analysis.declarations.is_empty() => previous.parsed.clone(),
             _ => Arc::new((text.clone(), analysis.clone())),
@@ -64,4 +64,16 @@ impl Document {
             .or_else(|| analysis.declarations.iter().position(|d| touches(d.name_span)))?;
         Some((index, analysis.declarations.get(index)?))
     }
+}
+
+/// `mrsl::analyze`, with a panic (a bug in the compiler) reported as a
+/// diagnostic of the document instead of ending the server.
+fn analyze(source: &str) -> Analysis {
+    std::panic::catch_unwind(|| mrsl::analyze(source)).unwrap_or_else(|_| Analysis {
+        diagnostics: vec![
+            mrsl::Diagnostic::bug("internal compiler error: the analysis of this program panicked")
+                .with_note("this is a bug in mrsl; please report it with the program (the server's log has the panic)"),
+        ],
+        ..Analysis::default()
+    })
 }

@@ -100,7 +100,12 @@ impl Server<'_> {
                     if self.connection.handle_shutdown(&request)? {
                         return Ok(());
                     }
-                    let response = self.request(request);
+                    let id = request.id.clone();
+                    // A panic answering one request (a bug) answers it with an error, not the session.
+                    let response = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| self.request(request)))
+                        .unwrap_or_else(|_| {
+                            error(id, ErrorCode::InternalError, "mrslc lsp panicked (see its log)".into())
+                        });
                     self.connection.sender.send(Message::Response(response))?;
                 }
                 Message::Notification(notification) => self.notification(notification)?,
