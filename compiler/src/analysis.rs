@@ -115,7 +115,7 @@ pub struct EffectLayoutFacts {
     /// trip counts, texture reads weighted; the layout's `operations`).
     pub operations: Option<u64>,
     /// The fully inlined operations the size budget counts (E0701 past
-    /// [`budget::MAX_EFFECT_OPERATIONS`]).
+    /// [`crate::MAX_EFFECT_OPERATIONS`]).
     pub inlined_operations: Option<u64>,
     /// The interface slot that carries it from the coarse to the fine pass.
     pub slot: Option<SlotFacts>,

@@ -53,6 +53,9 @@ pub use analysis::{
     Analysis, Declaration, DeclarationKind, EffectFacts, EffectLayoutFacts, Fix, Reference, SlotFacts, analyze,
     quick_fix,
 };
+/// The most operations one effect's fully inlined code may take (E0701):
+/// the limit [`EffectLayoutFacts::inlined_operations`] is measured against.
+pub use budget::MAX_EFFECT_OPERATIONS;
 pub use diagnostic::{Diagnostic, Label, Severity, emit_colored, render_all};
 pub use mrsl_abi::{CompiledProgram, Kernel, KernelKind, KernelRef, Layout, Mode, Plan};
 pub use span::Span;

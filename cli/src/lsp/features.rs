@@ -129,10 +129,11 @@ pub fn effect_markdown(facts: &EffectFacts) -> String {
     if let Some(operations) = layout.operations {
         let mut cost = format!("**cost**: {} operations per evaluation", thousands(operations));
         if let Some(inlined) = layout.inlined_operations {
+            // The size budget counts the inlined code, each loop body once (E0701).
             cost.push_str(&format!(
-                " ({} inlined, of the budget's {})",
+                "; its inlined code: {} of the size budget's {}",
                 thousands(inlined),
-                thousands(mrsl::internals::MAX_EFFECT_OPERATIONS)
+                thousands(mrsl::MAX_EFFECT_OPERATIONS)
             ));
         }
         lines.push(cost);
