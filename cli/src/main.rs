@@ -24,6 +24,7 @@ mod serve;
 mod setup;
 mod suite;
 mod timing;
+mod why;
 
 #[derive(Parser)]
 #[command(name = "mrslc", version, about = "Compiler for mrsl, a multi-rate shading language", long_about = None)]
@@ -48,6 +49,14 @@ enum Command {
     Check {
         /// The .mrsl program.
         file: PathBuf,
+        /// Also bind the program to this scene as `render` would, without
+        /// rendering: a channel the scene lacks or holds with another type,
+        /// or a uniform nothing sets, is an error (E0801-E0803).
+        #[arg(long)]
+        scene: Option<String>,
+        /// Set a uniform, as for `render` (with --scene).
+        #[arg(long = "set", value_parser = args::parse_set, requires = "scene")]
+        sets: Vec<(String, Vec<f64>)>,
     },
     /// Compile a program to WGSL kernels and a layout description.
     ///
@@ -356,7 +365,7 @@ fn main() -> ExitCode {
 
 fn run(cli: &Cli) -> Result<ExitCode> {
     match &cli.command {
-        Command::Check { file } => check(cli.color, file),
+        Command::Check { file, scene, sets } => check(cli.color, file, scene.as_deref(), sets),
         Command::Render(r) => {
             let args = r.args();
             Ok(written(match args.frames {
@@ -380,9 +389,16 @@ fn run(cli: &Cli) -> Result<ExitCode> {
 }
 
 /// `mrslc check`: the diagnostics; exit 1 with errors.
-fn check(color: Color, file: &Path) -> Result<ExitCode> {
+fn check(color: Color, file: &Path, scene: Option<&str>, sets: &[(String, Vec<f64>)]) -> Result<ExitCode> {
     let (name, source) = read(file)?;
-    let diagnostics = mrsl::check(&source);
+    let mut diagnostics = mrsl::check(&source);
+    if let Some(scene) = scene.filter(|_| !diagnostics.iter().any(|d| d.is_error())) {
+        let (bound, warnings) = scene_check::on_scene(&source, scene, sets)?;
+        for warning in warnings {
+            eprintln!("warning: {warning}");
+        }
+        diagnostics.extend(bound);
+    }
     report(color, &diagnostics, &name, &source);
     let errors = diagnostics.iter().filter(|d| d.is_error()).count();
     let warnings = diagnostics.len() - errors;
@@ -390,7 +406,8 @@ fn check(color: Color, file: &Path) -> Result<ExitCode> {
         eprintln!("{name}: {errors} error{}, {warnings} warning{}", plural(errors), plural(warnings));
         Ok(ExitCode::from(1))
     } else {
-        eprintln!("{name}: ok ({warnings} warning{})", plural(warnings));
+        let on = scene.map(|s| format!(" on scene `{s}`")).unwrap_or_default();
+        eprintln!("{name}: ok{on} ({warnings} warning{})", plural(warnings));
         Ok(ExitCode::SUCCESS)
     }
 }

@@ -298,6 +298,7 @@ impl Still<'_> {
         }
         if args.stats || args.output.is_none() {
             println!("{}", stats.table());
+            print!("{}", crate::why::verdicts(shader.layout(), &stats));
         }
         Ok(Run { stats, metrics, wall_ms, relative_to_reference: relative_to_reference.map(|(r, _)| r) })
     }

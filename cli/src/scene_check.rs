@@ -4,7 +4,8 @@
 //! E0802), with what the scene provides; a uniform without a default that
 //! neither the scene nor `--set` gives is one at its `uniform` declaration
 //! (E0803). The runtime refuses the same bindings later with a typed error;
-//! this says it in the program's terms.
+//! this says it in the program's terms. `render` checks before it renders;
+//! `check --scene` binds and checks without rendering ([`on_scene`]).
 
 use mrsl::{Diagnostic, Label};
 use mrsl_abi::{Layout, Scalar};
@@ -19,6 +20,48 @@ pub fn check_channels(
     scene: &str,
     channels: &[(String, wgpu::Texture)],
 ) -> Result<(), String> {
+    rendered(file, source, channel_diagnostics(source, layout, scene, channels))
+}
+
+/// The program's uniforms that have no default and were not set (by the
+/// scene or `--set`), as rendered diagnostics (`Err`).
+pub fn check_uniforms(file: &str, source: &str, shader: &mrsl_runtime::Shader, scene: &str) -> Result<(), String> {
+    rendered(file, source, uniform_diagnostics(source, shader, scene))
+}
+
+fn rendered(file: &str, source: &str, diagnostics: Vec<Diagnostic>) -> Result<(), String> {
+    if diagnostics.is_empty() { Ok(()) } else { Err(mrsl::render_all(&diagnostics, file, source)) }
+}
+
+/// `mrslc check --scene`: binds `source`'s program to `scene` as `render`
+/// does (the scene's uniforms, then `sets`), without rendering, and returns
+/// E0801-E0803 for what the binding lacks, and the binding's warnings. The
+/// scene is built at a small size: what it provides does not depend on it.
+pub fn on_scene(
+    source: &str,
+    scene: &str,
+    sets: &[(String, Vec<f64>)],
+) -> anyhow::Result<(Vec<Diagnostic>, Vec<String>)> {
+    let options = mrsl::Options::for_modes(&[mrsl::Mode::Reference]);
+    let program = mrsl::compile(source, &options)
+        .map_err(|_| anyhow::anyhow!("the program does not compile for the reference mode"))?;
+    let gpu = mrsl_lab::gpu::Gpu::new()?;
+    let mut bound = crate::setup::bind_scene_quietly(&gpu, scene, Some((64, 64)))?;
+    let diagnostics = channel_diagnostics(source, &program.layout, scene, &bound.channels);
+    if !diagnostics.is_empty() {
+        return Ok((diagnostics, vec![]));
+    }
+    let tile = mrsl_abi::shading_rate::DEFAULT_RATE_TILE;
+    let bound = crate::setup::bind_program(&gpu, &mut bound, scene, &program, sets, tile)?;
+    Ok((uniform_diagnostics(source, &bound.shader, scene), bound.warnings))
+}
+
+fn channel_diagnostics(
+    source: &str,
+    layout: &Layout,
+    scene: &str,
+    channels: &[(String, wgpu::Texture)],
+) -> Vec<Diagnostic> {
     let provided: Vec<(&str, String)> =
         channels.iter().map(|(name, texture)| (name.as_str(), readable_as(texture.format()))).collect();
     let listing = provided.iter().map(|(name, ty)| format!("{name} ({ty})")).collect::<Vec<_>>().join(", ");
@@ -56,22 +99,21 @@ pub fn check_channels(
         };
         diagnostics.push(d);
     }
-    if diagnostics.is_empty() { Ok(()) } else { Err(mrsl::render_all(&diagnostics, file, source)) }
+    diagnostics
 }
 
-/// The program's uniforms that have no default and were not set (by the
-/// scene or `--set`), as rendered diagnostics (`Err`).
-pub fn check_uniforms(file: &str, source: &str, shader: &mrsl_runtime::Shader, scene: &str) -> Result<(), String> {
+fn uniform_diagnostics(source: &str, shader: &mrsl_runtime::Shader, scene: &str) -> Vec<Diagnostic> {
     let fields = shader.layout().uniforms.iter().flat_map(|block| &block.fields);
     let unset = fields.filter(|f| f.default.is_none() && shader.uniform(&f.name).is_none());
     let mut diagnostics = vec![];
     for field in unset {
         let Some(span) = mrsl::declaration_span(source, &field.name) else { continue };
         let (name, ty, count) = (&field.name, &field.ty, field.ty.components());
-        let default = if matches!(ty, mrsl_abi::ValueType::Array(..)) {
-            "an array takes no default".to_string()
-        } else {
-            format!("or give it one: `uniform {ty} {name} = ...;`")
+        let default = match ty {
+            mrsl_abi::ValueType::Array(element, n) => {
+                format!("or give it one: `uniform {element} {name}[{n}] = {{ ... }};` ({n} elements)")
+            }
+            _ => format!("or give it one: `uniform {ty} {name} = ...;`"),
         };
         diagnostics.push(
             Diagnostic::error("E0803", format!("uniform `{name}` has no value"))
@@ -79,7 +121,7 @@ pub fn check_uniforms(file: &str, source: &str, shader: &mrsl_runtime::Shader, s
                 .with_note(format!("help: pass `--set {name}=V1,V2,...` ({count} numbers for a {ty}); {default}")),
         );
     }
-    if diagnostics.is_empty() { Ok(()) } else { Err(mrsl::render_all(&diagnostics, file, source)) }
+    diagnostics
 }
 
 /// The mrsl scalar a texture of `format` gives a kernel.

@@ -116,8 +116,8 @@ impl BoundScene {
     /// Sets the uniforms the scene provides (the mesh scene's rig and
     /// camera, then the scene file's), by name and type, and renders the
     /// shadow map if the program samples `shadow_map`. Returns the textures
-    /// to bind by name (the shadow map and the scene file's images) and the
-    /// names the program declares with another type, left at its defaults.
+    /// to bind by name (the shadow map and the scene file's images) and
+    /// what could not be set ([`Prepared::warnings`]).
     pub fn prepare(&mut self, gpu: &Gpu, shader: &mut Shader) -> Result<Prepared> {
         let mut textures = vec![];
         let mut warnings = vec![];
@@ -126,14 +126,15 @@ impl BoundScene {
             if applied.set.iter().any(|name| name == "shadow_map") {
                 textures.push(("shadow_map".to_string(), mesh.shadow_map(gpu)?.clone()));
             }
-            warnings.extend(applied.warnings);
+            warnings.extend(applied.warnings.iter().map(ToString::to_string));
         }
         if let Some(rig) = &self.rig {
-            warnings.extend(rig.apply_point_lights(shader)?.warnings);
+            warnings.extend(rig.apply_point_lights(shader)?.warnings.iter().map(ToString::to_string));
         }
         if let Some(file) = &self.file {
             let bound = file.bind(gpu, shader)?;
-            warnings.extend(bound.applied.warnings);
+            warnings.extend(bound.applied.warnings.iter().map(ToString::to_string));
+            warnings.extend(bound.applied.ignored.iter().map(ToString::to_string));
             textures.extend(bound.textures);
         }
         Ok(Prepared { textures, warnings })
@@ -143,7 +144,9 @@ impl BoundScene {
 /// What [`BoundScene::prepare`] provides besides uniform values.
 pub struct Prepared {
     pub textures: Vec<(String, wgpu::Texture)>,
-    pub warnings: Vec<mrsl_lab::uniforms::Mismatch>,
+    /// What the scene could not set, rendered: names the program declares
+    /// with another type, names a scene file sets that it does not declare.
+    pub warnings: Vec<String>,
 }
 
 impl Prepared {
@@ -160,8 +163,8 @@ impl Prepared {
 pub struct BoundProgram {
     pub shader: Shader,
     pub resources: Resources,
-    /// The scene's uniforms the program declares with another type.
-    pub warnings: Vec<mrsl_lab::uniforms::Mismatch>,
+    /// [`Prepared::warnings`].
+    pub warnings: Vec<String>,
 }
 
 /// Makes `program`'s shader over `scene` (called `scene_name` in errors):

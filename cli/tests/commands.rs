@@ -59,7 +59,8 @@ fn every_mode_renders_alone() {
 /// cannot give, is an error at the program's `in` declaration before
 /// anything renders or is written: with the scene's channels and a "did you
 /// mean", or the declaration to write instead; a uniform without a value,
-/// at its `uniform` declaration with the `--set` to pass.
+/// at its `uniform` declaration with the `--set` to pass. `check --scene`
+/// reports the same without rendering.
 fn scene_channels_are_checked_at_their_declarations() {
     let dir = scratch("channels");
     let cases = [
@@ -90,6 +91,13 @@ fn scene_channels_are_checked_at_their_declarations() {
             assert!(said.contains(text), "{file}: no `{text}` in:\n{said}");
         }
         assert!(!out.exists(), "{file}: nothing is written when the program cannot be bound");
+        // `check --scene` says the same without rendering.
+        let checked = mrslc(&["check", program.to_str().unwrap(), "--scene", "demo"]);
+        let said = stderr(&checked);
+        assert_eq!(checked.status.code(), Some(1), "{file}: {said}");
+        for text in expected {
+            assert!(said.contains(text), "{file}, check --scene: no `{text}` in:\n{said}");
+        }
     }
     // A uniform without a default (an array takes none) that neither the scene nor --set gives.
     let program = dir.join("unset.mrsl");
@@ -105,6 +113,10 @@ fn scene_channels_are_checked_at_their_declarations() {
     }
     assert!(!out.exists(), "nothing is written when a uniform has no value");
     let set = ["--set", "tint=1,0.5,0.25,1,0,0,0,0"];
+    let checked = mrslc(&["check", program.to_str().unwrap(), "--scene", "demo"]);
+    assert!(checked.status.code() == Some(1) && stderr(&checked).contains("error[E0803]"), "{}", stderr(&checked));
+    let checked = mrslc(&["check", program.to_str().unwrap(), "--scene", "demo", set[0], set[1]]);
+    assert!(checked.status.success() && stderr(&checked).contains("ok on scene `demo`"), "{}", stderr(&checked));
     let run = mrslc(&[
         "render",
         program.to_str().unwrap(),
@@ -116,12 +128,21 @@ fn scene_channels_are_checked_at_their_declarations() {
         set[1],
     ]);
     assert!(run.status.success(), "with --set: {}", stderr(&run));
+    // The same values as the array's default, `= { ... }`: no --set needed,
+    // and the image is the one --set gave.
+    let defaulted = dir.join("defaulted.mrsl");
+    let source = source.replace("tint[2];", "tint[2] = { float4(1.0, 0.5, 0.25, 1.0), float4(0.0) };");
+    std::fs::write(&defaulted, source).unwrap();
+    let run = mrslc(&["render", defaulted.to_str().unwrap(), "--size", "24x16", "--out", out.to_str().unwrap()]);
+    assert!(run.status.success(), "with a default: {}", stderr(&run));
+    let read = |stem: &str| std::fs::read(out.join(format!("{stem}.coarse4x4.png"))).unwrap();
+    assert!(read("defaulted") == read("unset"), "the default renders as the values set");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// A many-light program written for the mesh scenes' rig (uniform arrays,
-/// which take no defaults) renders on the built-in demo the first time: the
-/// demo carries a light rig too.
+/// A many-light program written for the mesh scenes' rig (uniform arrays
+/// without defaults) renders on the built-in demo the first time: the demo
+/// carries a light rig too.
 fn the_demo_lights_a_program_written_for_the_rig() {
     let dir = scratch("rig");
     let program = dir.join("lights.mrsl");

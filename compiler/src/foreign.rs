@@ -355,8 +355,8 @@ pub const TABLE: &[Foreign] = &[
 
 /// What mrsl writes for a local array, which has no word of its own.
 pub const LOCAL_ARRAY: &str = "one local per element, or a loop that computes each element where it is used; a \
-                               uniform array (`uniform float4 dirs[8];`, 16-byte elements) holds values the engine \
-                               sets";
+                               uniform array (`uniform float4 dirs[2] = { ... };`, 16-byte elements) holds \
+                               constants, or values the engine sets";
 
 /// The fix for `word`, if it is a foreign word: its kind, languages and help.
 pub fn lookup(word: &str) -> Option<(Kind, &'static str, String)> {

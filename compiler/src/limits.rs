@@ -109,7 +109,8 @@ pub fn nesting(program: &Program) -> Vec<Diagnostic> {
             Item::Input(d) => walk.attributes(&d.attrs),
             Item::Uniform(d) => {
                 walk.attributes(&d.attrs);
-                walk.roots.extend(d.array_len.iter().chain(&d.default).map(Root::folded));
+                let elements = d.elements.iter().flat_map(|e| &e.items);
+                walk.roots.extend(d.array_len.iter().chain(&d.default).chain(elements).map(Root::folded));
             }
             Item::Const(d) => walk.roots.push(Root { expr: &d.value, level: CONST_LEVEL, depth: 0, operand: false }),
             Item::Function(f) => {

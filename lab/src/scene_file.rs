@@ -39,7 +39,7 @@ use crate::mesh::{DEFAULT_CREASE_ANGLE, Mesh, MeshError};
 use crate::mesh_scene::MeshScene;
 use crate::raster::RasterError;
 use crate::scene::Scene;
-use crate::uniforms::{Applied, Offered, UniformTypeError, Verdict};
+use crate::uniforms::{Applied, Ignored, Offered, UniformTypeError, Verdict};
 use mrsl_runtime::Shader;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -224,7 +224,7 @@ impl SceneFile {
     /// name and type ([`crate::uniforms`]): a mismatch is a warning in the
     /// result when the program has a default, else
     /// [`SceneFileError::UniformType`]; a name the program does not declare
-    /// is [`SceneFileError::Key`], and an image that cannot be loaded
+    /// is left out ([`Applied::ignored`]), and an image that cannot be loaded
     /// [`SceneFileError::Image`].
     pub fn bind(&self, gpu: &Gpu, shader: &mut Shader) -> Result<SceneBinding, SceneFileError> {
         let source = format!("scene file {}", self.path.display());
@@ -238,7 +238,10 @@ impl SceneFile {
             let key_error =
                 |message: String| SceneFileError::Key { path: self.path.clone(), key: key.clone(), message };
             match verdict {
-                Verdict::Absent => return Err(key_error(format!("the program has no uniform `{name}`"))),
+                Verdict::Absent => {
+                    applied.ignored.push(Ignored { source: source.clone(), name: name.clone() });
+                    continue;
+                }
                 Verdict::Skip(mismatch) => applied.warnings.push(mismatch),
                 Verdict::Bind => {
                     match value {

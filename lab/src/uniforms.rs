@@ -174,6 +174,23 @@ pub struct Applied {
     pub set: Vec<String>,
     /// Names declared with another type, left at the program's default.
     pub warnings: Vec<Mismatch>,
+    /// Names a scene file sets that the program does not declare: a scene
+    /// written for several programs sets more than each reads.
+    pub ignored: Vec<Ignored>,
+}
+
+/// A uniform a scene file sets and the program does not declare.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ignored {
+    /// Who sets it: "scene file hall.toml".
+    pub source: String,
+    pub name: String,
+}
+
+impl fmt::Display for Ignored {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} sets `{}`, which the program does not declare; ignored", self.source, self.name)
+    }
 }
 
 impl Applied {
@@ -205,6 +222,7 @@ impl Applied {
     pub fn extend(&mut self, other: Applied) {
         self.set.extend(other.set);
         self.warnings.extend(other.warnings);
+        self.ignored.extend(other.ignored);
     }
 }
 

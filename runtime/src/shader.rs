@@ -292,11 +292,14 @@ impl Shader {
 
     /// Records the program's passes for one image into `encoder`. The
     /// statistics of the last dispatch can be read with [`Shader::read_stats`]
-    /// after the encoder's commands were submitted.
+    /// after the encoder's commands were submitted. Several `encode`s before
+    /// one submit (views of several sizes, uniforms and options) each render
+    /// their own image: the control and uniform blocks are copied in the
+    /// encoder. `_queue` is not used (it was, for those blocks).
     pub fn encode(
         &mut self,
         device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        _queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         bindings: &Bindings,
         options: DispatchOptions,
@@ -321,9 +324,12 @@ impl Shader {
             statistics: u32::from(options.statistics),
             reserved: 0,
         };
-        queue.write_buffer(&self.control, 0, bytemuck::bytes_of(&control));
+        // Copied in the encoder, not written with `queue.write_buffer` (which
+        // lands before the whole submission runs): several `encode`s of this
+        // shader before one submit each dispatch with their own values.
+        stage(device, encoder, &self.control, bytemuck::bytes_of(&control));
         if let (Some(buffer), Some(bytes)) = (&self.uniforms, &uniform_bytes) {
-            queue.write_buffer(buffer, 0, bytes);
+            stage(device, encoder, buffer, bytes);
         }
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         for id in plan.resources() {
@@ -470,6 +476,18 @@ impl Shader {
 /// The passes' GPU times from their timestamps (two per pass, in plan
 /// order): summed by stage, and from the first pass's beginning to the last
 /// pass's end.
+/// Records a copy of `bytes` into `target` (a uniform block) in `encoder`,
+/// through a buffer made for it.
+fn stage(device: &wgpu::Device, encoder: &mut wgpu::CommandEncoder, target: &wgpu::Buffer, bytes: &[u8]) {
+    use wgpu::util::DeviceExt;
+    let staging = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("mrsl staged block"),
+        contents: bytes,
+        usage: wgpu::BufferUsages::COPY_SRC,
+    });
+    encoder.copy_buffer_to_buffer(&staging, 0, target, 0, Some(bytes.len() as u64));
+}
+
 fn timings(plan: &ModePlan, ticks: &[u64], period_ns: f32) -> crate::Timings {
     let ms = |ticks: u64| ticks as f64 * f64::from(period_ns) / 1e6;
     let mut t = crate::Timings { coarse_ms: 0.0, coarse2_ms: 0.0, fine_ms: 0.0, total_ms: 0.0 };

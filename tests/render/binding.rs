@@ -76,6 +76,7 @@ fov = 45
 [uniforms]
 albedo_map = "albedo.png"
 roughness_map = { image = "rough.png", srgb = false }
+exposure = 1.5
 "#,
     )
     .unwrap();
@@ -133,6 +134,15 @@ pub fn textured_materials_are_lit_over_a_mesh_scene(gpu: &Gpu) {
     let bound = file.bind(gpu, &mut shader).unwrap();
     assert_eq!(bound.applied.set, ["albedo_map", "roughness_map"]);
     assert_eq!(bound.applied.warnings, []);
+    // A scene file written for several programs: a name this one does not
+    // declare is left out with a warning, and the render goes on.
+    let ignored: Vec<String> = bound.applied.ignored.iter().map(ToString::to_string).collect();
+    assert_eq!(ignored.len(), 1, "{ignored:?}");
+    assert!(
+        ignored[0].starts_with("scene file ")
+            && ignored[0].ends_with("sets `exposure`, which the program does not declare; ignored"),
+        "{ignored:?}"
+    );
     let formats: Vec<(&str, wgpu::TextureFormat, u32)> =
         bound.textures.iter().map(|(n, t)| (n.as_str(), t.format(), t.mip_level_count())).collect();
     assert_eq!(

@@ -25,6 +25,7 @@ mod sponza;
 mod storage_channels;
 mod suite_scenes;
 mod textures;
+mod views;
 
 pub use harness::*;
 use libtest_mimic::{Arguments, Trial};
@@ -177,6 +178,10 @@ const GPU_TESTS: &[GpuTest] = &[
     (
         "suite_scenes::generated_scene_workload_matches_its_reference",
         suite_scenes::generated_scene_workload_matches_its_reference,
+    ),
+    (
+        "views::views_in_one_submission_are_each_their_own_render",
+        views::views_in_one_submission_are_each_their_own_render,
     ),
 ];
 

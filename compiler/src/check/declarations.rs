@@ -353,50 +353,72 @@ impl Checker<'_> {
             ty = Type::Array(Box::new(ty), n);
             self.out.uniforms[id.index()].ty = ty.clone();
         }
-        if let Some(default) = &d.default {
-            match &self.out.uniforms[id.index()].kind {
-                UniformKind::Texture | UniformKind::Sampler => {
-                    self.error(err(
-                        "E0114",
-                        "textures and samplers cannot have a default",
-                        default.span,
-                        "remove this",
-                    ));
-                }
-                UniformKind::Value { .. } => {
-                    let value = self.const_eval(default);
-                    match value {
-                        // `uniform uint u = -1;`, `uniform int i = 2147483647 + 1;`.
-                        Some(v)
-                            if (v.ty.converts_to(&ty) || v.ty == ty)
-                                && super::fold::misfit(&ty, &v.values).is_some() =>
-                        {
-                            let name = super::fold::misfit(&ty, &v.values).unwrap_or("its type");
-                            self.error(err(
-                                "E0205",
-                                format!("uniform default out of range for `{name}`"),
-                                default.span,
-                                "out of range",
-                            ));
-                        }
-                        Some(v) if v.ty.converts_to(&ty) || v.ty == ty => {
-                            self.out.uniforms[id.index()].kind =
-                                UniformKind::Value { default: Some(ConstValue { ty: ty.clone(), values: v.values }) };
-                        }
-                        Some(v) => self.error(err(
-                            "E0201",
-                            format!("default value has type `{}`, but the uniform is `{ty}`", v.ty),
-                            default.span,
-                            "wrong type",
-                        )),
-                        None => self.error(err(
-                            "E0115",
-                            "a uniform default must be a constant expression",
-                            default.span,
-                            "not constant",
-                        )),
-                    }
-                }
+        let texture = matches!(self.out.uniforms[id.index()].kind, UniformKind::Texture | UniformKind::Sampler);
+        if let (Some(default), true) = (&d.default, texture) {
+            self.error(err("E0114", "textures and samplers cannot have a default", default.span, "remove this"));
+        } else if let Some(default) = &d.default
+            && let Some(values) = self.uniform_default(default, &ty)
+        {
+            self.out.uniforms[id.index()].kind =
+                UniformKind::Value { default: Some(ConstValue { ty: ty.clone(), values }) };
+        }
+        if let (Some(elements), Type::Array(element, n)) = (&d.elements, &ty)
+            && !element.is_error()
+        {
+            if elements.items.len() != *n as usize {
+                let k = elements.items.len();
+                self.error(err(
+                    "E0118",
+                    format!("the default has {k} element{}, the array {n}", if k == 1 { "" } else { "s" }),
+                    elements.span,
+                    format!("{n} expected"),
+                ));
+                return;
+            }
+            let values: Vec<Option<Vec<f64>>> =
+                elements.items.iter().map(|item| self.uniform_default(item, element)).collect();
+            if values.iter().all(Option::is_some) {
+                let values = values.into_iter().flatten().flatten().collect();
+                self.out.uniforms[id.index()].kind =
+                    UniformKind::Value { default: Some(ConstValue { ty: ty.clone(), values }) };
+            }
+        }
+    }
+
+    /// The components of a uniform's default (or of one element of an
+    /// array's) of type `ty`: a constant expression (E0115) of that type
+    /// (E0201) with values it holds (E0205).
+    fn uniform_default(&mut self, default: &Expr, ty: &Type) -> Option<Vec<f64>> {
+        match self.const_eval(default) {
+            // `uniform uint u = -1;`, `uniform int i = 2147483647 + 1;`.
+            Some(v) if (v.ty.converts_to(ty) || v.ty == *ty) && super::fold::misfit(ty, &v.values).is_some() => {
+                let name = super::fold::misfit(ty, &v.values).unwrap_or("its type");
+                self.error(err(
+                    "E0205",
+                    format!("uniform default out of range for `{name}`"),
+                    default.span,
+                    "out of range",
+                ));
+                None
+            }
+            Some(v) if v.ty.converts_to(ty) || v.ty == *ty => Some(v.values),
+            Some(v) => {
+                self.error(err(
+                    "E0201",
+                    format!("default value has type `{}`, but the uniform is `{ty}`", v.ty),
+                    default.span,
+                    "wrong type",
+                ));
+                None
+            }
+            None => {
+                self.error(err(
+                    "E0115",
+                    "a uniform default must be a constant expression",
+                    default.span,
+                    "not constant",
+                ));
+                None
             }
         }
     }

@@ -92,6 +92,15 @@ pub struct UniformDecl {
     pub name: Ident,
     pub array_len: Option<Expr>,
     pub default: Option<Expr>,
+    /// An array's default, `= { a, b, ... }`.
+    pub elements: Option<Elements>,
+    pub span: Span,
+}
+
+/// The elements of an array default, `{ a, b, ... }`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Elements {
+    pub items: Vec<Expr>,
     pub span: Span,
 }
 
