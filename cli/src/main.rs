@@ -11,6 +11,7 @@ use std::process::ExitCode;
 mod ablation;
 mod args;
 mod bench;
+mod fmt;
 mod frames;
 mod gbuffer;
 mod legend;
@@ -57,6 +58,22 @@ enum Command {
         /// Set a uniform, as for `render` (with --scene).
         #[arg(long = "set", value_parser = args::parse_set, requires = "scene")]
         sets: Vec<(String, Vec<f64>)>,
+    },
+    /// Format programs in the canonical layout, in place (only files that change are written).
+    ///
+    /// Folders are searched for .mrsl files. With --check nothing is written: each
+    /// file that would change is listed with its first changed line, and the exit
+    /// code is 1 if any would. A file that does not parse is reported and left as
+    /// it is (exit code 2).
+    Fmt {
+        /// The .mrsl programs, or folders of them.
+        files: Vec<PathBuf>,
+        /// Write nothing; list the files that are not formatted and exit 1 if any are.
+        #[arg(long)]
+        check: bool,
+        /// Format the program on standard input to standard output.
+        #[arg(long, conflicts_with_all = ["files", "check"])]
+        stdin: bool,
     },
     /// Compile a program to WGSL kernels and a layout description.
     ///
@@ -366,6 +383,9 @@ fn main() -> ExitCode {
 fn run(cli: &Cli) -> Result<ExitCode> {
     match &cli.command {
         Command::Check { file, scene, sets } => check(cli.color, file, scene.as_deref(), sets),
+        Command::Fmt { files, check, stdin } => {
+            fmt::fmt(cli.color, &fmt::FmtArgs { files, check: *check, stdin: *stdin })
+        }
         Command::Render(r) => {
             let args = r.args();
             Ok(written(match args.frames {

@@ -207,6 +207,14 @@ pub fn check(source: &str) -> Vec<Diagnostic> {
     with_stack(|| front_end(source, |_, _, _, warnings| warnings).unwrap_or_else(|errors| errors))
 }
 
+/// Formats a program in the canonical layout of `mrslc fmt` (see
+/// `syntax::format`): the same program, every comment kept. A program that
+/// does not parse is its syntax error. Runs on a thread with a large stack,
+/// like [`check`].
+pub fn format(source: &str) -> Result<String, Diagnostic> {
+    with_stack(|| syntax::format::format(source))
+}
+
 /// Compiles a program to kernels and a layout, or returns its diagnostics
 /// (errors, and warnings found alongside them).
 pub fn compile(source: &str, options: &Options) -> Result<Program, Vec<Diagnostic>> {

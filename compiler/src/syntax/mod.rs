@@ -1,6 +1,7 @@
 //! Front end: source text to [`ast::Program`], with lexical and syntax errors as diagnostics.
 
 pub mod ast;
+pub mod format;
 pub mod lexer;
 mod visit;
 

@@ -5,6 +5,7 @@ mod contract;
 mod corpus;
 mod examples;
 mod foreign;
+mod format;
 mod fuzz;
 mod highlight;
 mod interface;
