@@ -220,6 +220,22 @@ fn a_scripted_session() {
     assert_eq!(hints[0]["position"], at(PROGRAM, "diffuse", 0, "diffuse".len())["position"]);
     assert_eq!(hints.as_array().unwrap().len(), 2, "the effect and the output: {hints}");
 
+    // Formatting: one edit of the whole text to `mrslc fmt`'s layout; none when formatted.
+    let messy = PROGRAM.replace("uniform float3 light", "uniform   float3   light");
+    client.set_text(&messy, 4);
+    let document = json!({ "textDocument": { "uri": URI }, "options": { "tabSize": 4, "insertSpaces": true } });
+    let edits = client.ask("textDocument/formatting", document.clone());
+    let formatted = mrsl::format(&messy).unwrap();
+    assert!(formatted.contains("uniform float3 light"), "{formatted}");
+    assert_eq!(edits.as_array().unwrap().len(), 1, "{edits}");
+    assert_eq!(
+        (&edits[0]["newText"], &edits[0]["range"]["start"]),
+        (&json!(formatted), &json!({ "line": 0, "character": 0 }))
+    );
+    client.set_text(&formatted, 5);
+    assert_eq!(client.ask("textDocument/formatting", document), json!([]));
+    client.set_text(PROGRAM, 6);
+
     // What a client may send wrong: the server answers and goes on.
     let mut elsewhere = at(PROGRAM, "diffuse", 0, 0);
     elsewhere["textDocument"]["uri"] = json!("file:///nowhere.mrsl");

@@ -1,14 +1,14 @@
 //! The answers read from a document's analysis: diagnostics, hover,
 //! definition, references, document symbols, inlay hints (each effect's
-//! cost) and code actions (the fixes diagnostics name).
+//! cost), code actions (the fixes diagnostics name) and formatting.
 
 use super::document::Document;
 use lsp_types::{
     CodeAction, CodeActionKind, CodeActionOrCommand, CodeActionParams, DiagnosticRelatedInformation,
-    DiagnosticSeverity, DocumentSymbol, DocumentSymbolParams, DocumentSymbolResponse, GotoDefinitionParams,
-    GotoDefinitionResponse, Hover, HoverContents, HoverParams, InlayHint, InlayHintLabel, InlayHintParams,
-    InlayHintTooltip, Location, MarkupContent, MarkupKind, NumberOrString, ReferenceParams, SymbolKind, TextEdit, Uri,
-    WorkspaceEdit,
+    DiagnosticSeverity, DocumentFormattingParams, DocumentSymbol, DocumentSymbolParams, DocumentSymbolResponse,
+    GotoDefinitionParams, GotoDefinitionResponse, Hover, HoverContents, HoverParams, InlayHint, InlayHintLabel,
+    InlayHintParams, InlayHintTooltip, Location, MarkupContent, MarkupKind, NumberOrString, ReferenceParams,
+    SymbolKind, TextEdit, Uri, WorkspaceEdit,
 };
 use mrsl::{Declaration, DeclarationKind, EffectFacts, Severity, vocabulary};
 use std::collections::HashMap;
@@ -37,6 +37,7 @@ addressed! {
     InlayHintParams => |p| p.text_document.uri;
     CodeActionParams => |p| p.text_document.uri;
     lsp_types::CompletionParams => |p| p.text_document_position.text_document.uri;
+    DocumentFormattingParams => |p| p.text_document.uri;
 }
 
 /// The compiler's diagnostics in the protocol's terms: the code, the
@@ -301,6 +302,16 @@ pub fn inlay_hints(document: &Document, params: InlayHintParams) -> Vec<InlayHin
             })
         })
         .collect()
+}
+
+/// The document in `mrslc fmt`'s layout (`mrsl::format`), as one edit of
+/// the whole text; no edit when it is formatted already or does not parse
+/// (its syntax error is among the published diagnostics).
+pub fn format(document: &Document, _: DocumentFormattingParams) -> Vec<TextEdit> {
+    match mrsl::format(&document.text.text) {
+        Ok(formatted) if formatted != document.text.text => vec![TextEdit::new(document.text.whole(), formatted)],
+        _ => vec![],
+    }
 }
 
 /// A quick fix for each diagnostic in the range whose note names a

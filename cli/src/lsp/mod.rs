@@ -11,8 +11,8 @@
 //!
 //! The features live beside this file: `text` converts positions,
 //! `document` holds a document and its analysis, `features` answers hovers,
-//! definitions, references, symbols, inlay hints, code actions and
-//! diagnostics, and `completion` completes.
+//! definitions, references, symbols, inlay hints, code actions, formatting
+//! (`mrsl::format`, as `mrslc fmt`) and diagnostics, and `completion` completes.
 
 use anyhow::{Context, Result};
 use lsp_server::{Connection, ErrorCode, Message, Notification, Request, RequestId, Response};
@@ -20,8 +20,8 @@ use lsp_types::notification::{
     DidChangeTextDocument, DidCloseTextDocument, DidOpenTextDocument, Notification as _, PublishDiagnostics,
 };
 use lsp_types::request::{
-    CodeActionRequest, Completion, DocumentSymbolRequest, GotoDefinition, HoverRequest, InlayHintRequest, References,
-    Request as _,
+    CodeActionRequest, Completion, DocumentSymbolRequest, Formatting, GotoDefinition, HoverRequest, InlayHintRequest,
+    References, Request as _,
 };
 use lsp_types::{
     CodeActionProviderCapability, CompletionOptions, InitializeParams, OneOf, PositionEncodingKind,
@@ -77,6 +77,7 @@ fn capabilities(encoding: Encoding) -> ServerCapabilities {
         document_symbol_provider: Some(OneOf::Left(true)),
         inlay_hint_provider: Some(OneOf::Left(true)),
         code_action_provider: Some(CodeActionProviderCapability::Simple(true)),
+        document_formatting_provider: Some(OneOf::Left(true)),
         completion_provider: Some(CompletionOptions {
             trigger_characters: Some(vec!["@".into(), ".".into()]),
             ..CompletionOptions::default()
@@ -127,6 +128,7 @@ impl Server<'_> {
             InlayHintRequest::METHOD => self.answer(request, features::inlay_hints),
             CodeActionRequest::METHOD => self.answer(request, features::code_actions),
             Completion::METHOD => self.answer(request, completion::complete),
+            Formatting::METHOD => self.answer(request, features::format),
             method => return error(id, ErrorCode::MethodNotFound, format!("mrslc lsp does not answer `{method}`")),
         };
         match answer {

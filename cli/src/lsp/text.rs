@@ -72,6 +72,11 @@ impl Text {
         Span::new(self.offset(range.start), self.offset(range.end))
     }
 
+    /// The range of the whole text.
+    pub fn whole(&self) -> Range {
+        Range::new(Position::new(0, 0), self.position(self.text.len()))
+    }
+
     /// The identifier around `offset` (touching it on either side), if any.
     pub fn word_at(&self, offset: usize) -> Option<(Span, &str)> {
         let offset = offset.min(self.text.len());
