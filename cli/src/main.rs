@@ -15,6 +15,7 @@ mod fmt;
 mod frames;
 mod gbuffer;
 mod legend;
+mod lsp;
 mod output;
 mod rates;
 mod render;
@@ -147,6 +148,15 @@ enum Command {
         /// The port (0: any free port).
         #[arg(long, default_value_t = 8421)]
         port: u16,
+    },
+    /// Serve the language server protocol over standard input and output, for
+    /// editors: diagnostics as you type, hover with each effect's rate, cost
+    /// and interface slot, definition, references, completion, symbols, inlay
+    /// hints and quick fixes (README, "Editor setup").
+    Lsp {
+        /// Accepted for clients that pass it: standard input and output is the only transport.
+        #[arg(long, hide = true)]
+        stdio: bool,
     },
 }
 
@@ -394,6 +404,7 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         }
         Command::Gbuffer(g) => Ok(written(gbuffer_command(g))),
         Command::Serve { host, port } => serve::serve(host, *port).map(|()| ExitCode::SUCCESS),
+        Command::Lsp { stdio: _ } => lsp::serve().map(|()| ExitCode::SUCCESS),
     }
 }
 

@@ -145,7 +145,7 @@ fn type_of(format: wgpu::TextureFormat) -> String {
 
 /// What a program may declare over a texture of `format`: its type, and
 /// for four components also three (a colour target stores `float3` in four).
-fn readable_as(format: wgpu::TextureFormat) -> String {
+pub(crate) fn readable_as(format: wgpu::TextureFormat) -> String {
     let ty = type_of(format);
     match ty.strip_suffix('4') {
         Some(scalar) => format!("{scalar}3 or {ty}"),

@@ -26,6 +26,7 @@
 //!
 //! The crate does no I/O and touches no GPU: everything here runs anywhere.
 
+mod analysis;
 mod attributes;
 mod budget;
 mod builtins;
@@ -48,6 +49,13 @@ mod types;
 mod validate;
 pub mod vocabulary;
 
+pub use analysis::{
+    Analysis, Declaration, DeclarationKind, EffectFacts, EffectLayoutFacts, Fix, Reference, SlotFacts, analyze,
+    quick_fix,
+};
+/// The most operations one effect's fully inlined code may take (E0701):
+/// the limit [`EffectLayoutFacts::inlined_operations`] is measured against.
+pub use budget::MAX_EFFECT_OPERATIONS;
 pub use diagnostic::{Diagnostic, Label, Severity, emit_colored, render_all};
 pub use mrsl_abi::{CompiledProgram, Kernel, KernelKind, KernelRef, Layout, Mode, Plan};
 pub use span::Span;
@@ -334,12 +342,32 @@ fn front_end<R>(
     source: &str,
     then: impl FnOnce(&check::Checked, &graph::EffectGraph, &deriv::DerivInfo, Vec<Diagnostic>) -> R,
 ) -> Result<R, Vec<Diagnostic>> {
-    let program = syntax::parse(source).map_err(|d| vec![d])?;
+    stages(source, |analyses, diagnostics| match analyses {
+        Some((checked, graph, deriv)) if !diagnostics.iter().any(|d| d.is_error()) => {
+            Ok(then(checked, graph, deriv, diagnostics))
+        }
+        _ => Err(diagnostics),
+    })
+}
+
+/// Runs every stage that reports diagnostics on `source` and hands `then`
+/// the analyses, errors or not (`None` when the program does not parse or
+/// is past the nesting limits), and every diagnostic, sorted. [`front_end`]
+/// stops at errors; the tooling analysis ([`analyze`]) reads a program with
+/// errors too.
+fn stages<R>(
+    source: &str,
+    then: impl FnOnce(Option<(&check::Checked, &graph::EffectGraph, &deriv::DerivInfo)>, Vec<Diagnostic>) -> R,
+) -> R {
+    let program = match syntax::parse(source) {
+        Ok(program) => program,
+        Err(d) => return then(None, vec![d]),
+    };
     // Before anything recurses over the tree: past the nesting limits, stop.
     let mut too_deep = limits::nesting(&program);
     if !too_deep.is_empty() {
         sort(&mut too_deep);
-        return Err(too_deep);
+        return then(None, too_deep);
     }
     let (checked, mut diagnostics) = check::check(&program);
     let (graph, graph_diagnostics) = graph::build(&checked);
@@ -360,10 +388,7 @@ fn front_end<R>(
         diagnostics.extend(deriv_warnings::warnings(&checked, &deriv));
     }
     sort(&mut diagnostics);
-    if diagnostics.iter().any(|d| d.is_error()) {
-        return Err(diagnostics);
-    }
-    Ok(then(&checked, &graph, &deriv, diagnostics))
+    then(Some((&checked, &graph, &deriv)), diagnostics)
 }
 
 fn sort(diagnostics: &mut [Diagnostic]) {

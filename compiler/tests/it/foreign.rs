@@ -42,6 +42,19 @@ fn assert_named_fix(source: &str, word: &str, code: &str, instead: &str) {
     assert_eq!((d.code, text.as_str()), (code, word), "{rendered}");
     assert!(d.notes.iter().any(|n| n.starts_with("help: mrsl writes") && n.contains(instead)), "{rendered}");
     assert!(!d.notes.iter().any(|n| n.starts_with("expected")), "a list of expected tokens:\n{rendered}");
+    // Where the help names one word for a type or function, an editor's
+    // quick fix puts it in the word's place; syntax errors get none.
+    // (`float` (mrsl's floats are 32-bit)` names `float`; a sentence or a
+    // call, whose arguments may differ (`sample(t, s, uv)`), names nothing.)
+    let one_word = instead
+        .strip_prefix('`')
+        .and_then(|s| s.split_once('`'))
+        .filter(|(w, rest)| {
+            w.chars().all(|c| c.is_alphanumeric() || c == '_') && (rest.is_empty() || rest.starts_with(" ("))
+        })
+        .map(|(w, _)| w);
+    let expected = one_word.filter(|_| code != "E0003").map(|w| (d.span().unwrap(), w.to_string()));
+    assert_eq!(mrsl::quick_fix(&d).map(|f| (f.span, f.replacement)), expected, "{rendered}");
 }
 
 #[test]

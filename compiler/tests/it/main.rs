@@ -1,5 +1,6 @@
 //! The compiler's integration tests, in one binary (see tests/README.md).
 
+mod analysis;
 mod contract;
 mod corpus;
 mod examples;
@@ -79,6 +80,24 @@ fn compute_entry_points(wgsl: &str) -> Vec<&str> {
             let name_start = after.find("fn ").expect("an `@compute` attribute precedes a function") + 3;
             let name = &after[name_start..];
             &name[..name.find('(').expect("a function name is followed by `(`")]
+        })
+        .collect()
+}
+
+/// Every program in the top-level `examples/` folder, by file name, in name order.
+pub fn examples() -> Vec<(String, String)> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
+    let mut paths: Vec<_> = std::fs::read_dir(&dir)
+        .expect("examples/ exists")
+        .map(|entry| entry.expect("examples/ is readable").path())
+        .filter(|path| path.extension().is_some_and(|e| e == "mrsl"))
+        .collect();
+    paths.sort();
+    paths
+        .into_iter()
+        .map(|path| {
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            (name, std::fs::read_to_string(&path).expect("example is readable"))
         })
         .collect()
 }
