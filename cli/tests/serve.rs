@@ -25,6 +25,7 @@ const TESTS: &[(&str, Test)] = &[
     ("a_10_mb_program_is_413_and_the_server_goes_on", a_10_mb_program_is_413_and_the_server_goes_on),
     ("paths_outside_the_served_directory_are_400", paths_outside_the_served_directory_are_400),
     ("unknown_modes_and_scenes_are_400", unknown_modes_and_scenes_are_400),
+    ("the_editor_gets_hover_and_completion", the_editor_gets_hover_and_completion),
 ];
 
 /// Needs an adapter.
@@ -242,6 +243,35 @@ fn a_program_compiles_to_its_kernels_and_layout(server: &Server) {
     let kinds: Vec<&Value> = one["kernels"].as_array().unwrap().iter().map(|k| &k["kind"]).collect();
     assert_eq!(kinds, [&json!("reference")]);
     assert_eq!(one["kernels"][0]["block"], Value::Null);
+}
+
+/// The playground's editor help: a hover on an effect shows its rate and
+/// cost, one on a builtin its doc; completion offers the names in scope, the
+/// builtins and, after `@`, the attributes. Columns count UTF-16 units, as
+/// the browser does (an `é` before a name on its line).
+fn the_editor_gets_hover_and_completion(server: &Server) {
+    let program = "in float3 normal;\n// notes\n/*é*/ coarse effect float d = saturate(normal.y);\nfine out float4 color = float4(d);\n";
+    let at = |line: u32, character: u32| json!({ "source": program, "line": line, "character": character });
+    let hover = server.post("/api/hover", &at(3, 31)).json();
+    let text = hover["contents"]["value"].as_str().unwrap_or_default();
+    assert!(text.contains("coarse effect float d") && text.contains("operations"), "{hover}");
+    assert_eq!(hover["range"]["start"], json!({ "line": 3, "character": 31 }), "{hover}");
+    // `saturate` starts at UTF-16 column 30 (byte 31: `é` is two bytes).
+    let builtin = server.post("/api/hover", &at(2, 30)).json();
+    assert!(builtin["contents"]["value"].as_str().unwrap_or_default().contains("saturate"), "{builtin}");
+    assert_eq!(server.post("/api/hover", &at(1, 3)).json(), Value::Null, "a comment has no hover");
+    let labels = |reply: Value| -> Vec<String> {
+        reply.as_array().unwrap().iter().map(|item| item["label"].as_str().unwrap().to_string()).collect()
+    };
+    let names = labels(server.post("/api/complete", &at(3, 31)).json());
+    for name in ["d", "normal", "saturate", "float3", "refine"] {
+        assert!(names.iter().any(|n| n == name), "no `{name}` in {names:?}");
+    }
+    let source = format!("@{program}");
+    let attributes =
+        labels(server.post("/api/complete", &json!({ "source": source, "line": 0, "character": 1 })).json());
+    assert!(attributes.iter().any(|a| a == "key") && !attributes.iter().any(|a| a == "normal"), "{attributes:?}");
+    server.post("/api/hover", &json!({ "source": program })).error(400);
 }
 
 fn a_broken_program_gets_its_diagnostics_with_spans(server: &Server) {

@@ -121,6 +121,44 @@ test('the playground renders in WebGPU, and an edit renders as the Rust runtime 
   if (process.env.MRSL_PLAYGROUND_SCREENSHOT) await page.screenshot({ path: process.env.MRSL_PLAYGROUND_SCREENSHOT });
 });
 
+test('hovering an effect shows its rate and cost; completion offers names and builtins', async (t) => {
+  if (skip) return t.skip(skip);
+  const demo = readFileSync(join(REPO, 'examples', 'demo.mrsl'), 'utf8');
+  await page.locator('.cm-content').fill(demo);
+  const where = (text, into) =>
+    page.evaluate(([text, into]) => {
+      const view = window.mrslEditor;
+      const at = view.state.doc.toString().indexOf(text) + into;
+      view.dispatch({ effects: [], scrollIntoView: true, selection: { anchor: at } });
+      const box = view.coordsAtPos(at);
+      return { x: (box.left + box.right) / 2 + 2, y: (box.top + box.bottom) / 2, at };
+    }, [text, into]);
+  const name = await where('coarse effect float3 lights', 'coarse effect float3 l'.length);
+  await page.mouse.move(name.x, name.y);
+  const tooltip = page.locator('.cm-tooltip-hover .mrsl-hover');
+  await tooltip.waitFor({ timeout: 30_000 });
+  const text = await tooltip.textContent();
+  assert.match(text, /coarse effect float3 lights/, text);
+  assert.match(text, /operations/, text);
+  if (process.env.MRSL_HOVER_SCREENSHOT) await page.screenshot({ path: process.env.MRSL_HOVER_SCREENSHOT });
+  await page.mouse.move(0, 0);
+  // Typing `satu` offers the builtin `saturate`, with its doc.
+  await page.evaluate(() => {
+    const view = window.mrslEditor;
+    const end = view.state.doc.length;
+    view.dispatch({ changes: { from: end, insert: '\nconst float probe = satu' }, selection: { anchor: end + 25 } });
+    view.focus();
+  });
+  await page.keyboard.press('Control+Space');
+  const option = page.locator('.cm-tooltip-autocomplete li', { hasText: 'saturate' });
+  await option.first().waitFor({ timeout: 30_000 });
+  // Back to the demo, rendered, for the next test.
+  await page.keyboard.press('Escape');
+  const { renders } = await state();
+  await page.locator('.cm-content').fill(demo);
+  await settle('rendered', renders + 1);
+});
+
 test('a program that does not compile shows its diagnostics in the page', async (t) => {
   if (skip) return t.skip(skip);
   const broken = 'in float3 normal;\nfine out float4 color = float4(normal * undefined_name, 1.0);\n';

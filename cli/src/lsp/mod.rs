@@ -28,11 +28,12 @@ use lsp_types::{
     PublishDiagnosticsParams, ServerCapabilities, ServerInfo, TextDocumentSyncCapability, TextDocumentSyncKind, Uri,
 };
 use std::collections::HashMap;
-use text::Encoding;
+pub(crate) use text::Encoding;
 
-mod completion;
+// `completion` and `features` also answer the playground (serve::assist).
+pub(crate) mod completion;
 mod document;
-mod features;
+pub(crate) mod features;
 mod text;
 
 pub use document::Document;

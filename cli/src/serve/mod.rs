@@ -7,6 +7,7 @@
 //! never takes the server down. docs/serve.md describes the endpoints.
 
 mod api;
+mod assist;
 mod diagnostics;
 mod export;
 mod reply;
@@ -59,6 +60,8 @@ fn router(state: Arc<export::State>) -> Router {
         .route("/api/examples", get(api::examples))
         .route("/api/scenes", get(api::scenes))
         .route("/api/compile", post(api::compile))
+        .route("/api/hover", post(assist::hover))
+        .route("/api/complete", post(assist::complete))
         .route("/api/gbuffer", post(export::create))
         .route("/api/gbuffer/{key}/{file}", get(export::file))
         .fallback(not_found)

@@ -57,6 +57,31 @@ export const compile = async (source: string): Promise<Compiled> => json(await p
 export const exportGBuffer = async (scene: string, size: [number, number], source: string): Promise<Export> =>
   json(await post('/api/gbuffer', { scene, size, source }));
 
+/** A position as the language server protocol counts it: 0-based line, UTF-16 column. */
+export interface Position {
+  line: number;
+  character: number;
+}
+
+/** The language server's hover (`textDocument/hover`). */
+export interface Hover {
+  contents: { kind: string; value: string };
+  range?: { start: Position; end: Position };
+}
+
+/** A language server completion item (the fields the playground shows). */
+export interface CompletionItem {
+  label: string;
+  kind?: number;
+  detail?: string;
+  documentation?: string | { kind: string; value: string };
+}
+
+export const hover = async (source: string, at: Position): Promise<Hover | null> =>
+  json(await post('/api/hover', { source, ...at }));
+export const complete = async (source: string, at: Position): Promise<CompletionItem[]> =>
+  json(await post('/api/complete', { source, ...at }));
+
 /** A file of an export, as bytes. */
 export async function exportFile(base: string, file: string): Promise<ArrayBuffer> {
   const response = await fetch(base + file);

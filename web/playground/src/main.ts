@@ -21,6 +21,7 @@ import {
   type Stats,
 } from '../../src/index.js';
 import * as api from './api.js';
+import { completion, hover } from './assist.js';
 import { mrsl } from './language.js';
 import { drawHeatmap, drawImage, showDiagnostics, showProgram, showStats, showTimings, type ModeTiming } from './view.js';
 
@@ -244,6 +245,8 @@ async function start(): Promise<void> {
       basicSetup,
       mrsl,
       lintGutter(),
+      hover,
+      completion,
       EditorView.updateListener.of((u) => {
         if (!u.docChanged) return;
         clearTimeout(timer);
@@ -251,6 +254,8 @@ async function start(): Promise<void> {
       }),
     ],
   });
+  // For the browser test: the editor, to find where a name is drawn.
+  (window as unknown as { mrslEditor: EditorView }).mrslEditor = view;
   const pickExample = () => {
     const example = examples.find((e) => e.name === ui.example.value);
     if (!example) return;
