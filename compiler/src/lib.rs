@@ -83,7 +83,7 @@ pub mod internals {
     /// A chain of `n` coarse effects `e0` .. `e{n-1}` (n >= 1), each reading
     /// the previous one and refining where its own `fwidth` is large, and
     /// one output reading the last: the program whose neighbour evaluations
-    /// once grew exponentially with `n` (see docs/performance.md).
+    /// once grew exponentially with `n` (see docs/eval/compile-performance.md).
     pub fn derivative_chain(n: usize) -> String {
         let mut source = String::from("in float3 normal;\nin float2 uv;\nuniform float t = 0.05;\n\n");
         source.push_str(
