@@ -13,7 +13,7 @@
 #
 # Defaults: the scenes sponza, outdoor and small, 1920x1080, 3 rounds.
 # Builds mrslc in release first, unless $MRSLC names a binary to use.
-# docs/evaluation.md ("What refinement could give") reads its figures.
+# docs/eval/evaluation.md ("What refinement could give") reads its figures.
 set -eu
 usage="usage: scripts/workload-bounds.sh OUTDIR [--scene S]... [--size WxH] [--rounds N]"
 if [ $# -lt 1 ]; then
@@ -53,7 +53,7 @@ if cmp -s "$program" "$keyless"; then
     echo "workload-bounds: $program declares no key to remove" >&2
     exit 1
 fi
-# Every predicate of the workload made unreachable (docs/evaluation.md names them).
+# Every predicate of the workload made unreachable (docs/eval/evaluation.md names them).
 off="--set light_tolerance=1e9 --set shadow_tolerance=1e9 --set blocker_edge=1e9"
 raw="$out/renders/runs.txt"
 : >"$raw"

@@ -219,7 +219,7 @@ impl KernelKind {
     /// the `fine_tiles`, `fine_tile_args` and `fine_background` entry
     /// points, empty without a background rule): every per-pixel pass that
     /// writes the outputs but the reference's and the hierarchical mode's
-    /// (whose final pass measured no faster over them: docs/evaluation.md).
+    /// (whose final pass measured no faster over them: docs/eval/evaluation.md).
     pub fn has_tile_lists(self) -> bool {
         self.entry_points().contains(&entry::FINE_TILES)
     }

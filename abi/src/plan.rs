@@ -133,7 +133,7 @@ impl Plan {
 /// kernel per frame on GPUs, and on CPU devices (lavapipe, SwiftShader),
 /// which run every lane of a workgroup's masked-off code and pay for each
 /// workgroup-memory word, their coarse and fine kernels
-/// (docs/evaluation.md, "One tile kernel"). Both give the same image and
+/// (docs/eval/evaluation.md, "One tile kernel"). Both give the same image and
 /// statistics, bit for bit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

@@ -1,7 +1,7 @@
 //! Kernel sizes and pipeline-creation times of the derivative chain
 //! (`mrsl::internals::derivative_chain`), or of the programs given, on the
 //! first adapter wgpu finds (lavapipe on a machine without a GPU). The
-//! figures in docs/performance.md come from this program:
+//! figures in docs/eval/compile-performance.md come from this program:
 //!
 //! ```sh
 //! cargo run --release -p mrslc --example pipelines                # chains of length 2 to 12

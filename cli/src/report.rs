@@ -57,7 +57,7 @@ impl Point {
     /// which holds only mrsl's passes and their clears and copies), so that
     /// a speedup is the inverse of the median per-pair ratio. (The
     /// timestamp span is reported beside it, but on lavapipe it misses part of
-    /// the block modes' work: see docs/evaluation.md.)
+    /// the block modes' work: see docs/eval/evaluation.md.)
     pub fn time_ms(&self) -> f64 {
         self.relative_time * self.reference_ms
     }
@@ -313,7 +313,7 @@ fn summaries_markdown(out: &mut String, points: &[Point], scene: &str) {
         out,
         "Speedup is reference time / mode time, interpolated along each mode's quality/time frontier; \
          fewer shading operations is the reference's / the mode's by the compiler's cost model (operations per \
-         evaluation times evaluations, docs/evaluation.md), along the same frontier; \
+         evaluation times evaluations, docs/eval/evaluation.md), along the same frontier; \
          `*` marks a bound (the sweep's cheapest point already exceeds the quality: the speedup is at least this). \
          Efficiency = speedup / (1 / coarse shading rate) at MSSIM 0.99. \
          Times are paired with reference runs: speedup = 1 / median(mode time / reference time) over the pairs.\n"

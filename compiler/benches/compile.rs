@@ -1,4 +1,4 @@
-//! Compile-time benchmarks for mrsl (see docs/performance.md).
+//! Compile-time benchmarks for mrsl (see docs/performance.md; the runs are in docs/eval/compile-performance.md).
 //!
 //! Run with `cargo bench -p mrsl --bench compile [-- FILTER]`. Groups:
 //!

@@ -91,7 +91,7 @@ pub mod internals {
     /// A chain of `n` coarse effects `e0` .. `e{n-1}` (n >= 1), each reading
     /// the previous one and refining where its own `fwidth` is large, and
     /// one output reading the last: the program whose neighbour evaluations
-    /// once grew exponentially with `n` (see docs/performance.md).
+    /// once grew exponentially with `n` (see docs/eval/compile-performance.md).
     pub fn derivative_chain(n: usize) -> String {
         let mut source = String::from("in float3 normal;\nin float2 uv;\nuniform float t = 0.05;\n\n");
         source.push_str(
@@ -126,7 +126,7 @@ pub struct Options {
     /// exchanging values through workgroup memory (one barrier per coarse
     /// effect). The images are the same bit for bit. Off by default: on
     /// lavapipe, where a barrier switches every invocation's coroutine, it
-    /// made the Sponza workload's fine pass slower (docs/evaluation.md,
+    /// made the Sponza workload's fine pass slower (docs/eval/evaluation.md,
     /// `mrslc bench --ablation`); on GPUs, whose barriers are cheap, it is
     /// the layout He et al. describe, but it has not been measured on one.
     pub compact: bool,
@@ -140,7 +140,7 @@ pub struct Options {
     /// many). The images are the same bit for bit. Off by default; on
     /// lavapipe a storage texel costs about a third of a sampled one, and
     /// the hierarchical mode, which loads the key channels of five pixels
-    /// per pixel, gains most (docs/evaluation.md).
+    /// per pixel, gains most (docs/eval/evaluation.md).
     pub storage_channels: bool,
     /// Pack the hierarchical kernel's per-pixel records four words to a
     /// texel of an `rgba32uint` read-write storage texture instead of a
@@ -151,7 +151,7 @@ pub struct Options {
     /// core WebGPU (wgpu grants it with `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES`
     /// where the adapter has it, as lavapipe does; browsers with
     /// `texture-formats-tier2`). On lavapipe the hierarchical frame is about
-    /// a tenth faster (docs/evaluation.md).
+    /// a tenth faster (docs/eval/evaluation.md).
     pub packed_records: bool,
 }
 

@@ -40,7 +40,7 @@ pub fn set_workgroup_bytes(plan: &mut Plan, kernels: &[(KernelRef, u32)]) {
 /// The kinds of device `mode` has a plan of its own for (`None`: one plan
 /// for every device). The block modes run the tile kernel on GPUs and the
 /// coarse and fine kernels on CPU devices, where they measured faster
-/// (docs/evaluation.md, "One tile kernel").
+/// (docs/eval/evaluation.md, "One tile kernel").
 fn devices(mode: Mode) -> Vec<Option<Device>> {
     match mode {
         Mode::Coarse2x2 | Mode::Coarse4x4 => vec![Some(Device::Gpu), Some(Device::Cpu)],

@@ -5,7 +5,7 @@
 //! workgroup memory (`workgroupUniformLoad`); an `if` on a word indexed by
 //! the workgroup, of a read-only storage buffer and of a uniform buffer;
 //! and an `if` on a uniform-buffer word at a fixed place. `barrier_only`
-//! is the agreement without the work. docs/evaluation.md ("What llvmpipe
+//! is the agreement without the work. docs/eval/evaluation.md ("What llvmpipe
 //! charges for") holds a run.
 //!
 //! `cargo run --release -p mrsl-lab --example uniform_branch [ROUNDS]`

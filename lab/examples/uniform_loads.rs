@@ -5,7 +5,7 @@
 //! a block's corners), or that depend on the workgroup id alone, from a
 //! read-only `rgba32uint` storage texture, a read-only storage buffer and (the
 //! last) a uniform buffer; `arithmetic` is the same sum over values made
-//! without a load. docs/evaluation.md ("What llvmpipe charges for")
+//! without a load. docs/eval/evaluation.md ("What llvmpipe charges for")
 //! holds a run.
 //!
 //! `cargo run --release -p mrsl-lab --example uniform_loads [ROUNDS]`

@@ -33,7 +33,7 @@ pub struct DispatchOptions {
     /// off for frames that are only displayed or timed: the counters are
     /// workgroup atomics and a barrier per tile, whose cost depends on the
     /// program and scene (on lavapipe 8% to 35% of a coarse 4x4 frame in the
-    /// ablation of docs/evaluation.md, 18% for the demo at 640x360;
+    /// ablation of docs/eval/evaluation.md, 18% for the demo at 640x360;
     /// docs/runtime.md, section 5).
     pub statistics: bool,
     /// Which of the mode's plans to run ([`mrsl_abi::Device`]): `None`, the

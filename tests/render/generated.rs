@@ -199,10 +199,10 @@ fn forced_equals_reference(gpu: &Gpu, program: &CompiledProgram, source: &str, n
 /// there (for seeds 20 and 23, tested with `MRSL_GENERATED_SOURCE`, because
 /// lavapipe specialises the small reference kernel on a uniform its loop
 /// leaves on and folds the expression on the host; for 41 and 55 the cause
-/// is not established: docs/language.md, section 8.3). Deeper runs
+/// is not established: docs/eval/language-notes.md). Deeper runs
 /// (`MRSL_GENERATED_PROGRAMS`) can still fail where a NaN on the way to a
 /// finite output is folded away in one kernel only, or cancellation turns
-/// such an ulp into many (docs/fuzzing.md lists the two seen in 800
+/// such an ulp into many (docs/eval/fuzzing-campaigns.md lists the two seen in 800
 /// programs): read such a failure before believing it. Seed 55 is one in
 /// the tile kernel at 2x2 (`MRSL_GENERATED_PROGRAMS=60`): its output
 /// `k.x + mrsl_eval_x + uv.x` is about 0.049 from terms of about 1.5, so

@@ -632,7 +632,7 @@ pub fn sponza_lights_workload_matches_its_reference(gpu: &Gpu) {
     // block was refined), and the hierarchical mode interpolates along an
     // edge from the neighbours on a pixel's side (56.0 dB at 0.751 when it
     // shaded at every edge); at 1920x1080 both are above MSSIM 0.99
-    // (docs/evaluation.md). The bars are 3 dB below, as in the test above:
+    // (docs/eval/evaluation.md). The bars are 3 dB below, as in the test above:
     // threshold comparisons may flip a few blocks on another driver.
     // (20,427 of 20,504 visible points agreed with the shadow map.)
     for (mode, bar) in [(Mode::Coarse4x4, 39.1), (Mode::Hierarchical, 40.6)] {

@@ -62,7 +62,7 @@ fn mean_of_surfaces(reference: &Output, gpu: &Gpu, scene: &MeshScene, size: (u32
 /// neighbours on the pixel's side, and across a few pixels the lights'
 /// falloff is far from linear, which costs it up to 7 dB there against
 /// shading at every edge (its rule until 2 December 2026); at 1920x1080 it
-/// stays above MSSIM 0.99 on every scene (docs/evaluation.md).
+/// stays above MSSIM 0.99 on every scene (docs/eval/evaluation.md).
 fn every_mode_matches_the_reference(gpu: &Gpu, scene: Scene, lit: f32, bars: (f64, f64)) {
     let mut mesh_scene = scene.mesh_scene(gpu).unwrap().expect("a mesh scene");
     let plain = scene.mesh_scene(gpu).unwrap().expect("a mesh scene");
@@ -335,7 +335,7 @@ pub fn outdoor_scene_has_a_large_sky_and_matches_its_reference(gpu: &Gpu) {
 /// 0.25, 43.5 dB and 49.4 dB: at this size the part is 50 pixels tall and
 /// a pixel spans millimetres of its curved surface, where the tighter key
 /// shaded more pixels as torn; at 1920x1080 the hierarchical mode measures
-/// 47.8 dB with either key, MSSIM 0.9972, docs/evaluation.md.)
+/// 47.8 dB with either key, MSSIM 0.9972, docs/eval/evaluation.md.)
 pub fn small_scene_fills_half_the_frame_and_matches_its_reference(gpu: &Gpu) {
     let mesh = mrsl_lab::fixtures::small_shared().unwrap();
     mesh.validate().unwrap();

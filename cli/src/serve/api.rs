@@ -13,7 +13,7 @@ use serde::Deserialize;
 use serde_json::{Value, json};
 use std::sync::Arc;
 
-/// Every example with the scene it is made for (README.md's table of the examples).
+/// Every example with the scene it is made for (the table of the examples in docs/eval/examples.md).
 const EXAMPLES: [(&str, &str, &str); 10] = [
     ("demo", "demo", include_str!("../../../examples/demo.mrsl")),
     ("sponza_lights", "sponza", include_str!("../../../examples/sponza_lights.mrsl")),

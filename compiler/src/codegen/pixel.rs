@@ -117,7 +117,7 @@ impl Writer<'_, '_, '_> {
     /// effects ([`Self::effect_major_pixels`]). (A loop over the pixels, the
     /// whole work in its body, ran at about the one-pixel kernel's time on
     /// llvmpipe; the pixels written out one after the other at 0.75 of it;
-    /// docs/evaluation.md.)
+    /// docs/eval/evaluation.md.)
     pub(super) fn pixel_main(
         &mut self,
         mut prologue: impl FnMut(&mut Self, Scope),
@@ -309,7 +309,7 @@ impl Writer<'_, '_, '_> {
     /// per pixel therefore costs a masked evaluation per pixel where nothing
     /// is refined; the loop costs one per lane, and where a lane refines one
     /// pixel of its two it runs the evaluation once, not twice (ablation
-    /// "nothing refined at run time", docs/evaluation.md).
+    /// "nothing refined at run time", docs/eval/evaluation.md).
     fn effect_major_pixels(&mut self, prologue: &mut impl FnMut(&mut Self, Scope)) {
         let pixels: Vec<u32> = (0..FINE_PIXELS_PER_LANE).collect();
         self.resolve_lane_pixels(prologue);

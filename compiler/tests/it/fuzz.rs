@@ -336,7 +336,7 @@ const GENERATOR_FEATURES: &[&str] = &[
     "any/all",
     "dot",
     "?:",
-    // What earlier fuzzing found mishandled (docs/fuzzing.md, findings).
+    // What earlier fuzzing found mishandled (docs/eval/fuzzing-campaigns.md, findings).
     "?: on matrices",
     "@nearest matrix",
     "name WGSL reserves or escapes",

@@ -16,7 +16,7 @@
 //! indexing, constructors, conversions and the builtins.
 //!
 //! It also writes what the fuzzing found the compiler mishandling before
-//! (docs/fuzzing.md, findings): `?:` on matrices and `@nearest` matrix
+//! (docs/eval/fuzzing-campaigns.md, findings): `?:` on matrices and `@nearest` matrix
 //! effects, names WGSL reserves or that collide with escaped names, locals
 //! that shadow constants and functions, operations whose operands are all
 //! constant (builtins, `%`, shifts, indexing, within the ranges WGSL
