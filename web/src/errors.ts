@@ -29,10 +29,13 @@ export type ErrorKind =
   | 'rate-image-size'
   | 'bad-tile-size'
   | 'bad-option'
+  | 'not-a-texture'
+  | 'foreign-device'
   | 'pipeline'
   | 'readback'
   | 'statistics-off'
-  | 'program';
+  | 'program'
+  | 'program-file';
 
 /** An error of the mrsl web runtime, naming the binding or option at fault. */
 export class MrslError extends Error {

@@ -65,6 +65,39 @@ export function missingFeature(device: GPUDevice, bindings: readonly PassBinding
   );
 }
 
+const STORAGE_TEXTURES: readonly string[] = ['storage_texture', 'record_storage_texture', 'word_texture', 'packed_word_texture'];
+
+/**
+ * Why the device's per-stage limits refuse a kernel whose stage group has
+ * \`bindings\` (with \`storageChannels\` channels read through storage
+ * bindings in group 1, and the indirect arguments in group 3 where it
+ * writes them), or \`null\`: said before anything is made, so that the
+ * reason names the limit rather than an invalid pipeline layout.
+ */
+export function overLimits(device: GPUDevice, bindings: readonly PassBinding[], storageChannels: number, writesArguments: boolean): string | null {
+  const own = bindings.filter((b) => STORAGE_TEXTURES.includes(b.type.kind)).length;
+  const textures = own + storageChannels;
+  const textureLimit = device.limits.maxStorageTexturesPerShaderStage;
+  if (textures > textureLimit) {
+    const channels = storageChannels > 0 ? ` (${storageChannels} of them the G-buffer channels read through storage bindings)` : '';
+    const fewer = storageChannels > 0 ? 'compile without --storage-channels, or ' : '';
+    return (
+      `it binds ${textures} storage textures in its compute stage${channels}, more than the device's limit ` +
+      `maxStorageTexturesPerShaderStage, ${textureLimit}: request a device with requiredLimits: { maxStorageTexturesPerShaderStage: ${textures} } ` +
+      `where the adapter allows it (adapter.limits), ${fewer}compile only the modes the device runs (mrslc compile --mode ...)`
+    );
+  }
+  const buffers = bindings.filter((b) => b.type.kind === 'buffer').length + (writesArguments ? 1 : 0);
+  const bufferLimit = device.limits.maxStorageBuffersPerShaderStage;
+  if (buffers > bufferLimit) {
+    return (
+      `it binds ${buffers} storage buffers in its compute stage, more than the device's limit maxStorageBuffersPerShaderStage, ${bufferLimit}: ` +
+      `request a device with requiredLimits: { maxStorageBuffersPerShaderStage: ${buffers} } where the adapter allows it, or compile only the modes the device runs`
+    );
+  }
+  return null;
+}
+
 /** The stage group of a kernel, from the bindings a pass of the plan lists. */
 export function stageLayout(device: GPUDevice, label: string, bindings: readonly PassBinding[]): GPUBindGroupLayout {
   return device.createBindGroupLayout({ label, entries: bindings.map((b) => entry(b.binding, b.type)) });

@@ -1,41 +1,45 @@
-// The runtime-owned resources of a program's plan, made from their
-// descriptors the first time a mode needs them and made again only when the
-// image size changes what they hold: one cache for every mode, keyed by
-// resource id.
+// The runtime-owned resources of a program's plan, one set per image size:
+// made from their descriptors the first time a mode needs them at that
+// size, and shared by every mode that names them. Several `encode`s of one
+// Shader into one submission may use several sizes (views, split screens,
+// probes); each keeps its set, so none is destroyed while recorded commands
+// still use it, and views that keep their sizes make nothing anew frame
+// after frame. The sets of the `KEPT_SIZES` sizes used last are kept; an
+// older one is destroyed once the queue has finished the work submitted by
+// the end of the task that retired it.
 
 import type { Plan, ResourceDesc, ResourceId } from './contract.js';
 import { resourceKey } from './contract.js';
 import { extentCount, extentGrid, type Size } from './geometry.js';
 import { resourceUses, type Uses } from './plan.js';
 
+/** How many image sizes keep their resources (the sizes encoded last). */
+export const KEPT_SIZES = 4;
+
 type Made =
   | { kind: 'buffer'; buffer: GPUBuffer; bytes: number }
-  | { kind: 'texture'; texture: GPUTexture; view: GPUTextureView; extent: [number, number, number] };
+  | { kind: 'texture'; texture: GPUTexture; view: GPUTextureView };
 
-export class ResourcePool {
-  readonly #uses: Map<string, Uses>;
+/** The resources of one image size. */
+export class ResourceSet {
   readonly #made = new Map<string, Made>();
-  /** Read-back copies of buffers (`readback` steps), by resource. */
-  readonly #readbacks = new Map<string, GPUBuffer>();
 
   constructor(
     private readonly device: GPUDevice,
     private readonly plan: Plan,
-  ) {
-    this.#uses = resourceUses(plan);
-  }
+    private readonly uses: Map<string, Uses>,
+    readonly size: Size,
+  ) {}
 
-  /** Makes the resource for a `size` image unless what exists already fits it. */
-  ensure(desc: ResourceDesc, size: Size): void {
+  /** Makes the resource unless it was made. */
+  ensure(desc: ResourceDesc): void {
     const key = resourceKey(desc.id);
-    const uses = this.#uses.get(key) ?? { cleared: false, readBack: false, indirect: false, sampled: false };
+    if (this.#made.has(key)) return;
+    const uses = this.uses.get(key) ?? { cleared: false, readBack: false, indirect: false, sampled: false };
     const label = `mrsl ${desc.what.replace(/^the /, '')}`;
     const shape = desc.shape;
     if (shape.type === 'buffer') {
-      const bytes = Math.max(extentCount(this.plan.constants, shape.elements, size) * shape.words * 4, 4);
-      const made = this.#made.get(key);
-      if (made?.kind === 'buffer' && made.bytes === bytes) return;
-      if (made?.kind === 'buffer') made.buffer.destroy();
+      const bytes = Math.max(extentCount(this.plan.constants, shape.elements, this.size) * shape.words * 4, 4);
       let usage = GPUBufferUsage.STORAGE;
       if (uses.cleared) usage |= GPUBufferUsage.COPY_DST;
       if (uses.readBack) usage |= GPUBufferUsage.COPY_SRC;
@@ -43,17 +47,15 @@ export class ResourcePool {
       this.#made.set(key, { kind: 'buffer', buffer: this.device.createBuffer({ label, size: bytes, usage }), bytes });
       return;
     }
-    const [w, h] = shape.type === 'texture_array' ? (extentGrid(shape.texels, size) ?? [1, 1]) : size;
+    const [w, h] = shape.type === 'texture_array' ? (extentGrid(shape.texels, this.size) ?? [1, 1]) : this.size;
     const layers = shape.type === 'texture_array' ? Math.max(shape.layers, 1) : 1;
-    const made = this.#made.get(key);
-    if (made?.kind === 'texture' && made.extent.join() === [w, h, layers].join()) return;
-    if (made?.kind === 'texture') made.texture.destroy();
     let usage = GPUTextureUsage.STORAGE_BINDING;
-    if (uses.sampled) usage |= GPUTextureUsage.TEXTURE_BINDING;
+    // A readable texture (the refine mask) is for the page: to copy, and to sample in its own passes.
+    if (uses.sampled || desc.readable) usage |= GPUTextureUsage.TEXTURE_BINDING;
     if (desc.readable) usage |= GPUTextureUsage.COPY_SRC;
     const texture = this.device.createTexture({ label, size: [w, h, layers], format: shape.format, usage });
     const view = texture.createView({ dimension: shape.type === 'texture_array' ? '2d-array' : '2d' });
-    this.#made.set(key, { kind: 'texture', texture, view, extent: [w, h, layers] });
+    this.#made.set(key, { kind: 'texture', texture, view });
   }
 
   /** A buffer made by `ensure`. */
@@ -61,6 +63,12 @@ export class ResourcePool {
     const made = this.#made.get(resourceKey(id));
     if (made?.kind !== 'buffer') throw new Error(`${resourceKey(id)} is a buffer made before the steps that use it`);
     return made.buffer;
+  }
+
+  /** The bytes of buffer `id`. */
+  bytes(id: ResourceId): number {
+    const made = this.#made.get(resourceKey(id));
+    return made?.kind === 'buffer' ? made.bytes : 0;
   }
 
   /** Resource `id` as a bind group entry's resource. */
@@ -76,34 +84,58 @@ export class ResourcePool {
     return made?.kind === 'texture' ? made.texture : null;
   }
 
-  /** Records a copy of `bytes` (or all) of buffer `id` into its read-back buffer. */
-  copyOut(encoder: GPUCommandEncoder, id: ResourceId, bytes: number | null): void {
-    const key = resourceKey(id);
-    const made = this.#made.get(key);
-    if (made?.kind !== 'buffer') throw new Error(`${key} is a buffer made before it is read back`);
-    let readback = this.#readbacks.get(key);
-    if (!readback || readback.size !== made.bytes) {
-      readback?.destroy();
-      readback = this.device.createBuffer({
-        label: 'mrsl readback',
-        size: made.bytes,
-        usage: GPUBufferUsage.MAP_READ | GPUBufferUsage.COPY_DST,
-      });
-      this.#readbacks.set(key, readback);
-    }
-    encoder.copyBufferToBuffer(made.buffer, 0, readback, 0, bytes ?? made.bytes);
-  }
-
-  /** The read-back buffer of `id`, if it was ever copied out. */
-  readback(id: ResourceId): GPUBuffer | null {
-    return this.#readbacks.get(resourceKey(id)) ?? null;
-  }
-
-  /** Frees every resource. */
   destroy(): void {
     for (const made of this.#made.values()) (made.kind === 'buffer' ? made.buffer : made.texture).destroy();
-    for (const b of this.#readbacks.values()) b.destroy();
     this.#made.clear();
-    this.#readbacks.clear();
+  }
+}
+
+/** The resource sets of the sizes encoded last. */
+export class ResourcePool {
+  readonly #uses: Map<string, Uses>;
+  /** By size ("WxH"), the one encoded last at the end. */
+  readonly #sets = new Map<string, ResourceSet>();
+
+  constructor(
+    private readonly device: GPUDevice,
+    private readonly plan: Plan,
+  ) {
+    this.#uses = resourceUses(plan);
+  }
+
+  /** The set of `size`, made if it is not kept; it becomes the one used last. */
+  at(size: Size): ResourceSet {
+    const key = `${size[0]}x${size[1]}`;
+    let set = this.#sets.get(key);
+    this.#sets.delete(key);
+    set ??= new ResourceSet(this.device, this.plan, this.#uses, [size[0], size[1]]);
+    this.#sets.set(key, set);
+    for (const [old, retired] of this.#sets) {
+      if (this.#sets.size <= KEPT_SIZES) break;
+      this.#sets.delete(old);
+      this.#retire(retired);
+    }
+    return set;
+  }
+
+  /**
+   * Destroys `set` once the queue has finished the work submitted by the end
+   * of this task: an encoder that recorded it in this task (a page's frame
+   * encodes and submits in one) is then submitted, and done with.
+   */
+  #retire(set: ResourceSet): void {
+    const queue = this.device.queue;
+    setTimeout(() => {
+      queue.onSubmittedWorkDone().then(
+        () => set.destroy(),
+        () => set.destroy(),
+      );
+    }, 0);
+  }
+
+  /** Frees every set now. */
+  destroy(): void {
+    for (const set of this.#sets.values()) set.destroy();
+    this.#sets.clear();
   }
 }

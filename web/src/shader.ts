@@ -4,16 +4,17 @@
 // no dispatch rule of its own.
 
 import type { KernelRef, Mode, ModePlan, Pass, PlanDevice, ResourceId } from './contract.js';
-import { MODES } from './contract.js';
+import { MODES, resourceKey } from './contract.js';
 import { MrslError } from './errors.js';
 import { directWorkgroups, type DispatchContext, type Size } from './geometry.js';
 import * as groups from './groups.js';
 import { modePlan, mostPasses, passes, planResources } from './plan.js';
-import { ResourcePool } from './pool.js';
+import { ResourcePool, type ResourceSet } from './pool.js';
+import { ReadbackRing, readWords, type ReadbackSlot } from './ring.js';
 import type { CompiledProgram, Kernel } from './program.js';
 import { makeStats, type Stats, type Timings } from './stats.js';
 import { controlBytes, UniformValues } from './uniforms.js';
-import { checkBindings, checkSize } from './validate.js';
+import { checkBindings, checkSize, checkSizeShape, described } from './validate.js';
 import type { Bindings } from './bindings.js';
 
 export interface DispatchOptions {
@@ -42,8 +43,21 @@ export const DEFAULT_RATE_TILE = 8;
 interface Timestamps {
   set: GPUQuerySet;
   resolve: GPUBuffer;
-  readback: GPUBuffer;
 }
+
+/** What one `encode` recorded: its options and size, its resources, where it copied its counters. */
+interface Encoded {
+  options: Required<DispatchOptions>;
+  size: Size;
+  passes: number;
+  set: ResourceSet;
+  slot: ReadbackSlot;
+  /** Its statistics, once a `readStats` asked for them. */
+  stats: Promise<Stats> | null;
+}
+
+/** The read-back slot's key of the timestamps. */
+const TICKS = 'timestamps';
 
 const kernelKey = (k: KernelRef) => `${k.kind}/${k.block}`;
 
@@ -51,10 +65,12 @@ const kernelKey = (k: KernelRef) => `${k.kind}/${k.block}`;
 export class Shader {
   readonly #uniforms: UniformValues;
   readonly #pool: ResourcePool;
+  readonly #readbacks: ReadbackRing;
   readonly #control: GPUBuffer;
   readonly #uniformBuffer: GPUBuffer | null;
   #frame = 0;
-  #last: { options: Required<DispatchOptions>; size: Size; passes: number } | null = null;
+  #last: Encoded | null = null;
+  #destroyed = false;
 
   private constructor(
     readonly device: GPUDevice,
@@ -68,6 +84,7 @@ export class Shader {
     const layout = program.layout;
     this.#uniforms = new UniformValues(layout.uniforms);
     this.#pool = new ResourcePool(device, layout.plan);
+    this.#readbacks = new ReadbackRing(device);
     const uniform = (label: string, size: number) =>
       device.createBuffer({ label, size, usage: GPUBufferUsage.UNIFORM | GPUBufferUsage.COPY_DST });
     this.#control = uniform('mrsl control', layout.control.size);
@@ -96,7 +113,13 @@ export class Shader {
       const key = kernelKey(kernel);
       const kernelPasses = allPasses.filter((p) => kernelKey(p.kernel) === key);
       if (kernelPasses.length === 0) continue;
-      const made = await makeKernel(device, kernel, kernelPasses, { resources, gbuffer, arguments: argumentsLayout, argumentsGroup: c.arguments_group });
+      const made = await makeKernel(device, kernel, kernelPasses, {
+        resources,
+        gbuffer,
+        arguments: argumentsLayout,
+        argumentsGroup: c.arguments_group,
+        storageChannels: layout.channels.filter((ch) => ch.access === 'storage').length,
+      });
       if ('refused' in made) unavailable.set(kernel.kind, made.refused);
       else {
         stages.set(key, made.stage);
@@ -151,11 +174,18 @@ export class Shader {
   }
 
   /**
-   * Records the program's passes for one image into `encoder`. Everything is
-   * checked before anything is recorded; the statistics of the last dispatch
-   * can be read with `readStats` after the encoder's commands were submitted.
+   * Records the program's passes for one image into `encoder`. Everything
+   * WebGPU lets a page check is checked before anything is recorded (a typed
+   * `MrslError`, thrown). The returned promise settles once the device has
+   * checked what was made: it rejects with an `MrslError` where the device
+   * refused it (`foreign-device`: a texture of another GPUDevice, which
+   * WebGPU does not let a page see); that encoder must not be submitted then.
+   * Several `encode`s into one encoder (views of their own size, uniforms
+   * and options) each render their own image. The statistics of the last
+   * one can be read with `readStats` after the encoder's commands were submitted.
    */
-  encode(encoder: GPUCommandEncoder, bindings: Bindings, options: DispatchOptions): void {
+  encode(encoder: GPUCommandEncoder, bindings: Bindings, options: DispatchOptions): Promise<void> {
+    checkArguments(bindings, options, () => this.modes());
     const o: Required<DispatchOptions> = {
       mode: options.mode,
       forceRefine: options.forceRefine ?? false,
@@ -170,6 +200,7 @@ export class Shader {
     this.supports(o.mode, o.device);
     const layout = this.program.layout;
     const plan = modePlan(layout.plan, o.mode, o.device) as ModePlan;
+    checkSizeShape(bindings.size);
     checkSize(layout.plan, plan, bindings.size, this.device.limits);
     checkBindings(layout, plan, bindings, o.rateTile);
     const uniformBytes = this.#uniformBuffer ? this.#uniforms.bytes() : null;
@@ -182,33 +213,67 @@ export class Shader {
       rate_tile: [o.rateTile],
       statistics: [o.statistics ? 1 : 0],
     });
-    const queue = this.device.queue;
-    queue.writeBuffer(this.#control, 0, control);
-    if (this.#uniformBuffer && uniformBytes) queue.writeBuffer(this.#uniformBuffer, 0, uniformBytes);
-    for (const desc of planResources(layout.plan, plan)) this.#pool.ensure(desc, bindings.size);
+    this.device.pushErrorScope('validation');
+    try {
+      this.#record(encoder, bindings, o, plan, control, uniformBytes);
+    } catch (error) {
+      void this.device.popErrorScope();
+      throw error;
+    }
+    return this.device.popErrorScope().then((error) => {
+      if (error) throw deviceError(error.message);
+    });
+  }
+
+  #record(encoder: GPUCommandEncoder, bindings: Bindings, o: Required<DispatchOptions>, plan: ModePlan, control: ArrayBuffer, uniformBytes: ArrayBuffer | null): void {
+    const set = this.#pool.at(bindings.size);
+    for (const desc of planResources(this.program.layout.plan, plan)) set.ensure(desc);
+    this.#stage(encoder, control, uniformBytes);
     const shared = [this.#resourcesGroup(bindings), this.#gbufferGroup(bindings)] as const;
     const context: DispatchContext = { size: bindings.size, forced: o.forceRefine, rateTile: o.rateTile };
     const stageGroups = new Map<string, GPUBindGroup>();
+    const slot = this.#readbacks.take();
     let index = 0;
     for (const step of plan.steps) {
-      if (step.step === 'clear') encoder.clearBuffer(this.#pool.buffer(step.resource));
-      else if (step.step === 'readback') this.#pool.copyOut(encoder, step.resource, step.bytes);
-      else {
+      if (step.step === 'clear') encoder.clearBuffer(set.buffer(step.resource));
+      else if (step.step === 'readback') {
+        const size = set.bytes(step.resource);
+        slot.copy(encoder, resourceKey(step.resource), set.buffer(step.resource), step.bytes ?? size, size);
+      } else {
         const key = kernelKey(step.kernel);
         let stage = stageGroups.get(key);
-        if (!stage) stageGroups.set(key, (stage = this.#stageGroup(step, bindings)));
-        this.#recordPass(encoder, step, index++, [shared[0], shared[1], stage], context);
+        if (!stage) stageGroups.set(key, (stage = this.#stageGroup(step, bindings, set)));
+        this.#recordPass(encoder, step, index++, [shared[0], shared[1], stage], context, set);
       }
     }
     if (this.timestamps && index > 0) {
       const t = this.timestamps;
       encoder.resolveQuerySet(t.set, 0, 2 * index, t.resolve, 0);
-      encoder.copyBufferToBuffer(t.resolve, 0, t.readback, 0, 16 * index);
+      slot.copy(encoder, TICKS, t.resolve, 16 * index, t.resolve.size);
     }
-    this.#last = { options: o, size: bindings.size, passes: index };
+    this.#last = { options: o, size: [bindings.size[0], bindings.size[1]], passes: index, set, slot, stats: null };
   }
 
-  #recordPass(encoder: GPUCommandEncoder, pass: Pass, index: number, bound: GPUBindGroup[], context: DispatchContext): void {
+  /**
+   * Records copies of the control and uniform blocks into their buffers,
+   * from a buffer made for this `encode`: in order with the passes, so that
+   * several `encode`s before one submit each dispatch with their own values
+   * (`queue.writeBuffer` lands before the whole submission runs). The
+   * staging buffer is not destroyed (the page submits the encoder later):
+   * it is freed once nothing uses it.
+   */
+  #stage(encoder: GPUCommandEncoder, control: ArrayBuffer, uniforms: ArrayBuffer | null): void {
+    const size = control.byteLength + (uniforms?.byteLength ?? 0);
+    const staging = this.device.createBuffer({ label: 'mrsl staged blocks', size, usage: GPUBufferUsage.COPY_SRC, mappedAtCreation: true });
+    const mapped = new Uint8Array(staging.getMappedRange());
+    mapped.set(new Uint8Array(control), 0);
+    if (uniforms) mapped.set(new Uint8Array(uniforms), control.byteLength);
+    staging.unmap();
+    encoder.copyBufferToBuffer(staging, 0, this.#control, 0, control.byteLength);
+    if (uniforms && this.#uniformBuffer) encoder.copyBufferToBuffer(staging, control.byteLength, this.#uniformBuffer, 0, uniforms.byteLength);
+  }
+
+  #recordPass(encoder: GPUCommandEncoder, pass: Pass, index: number, bound: GPUBindGroup[], context: DispatchContext, set: ResourceSet): void {
     const timestampWrites = this.timestamps
       ? { querySet: this.timestamps.set, beginningOfPassWriteIndex: 2 * index, endOfPassWriteIndex: 2 * index + 1 }
       : undefined;
@@ -221,12 +286,12 @@ export class Shader {
         const group = this.device.createBindGroup({
           label: 'mrsl indirect arguments',
           layout: this.layouts.arguments,
-          entries: [{ binding: c.arguments_binding, resource: { buffer: this.#pool.buffer(dispatch.arguments) } }],
+          entries: [{ binding: c.arguments_binding, resource: { buffer: set.buffer(dispatch.arguments) } }],
         });
         compute.setBindGroup(c.arguments_group, group);
       }
       const w = dispatch.workgroups;
-      if (w.kind === 'indirect') compute.dispatchWorkgroupsIndirect(this.#pool.buffer(w.buffer), w.offset);
+      if (w.kind === 'indirect') compute.dispatchWorkgroupsIndirect(set.buffer(w.buffer), w.offset);
       else {
         const [x, y] = directWorkgroups(c, w, context) as [number, number];
         compute.dispatchWorkgroups(x, y, 1);
@@ -260,12 +325,12 @@ export class Shader {
   }
 
   /** Group 2 of `pass`: each binding the resource the plan names. */
-  #stageGroup(pass: Pass, bindings: Bindings): GPUBindGroup {
+  #stageGroup(pass: Pass, bindings: Bindings, set: ResourceSet): GPUBindGroup {
     const outputs = this.program.layout.outputs;
     const resource = (id: ResourceId): GPUBindingResource => {
       if (id.id === 'output') return (bindings.outputs[outputs[id.index]!.name] as GPUTexture).createView();
       if (id.id === 'shading_rate') return (bindings.shadingRate as GPUTexture).createView();
-      return this.#pool.binding(id);
+      return set.binding(id);
     };
     return this.device.createBindGroup({
       label: pass.kernel.kind,
@@ -280,44 +345,107 @@ export class Shader {
    * was evaluated per pixel, y bit k when it came from the dynamic mode's 2x2 level.
    */
   refineMask(): GPUTexture | null {
-    return this.#pool.texture({ id: 'refine_mask' });
+    return this.#last?.set.texture({ id: 'refine_mask' }) ?? null;
   }
 
-  /** Reads the statistics of the last submitted dispatch (waits for the GPU). */
-  async readStats(): Promise<Stats> {
+  /**
+   * The statistics of the last `encode`, once the GPU has run it: call it
+   * after submitting that `encode`'s encoder. It does not stall the frame
+   * loop: a page may call it every frame without waiting for it, since the
+   * next `encode`s copy their counters into other buffers. Its failures are
+   * `MrslError`s (`readback`, `statistics-off`).
+   */
+  readStats(): Promise<Stats> {
     const last = this.#last;
-    if (!last) throw new MrslError('readback', 'reading results back failed: nothing was dispatched yet');
-    if (!last.options.statistics) {
-      throw new MrslError('statistics-off', 'the last dispatch ran with statistics off, so it counted nothing');
+    if (!last) {
+      return Promise.reject(
+        new MrslError('readback', 'reading the statistics back failed: nothing was encoded yet (call `readStats` after an `encode` and the submit of its encoder)'),
+      );
     }
+    if (!last.options.statistics) {
+      return Promise.reject(new MrslError('statistics-off', 'the last dispatch ran with statistics off, so it counted nothing'));
+    }
+    if (!last.stats) {
+      last.stats = this.#read(last);
+      const done = () => {
+        last.slot.reading = null;
+      };
+      last.slot.reading = last.stats.then(done, done);
+    }
+    return last.stats;
+  }
+
+  async #read(last: Encoded): Promise<Stats> {
     const layout = this.program.layout;
     const plan = modePlan(layout.plan, last.options.mode, last.options.device) as ModePlan;
-    const read = async (id: ResourceId) => {
-      const buffer = this.#pool.readback(id);
-      if (!buffer) throw new MrslError('readback', `reading results back failed: ${id.id} was not read back`);
-      return readWords(buffer);
-    };
-    const counters = await read({ id: 'statistics' });
-    const listed = plan.counts.samples.kind === 'listed' ? ((await read(plan.counts.samples.resource))[plan.counts.samples.word] ?? 0) : 0;
-    const lists = plan.counts.work_lists;
-    let workLists: number[] = [];
-    if (lists) {
-      const words = await read(lists.resource);
-      workLists = lists.levels.map((level) => words[lists.words_per_level * level] ?? 0);
+    try {
+      // Not before the work submitted by then is done: a page that calls this
+      // between `encode` and its submit has then submitted (a map pending on
+      // a buffer fails the submit that uses it).
+      await this.device.queue.onSubmittedWorkDone();
+      const mapped = new Map<string, Promise<ArrayBuffer>>();
+      const words = (key: string, bytes?: number) => {
+        let read = mapped.get(key);
+        if (!read) {
+          const buffer = last.slot.buffer(key);
+          if (!buffer) return Promise.reject(new MrslError('readback', `reading the statistics back failed: ${key} was not read back`));
+          mapped.set(key, (read = readWords(buffer, bytes)));
+        }
+        return read;
+      };
+      const u32 = async (id: ResourceId) => new Uint32Array(await words(resourceKey(id)));
+      const samples = plan.counts.samples;
+      const lists = plan.counts.work_lists;
+      const [counters, listed, listWords, ticks] = await Promise.all([
+        u32({ id: 'statistics' }),
+        samples.kind === 'listed' ? u32(samples.resource).then((w) => w[samples.word] ?? 0) : 0,
+        lists ? u32(lists.resource) : null,
+        this.timestamps && last.passes > 0 ? words(TICKS, 16 * last.passes).then((b) => new BigUint64Array(b)) : null,
+      ]);
+      const workLists = lists && listWords ? lists.levels.map((level) => listWords[lists.words_per_level * level] ?? 0) : [];
+      const timings = this.timestamps ? timingsOf(plan, ticks ?? new BigUint64Array(0)) : null;
+      const counted = { counters, listedSamples: listed, workLists };
+      return makeStats(layout, plan.counts, last.options.mode, last.options.forceRefine, last.size, counted, timings);
+    } catch (error) {
+      if (error instanceof MrslError && !this.#destroyed) throw error;
+      const why = this.#destroyed ? 'the Shader was destroyed before they were read' : error instanceof Error ? `${error.name}: ${error.message}` : String(error);
+      throw new MrslError('readback', `reading the statistics back failed: ${why}`);
     }
-    const timings = this.timestamps ? timingsOf(plan, await readTicks(this.timestamps.readback, last.passes)) : null;
-    const counted = { counters, listedSamples: listed, workLists };
-    return makeStats(layout, plan.counts, last.options.mode, last.options.forceRefine, last.size, counted, timings);
   }
 
-  /** Frees the shader's buffers and textures. */
+  /** Frees the shader's buffers and textures; a `readStats` in progress fails with a `readback` error. */
   destroy(): void {
+    this.#destroyed = true;
     this.#pool.destroy();
+    this.#readbacks.destroy();
     this.#control.destroy();
     this.#uniformBuffer?.destroy();
-    if (this.timestamps) [this.timestamps.resolve, this.timestamps.readback].forEach((b) => b.destroy());
+    this.timestamps?.resolve.destroy();
     this.timestamps?.set.destroy();
   }
+}
+
+/** `encode`'s arguments are there: the bindings an object, the options one with a mode. */
+function checkArguments(bindings: Bindings, options: DispatchOptions, modes: () => Mode[]): void {
+  const example = () => `shader.encode(encoder, bindings, { mode: '${modes()[0] ?? 'reference'}' }) (this shader runs ${modes().join(', ')})`;
+  if (!options || typeof options !== 'object') {
+    throw new MrslError('bad-option', `encode's options are ${described(options)}, but they name the mode at least: ${example()}`);
+  }
+  if (options.mode === undefined) throw new MrslError('bad-option', `encode's options have no \`mode\`: ${example()}`);
+  if (!bindings || typeof bindings !== 'object') {
+    throw new MrslError('bad-option', `encode's bindings are ${described(bindings)}, but they are { size: [width, height], channels: { ... }, outputs: { ... } }`);
+  }
+}
+
+/** What the device refused in what `encode` made, as an `MrslError`. */
+function deviceError(message: string): MrslError {
+  if (/is associated with .* and cannot be used with|another device|different device/is.test(message)) {
+    return new MrslError(
+      'foreign-device',
+      `a texture, view or sampler bound was made on another GPUDevice than the one passed to Shader.create: make the G-buffer, the outputs and the textures on that device (in an engine, the device its renderer runs on); do not submit this encoder. The device said: ${message.trim()}`,
+    );
+  }
+  return new MrslError('pipeline', `the device refused what encode made: do not submit this encoder. The device said: ${message.trim()}`);
 }
 
 interface SharedLayouts {
@@ -325,6 +453,8 @@ interface SharedLayouts {
   gbuffer: GPUBindGroupLayout;
   arguments: GPUBindGroupLayout;
   argumentsGroup: number;
+  /** The G-buffer channels read through storage bindings, storage textures in every kernel's stage. */
+  storageChannels: number;
 }
 
 /**
@@ -340,6 +470,9 @@ async function makeKernel(
 ): Promise<{ stage: GPUBindGroupLayout; pipelines: Map<string, GPUComputePipeline> } | { refused: string }> {
   const missing = groups.missingFeature(device, kernelPasses[0]!.bindings);
   if (missing !== null) return { refused: missing };
+  const writes = kernelPasses.some((p) => p.dispatches.some((d) => d.arguments !== null));
+  const over = groups.overLimits(device, kernelPasses[0]!.bindings, shared.storageChannels, writes);
+  if (over !== null) return { refused: over };
   const memory = kernelPasses[0]!.workgroup_bytes ?? 0;
   const limit = device.limits.maxComputeWorkgroupStorageSize;
   if (memory > limit) {
@@ -376,22 +509,7 @@ function makeTimestamps(device: GPUDevice, count: number): Timestamps {
   return {
     set: device.createQuerySet({ label: 'mrsl timestamps', type: 'timestamp', count }),
     resolve: device.createBuffer({ label: 'mrsl timestamps resolve', size: 8 * count, usage: GPUBufferUsage.QUERY_RESOLVE | GPUBufferUsage.COPY_SRC }),
-    readback: device.createBuffer({ label: 'mrsl timestamps readback', size: 8 * count, usage: GPUBufferUsage.MAP_READ | GPUBufferUsage.COPY_DST }),
   };
-}
-
-async function readWords(buffer: GPUBuffer): Promise<Uint32Array> {
-  await buffer.mapAsync(GPUMapMode.READ);
-  const words = new Uint32Array(buffer.getMappedRange().slice(0));
-  buffer.unmap();
-  return words;
-}
-
-async function readTicks(buffer: GPUBuffer, passes: number): Promise<BigUint64Array> {
-  await buffer.mapAsync(GPUMapMode.READ, 0, 16 * passes);
-  const ticks = new BigUint64Array(buffer.getMappedRange(0, 16 * passes).slice(0));
-  buffer.unmap();
-  return ticks;
 }
 
 /** The passes' GPU times (WebGPU timestamps are nanoseconds), summed by stage. */

@@ -12,6 +12,37 @@ import type { Bindings } from './bindings.js';
 /** Shading-rate tile sizes the rate-image mode supports. */
 export const RATE_TILE_SIZES: readonly number[] = [8, 16];
 
+/** How a value the page passed reads in a message: `a GPUTextureView`, `an object {width, height}`, `undefined`. */
+export function described(value: unknown): string {
+  if (value === null || value === undefined) return String(value);
+  if (typeof value !== 'object') return `the ${typeof value} ${JSON.stringify(value)}`;
+  const name = (value as object).constructor?.name;
+  if (name && name !== 'Object') return /^[AEIOU]/.test(name) ? `an ${name}` : `a ${name}`;
+  return `an object {${Object.keys(value).join(', ')}}`;
+}
+
+/** `bindings.size` is `[width, height]` (what `{width, height}`, a GPUExtent3DDict, is not). */
+export function checkSizeShape(size: unknown): void {
+  const pair = (Array.isArray(size) || ArrayBuffer.isView(size)) && (size as ArrayLike<unknown>).length === 2;
+  if (pair) return;
+  throw new MrslError(
+    'bad-size',
+    `the target size \`bindings.size\` must be [width, height], but it is ${described(size)}: pass [width, height] (of a texture, [texture.width, texture.height])`,
+  );
+}
+
+/**
+ * `value`, bound as `what` \`name\`, is a GPUTexture (the runtime makes the
+ * views it binds: a depth aspect, one mip level), not a view or anything else.
+ */
+function checkIsTexture(what: string, name: string, value: unknown): asserts value is GPUTexture {
+  const t = value as Partial<GPUTexture> | null;
+  if (t && typeof t === 'object' && typeof t.createView === 'function' && typeof t.format === 'string') return;
+  const view = described(value) === 'a GPUTextureView';
+  const fix = view ? 'pass the GPUTexture itself, not a view of it (the runtime makes the views it binds)' : 'pass a GPUTexture';
+  throw new MrslError('not-a-texture', `${what} \`${name}\` is ${described(value)}, but it takes a GPUTexture: ${fix}`, name);
+}
+
 function badSize([w, h]: Size, reason: string): MrslError {
   return new MrslError('bad-size', `target size ${w}x${h} is not supported: ${reason}`);
 }
@@ -163,7 +194,7 @@ function checkUsageAndShape(ch: Channel, t: GPUTexture): void {
 
 function checkOutput(o: Output, t: GPUTexture): void {
   if (t.format !== o.format) {
-    throw new MrslError('output-format', `output \`${o.name}\` must be a ${o.format} storage texture, found ${t.format}`, o.name);
+    throw new MrslError('output-format', `output \`${o.name}\` must be a ${o.format} storage texture, found ${t.format}: ${outputFormatHint(o, t.format)}`, o.name);
   }
   if (!(t.usage & GPUTextureUsage.STORAGE_BINDING)) {
     throw new MrslError(
@@ -178,6 +209,35 @@ function checkOutput(o: Output, t: GPUTexture): void {
   }
 }
 
+/** The formats \`@format(..)\` can declare an output of \`type\` as (the language's \`TextureFormat::for_output\`). */
+function declarableFormats(type: string): string[] {
+  const m = /^(float|uint|int)([234])?$/.exec(type);
+  if (!m) return [];
+  const n = m[2] ? Number(m[2]) : 1;
+  const any: Record<string, string[]> = {
+    float: n === 1 ? ['r32float', 'rgba16float', 'rgba32float', 'rgba8unorm'] : ['rgba32float', 'rgba16float', 'rgba8unorm', 'rg32float'],
+    uint: ['r32uint', 'rgba32uint'],
+    int: ['r32sint', 'rgba32sint'],
+  };
+  return (any[m[1]!] ?? []).filter((f) => {
+    const components = formatInfo(f)?.components ?? 0;
+    return components >= Math.min(n, 4) || components === 4;
+  });
+}
+
+/**
+ * How to fix an output bound with a texture of format \`found\`: declare the
+ * output with \`@format\` where the language can store its type in it, else
+ * create the texture in the layout's format (the Rust runtime's hint).
+ */
+export function outputFormatHint(o: Output, found: string): string {
+  const declarable = declarableFormats(o.type);
+  if (declarable.includes(found)) {
+    return `to write a ${found} texture, declare the output \`@format(${found}) fine out ${o.type} ${o.name}\` and compile the program again`;
+  }
+  return `create it as ${o.format} (the layout's format); \`@format(..)\` can declare a \`${o.type}\` output as ${declarable.join(', ')}`;
+}
+
 function checkShadingRate(bindings: Bindings, tile: number): void {
   const what = 'the shading-rate image';
   if (!RATE_TILE_SIZES.includes(tile)) {
@@ -187,6 +247,7 @@ function checkShadingRate(bindings: Bindings, tile: number): void {
   if (!t) {
     throw new MrslError('missing-shading-rate', 'the rate-image mode needs a shading-rate image (`Bindings.shadingRate`), and none is bound');
   }
+  checkIsTexture('the shading-rate image', 'shadingRate', t);
   if (!['r8uint', 'r16uint', 'r32uint'].includes(t.format)) {
     throw new MrslError('rate-format', `${what} has format ${t.format}, expected r8uint (as in D3D12 and Vulkan), r16uint or r32uint`);
   }
@@ -205,8 +266,9 @@ export function checkBindings(layout: Layout, mode: ModePlan, bindings: Bindings
   const bindsRate = mode.steps.some((s) => s.step === 'pass' && s.bindings.some((b) => b.resource.id === 'shading_rate'));
   if (bindsRate) checkShadingRate(bindings, rateTile);
   for (const ch of layout.channels) {
-    const t = bindings.channels[ch.name];
+    const t = bindings.channels?.[ch.name];
     if (!t) throw new MrslError('missing-channel', `G-buffer channel \`${ch.name}\` is not bound`, ch.name);
+    checkIsTexture('G-buffer channel', ch.name, t);
     checkChannel(ch, t);
     checkTextureSize('G-buffer channel', ch.name, t, bindings.size);
   }
@@ -225,8 +287,9 @@ export function checkBindings(layout: Layout, mode: ModePlan, bindings: Bindings
     if (!bindings.samplers?.[s.name]) throw new MrslError('missing-sampler', `sampler \`${s.name}\` is not bound`, s.name);
   }
   for (const o of layout.outputs) {
-    const t = bindings.outputs[o.name];
+    const t = bindings.outputs?.[o.name];
     if (!t) throw new MrslError('missing-output', `output \`${o.name}\` is not bound`, o.name);
+    checkIsTexture('output', o.name, t);
     checkOutput(o, t);
     checkTextureSize('output', o.name, t, bindings.size);
   }

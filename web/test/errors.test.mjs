@@ -2,12 +2,13 @@
 // fault, thrown before anything is recorded into its encoder.
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync, rmSync } from 'node:fs';
+import { mkdtempSync, rmSync, unlinkSync } from 'node:fs';
 import { readFile } from 'node:fs/promises';
+import { createServer } from 'node:http';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { loadProgram, MODES, MrslError, parseLayout, Shader } from '../dist/index.js';
-import { testDevice } from './support/gpu.mjs';
+import { freshAdapter, testDevice } from './support/gpu.mjs';
 import { mrslc } from './support/mrslc.mjs';
 
 const SIZE = [40, 24];
@@ -173,4 +174,97 @@ test('statistics off: readStats says so', async (t) => {
 
 test('a layout without a plan is refused', () => {
   assert.throws(() => parseLayout('{"format": "mrsl-layout/5"}'), (e) => e instanceof MrslError && /current mrslc/.test(e.message));
+});
+
+test('a view where a texture goes, and a size as {width, height}, say how to pass them', async (t) => {
+  if (skip(t)) return;
+  const view = (c) => ({ channels: { ...c, normal: c.normal.createView() } });
+  await refused(shader, bindings(view), { mode: 'reference' }, 'not-a-texture', ['`normal`', 'GPUTextureView', 'GPUTexture itself']);
+  const outputView = (c, o) => ({ outputs: { color: o.color.createView() } });
+  await refused(shader, bindings(outputView), { mode: 'reference' }, 'not-a-texture', ['`color`', 'GPUTextureView']);
+  const object = () => ({ size: { width: SIZE[0], height: SIZE[1] } });
+  await refused(shader, bindings(object), { mode: 'reference' }, 'bad-size', ['[width, height]', '{width, height}']);
+});
+
+test('encode without options, or without a mode, names the option', async (t) => {
+  if (skip(t)) return;
+  await refused(shader, bindings(() => ({})), undefined, 'bad-option', ['mode', "{ mode: 'reference' }"]);
+  await refused(shader, bindings(() => ({})), {}, 'bad-option', ['no `mode`']);
+});
+
+test('an output of another format gets the `@format` declaration that writes it', async (t) => {
+  if (skip(t)) return;
+  const half = gpu.device.createTexture({ size: SIZE, format: 'rgba16float', usage: usage.storage });
+  await refused(shader, bindings(() => ({ outputs: { color: half } })), { mode: 'reference' }, 'output-format', [
+    'rgba32float',
+    '`@format(rgba16float) fine out float4 color`',
+  ]);
+  const bgra = gpu.device.createTexture({ size: SIZE, format: 'bgra8unorm', usage: usage.storage });
+  await refused(shader, bindings(() => ({ outputs: { color: bgra } })), { mode: 'reference' }, 'output-format', ['create it as rgba32float', 'rgba16float, rgba8unorm']);
+});
+
+test('a program past the device\'s storage-texture limit: supports names the limit', async (t) => {
+  if (skip(t)) return;
+  mrslc(['compile', 'examples/demo.mrsl', '--storage-channels', '--mode', 'reference,coarse4x4', '-o', join(dir, 'storage')]);
+  const storage = await Shader.create(gpu.device, await loadProgram((f) => readFile(join(dir, 'storage', f), 'utf8'), 'demo'));
+  const limit = gpu.device.limits.maxStorageTexturesPerShaderStage;
+  for (const mode of ['reference', 'coarse4x4']) {
+    assert.throws(
+      () => storage.supports(mode),
+      (e) => e instanceof MrslError && e.kind === 'unsupported-mode' && e.message.includes(`maxStorageTexturesPerShaderStage, ${limit}`) && /--storage-channels/.test(e.message),
+    );
+  }
+  assert.deepEqual(storage.modes(), []);
+});
+
+test('a texture of another device: encode\'s promise rejects with foreign-device', async (t) => {
+  if (skip(t)) return;
+  const other = await (await freshAdapter()).requestDevice();
+  try {
+    const normal = other.createTexture({ size: SIZE, format: 'rgba32float', usage: usage.sampled });
+    const b = bindings((c) => ({ channels: { ...c, normal } }));
+    const encoder = gpu.device.createCommandEncoder();
+    await assert.rejects(shader.encode(encoder, b, { mode: 'reference' }), (e) => e instanceof MrslError && e.kind === 'foreign-device' && /Shader.create/.test(e.message));
+  } finally {
+    other.destroy();
+  }
+  // A right encode still resolves.
+  const encoder = gpu.device.createCommandEncoder();
+  await shader.encode(encoder, bindings(() => ({})), { mode: 'reference' });
+  gpu.device.queue.submit([encoder.finish()]);
+});
+
+/** Serves `root` over HTTP (404 for what is not there); resolves with its base URL and a close function. */
+async function serveFiles(root) {
+  const server = createServer(async (request, response) => {
+    try {
+      const body = await readFile(join(root, decodeURIComponent(new URL(request.url, 'http://x').pathname)));
+      response.writeHead(200).end(body);
+    } catch {
+      response.writeHead(404, { 'content-type': 'text/html' }).end('<!DOCTYPE html><title>404 Not Found</title>');
+    }
+  });
+  await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
+  return { url: `http://127.0.0.1:${server.address().port}/`, close: () => server.close() };
+}
+
+test('loadProgram: a wrong stem, a missing kernel or an error page name the file and the HTTP status', async (t) => {
+  if (skip(t)) return;
+  const fails = (promise, words) =>
+    assert.rejects(promise, (e) => e instanceof MrslError && e.kind === 'program-file' && words.every((w) => e.message.includes(w)) && (console.log(`  program-file: ${e.message}`), true));
+  mrslc(['compile', 'examples/demo.mrsl', '--mode', 'reference,coarse4x4', '-o', join(dir, 'served')]);
+  unlinkSync(join(dir, 'served', 'demo.tile.b4.wgsl'));
+  const server = await serveFiles(dir);
+  try {
+    const program = await loadProgram(`${server.url}all`, 'demo');
+    assert.ok(program.kernels.length > 0, 'a served directory loads by its URL');
+    await fails(loadProgram(`${server.url}served/`, 'demo'), ['`demo.tile.b4.wgsl`', 'HTTP 404', 'coarse4x4', '--mode']);
+    await fails(loadProgram(`${server.url}all/`, 'dem'), ['`dem.layout.json`', 'HTTP 404', 'the stem']);
+    await fails(loadProgram((f) => fetch(`${server.url}all/${f}`), 'dem'), ['HTTP 404']);
+    // The text of a server's error page, as `fetch(...).then((r) => r.text())` gives it.
+    await fails(loadProgram((f) => fetch(`${server.url}all/${f}`).then((r) => r.text()), 'dem'), ['`dem.layout.json`', 'HTML page']);
+    await fails(loadProgram((f) => readFile(join(dir, 'all', f), 'utf8'), 'dem'), ['`dem.layout.json`', 'ENOENT']);
+  } finally {
+    server.close();
+  }
 });

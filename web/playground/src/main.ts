@@ -205,9 +205,7 @@ async function renderSelected(mine = generation): Promise<void> {
   setState('rendering', `rendering ${mode}…`);
   const r = await render(mode, ui.forced.checked);
   if (mine !== generation) return;
-  const coarse = shader.layout.stats.counters.length;
-  const mark = shader.layout.plan.constants.background_mark;
-  if (ui.view.value === 'heatmap' && r.mask) drawHeatmap(ui.canvas, gbuffer.loaded.size, r.mask, r.image, coarse, mark);
+  if (ui.view.value === 'heatmap' && r.mask) drawHeatmap(ui.canvas, shader.layout, gbuffer.loaded.size, r.mask, r.image);
   else drawImage(ui.canvas, gbuffer.loaded.size, r.image);
   const heat = ui.view.value === 'heatmap' ? (r.mask ? 'heatmap: red by the share of coarse effects evaluated per pixel, green from the 2x2 level, grey the background; ' : 'no heatmap in this mode; ') : '';
   const rate = mode === 'rate-image' ? `; every ${RATE.tile}x${RATE.tile} tile at ${RATE.rate.join('x')}` : '';

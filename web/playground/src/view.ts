@@ -2,16 +2,8 @@
 // float output), the heatmap of where coarse effects were evaluated per
 // pixel, the per-effect statistics and the per-mode timings.
 
-import type { Layout, Mode, Stats } from '../../src/index.js';
+import { linearToSrgb8, refineHeatmap, type Layout, type Mode, type Stats } from '../../src/index.js';
 import type { Diagnostic } from './api.js';
-
-/** The sRGB curve and the rounding to a byte (the lab's `linear_to_srgb8`: clamp, encode, round half up). */
-export function linearToSrgb8(v: number): number {
-  if (!Number.isFinite(v)) return 0;
-  const c = Math.min(Math.max(v, 0), 1);
-  const s = c <= 0.0031308 ? 12.92 * c : 1.055 * Math.pow(c, 1 / 2.4) - 0.055;
-  return Math.floor(s * 255 + 0.5);
-}
 
 /** Draws an rgba32float output, tightly packed, into the canvas. */
 export function drawImage(canvas: HTMLCanvasElement, size: readonly [number, number], texels: Uint8Array): void {
@@ -24,53 +16,20 @@ export function drawImage(canvas: HTMLCanvasElement, size: readonly [number, num
   put(canvas, image);
 }
 
-/** What `mrslc render`'s heatmaps paint the background (cli/src/legend.rs). */
-const BACKGROUND_GREY = 150;
-
 /**
  * Draws the refine mask (rg32uint): the image dimmed where every coarse
  * effect was resampled, red by the share of coarse effects evaluated per
  * pixel, green where one came from the dynamic mode's 2x2 level, grey on
  * the background (where the background rule skipped the coarse effects).
  */
-export function drawHeatmap(
-  canvas: HTMLCanvasElement,
-  size: readonly [number, number],
-  mask: Uint8Array,
-  image: Uint8Array,
-  coarseEffects: number,
-  backgroundMark: readonly [number, number],
-): void {
-  const words = new Uint32Array(mask.buffer, mask.byteOffset, mask.byteLength / 4);
-  const floats = new Float32Array(image.buffer, image.byteOffset, image.byteLength / 4);
-  const out = new ImageData(size[0], size[1]);
-  for (let i = 0; i < size[0] * size[1]; i++) {
-    out.data[4 * i + 3] = 255;
-    if (words[2 * i] === backgroundMark[0] && words[2 * i + 1] === backgroundMark[1]) {
-      out.data.fill(BACKGROUND_GREY, 4 * i, 4 * i + 3);
-      continue;
-    }
-    const evaluated = popcount(words[2 * i]!) / Math.max(coarseEffects, 1);
-    const fromLevel2 = words[2 * i + 1]! !== 0;
-    const grey = 0.3 * linearToSrgb8(floats[4 * i]!) + 0.4 * linearToSrgb8(floats[4 * i + 1]!) + 0.1 * linearToSrgb8(floats[4 * i + 2]!);
-    const base = 0.35 * grey;
-    out.data[4 * i] = Math.round(base + evaluated * (255 - base));
-    out.data[4 * i + 1] = Math.round(fromLevel2 ? 200 : base * (1 - evaluated));
-    out.data[4 * i + 2] = Math.round(base * (1 - evaluated));
-  }
-  put(canvas, out);
+export function drawHeatmap(canvas: HTMLCanvasElement, layout: Layout, size: readonly [number, number], mask: Uint8Array, image: Uint8Array): void {
+  put(canvas, new ImageData(refineHeatmap(layout, mask, image), size[0], size[1]));
 }
 
 function put(canvas: HTMLCanvasElement, image: ImageData): void {
   canvas.width = image.width;
   canvas.height = image.height;
   (canvas.getContext('2d') as CanvasRenderingContext2D).putImageData(image, 0, 0);
-}
-
-function popcount(n: number): number {
-  let count = 0;
-  for (let v = n >>> 0; v; v &= v - 1) count++;
-  return count;
 }
 
 const percent = (f: number) => `${(100 * f).toFixed(1)}%`;
