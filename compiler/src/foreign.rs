@@ -241,8 +241,8 @@ pub const TABLE: &[Foreign] = &[
         words: &["while", "do"],
         from: "GLSL, HLSL, WGSL",
         kind: Kind::Keyword,
-        instead: "a `for` loop with a bound the compiler can see, left early: `for (int i = 0; i < MAX; i++) { if \
-                  (!(cond)) break; ... }`",
+        instead: "a `for` loop with a bound the compiler can see beside the condition: `for (int i = 0; i < MAX && \
+                  cond; i++) { ... }`",
         example: "while (n.x > 0.0) { n.x -= 1.0; }",
     },
     Foreign {

@@ -15,6 +15,7 @@ mod engine_formats;
 mod errors;
 mod frames;
 mod generated;
+mod language;
 mod lifted_derivatives;
 mod modes;
 mod packed_records;
@@ -183,6 +184,8 @@ const GPU_TESTS: &[GpuTest] = &[
         "views::views_in_one_submission_are_each_their_own_render",
         views::views_in_one_submission_are_each_their_own_render,
     ),
+    ("language::new_forms_force_to_the_reference", language::new_forms_force_to_the_reference),
+    ("language::dynamic_limits_render_as_breaks", language::dynamic_limits_render_as_breaks),
 ];
 
 /// Tests that run on the CPU only.

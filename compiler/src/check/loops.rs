@@ -12,8 +12,9 @@ const MAX_LOOP_TRIPS: u64 = 1 << 16;
 
 impl Checker<'_> {
     /// Loops must have the form `for (T i = c0; i OP c1; i++ | i-- | i += c | i -= c)`
-    /// with constant `c`s, and must not assign `i` in the body, so that the
-    /// compiler (and the GPU's watchdog) can rely on a bounded trip count.
+    /// with constant `c`s (the condition may add a dynamic limit:
+    /// [`Checker::static_comparison`]), and must not assign `i` in the body, so
+    /// that the compiler (and the GPU's watchdog) can rely on a bounded trip count.
     pub(super) fn check_static_bound(
         &mut self,
         s: &Stmt,
@@ -70,39 +71,54 @@ impl Checker<'_> {
 
     /// Whether the condition compares the counter with a constant (else an error).
     fn loop_condition_is_static(&mut self, s: &Stmt, var: &str, cond: Option<&Expr>) -> bool {
-        let is_var = |e: &Expr| matches!(&e.kind, ExprKind::Name(n) if n == var);
-        let bound = match cond.map(|c| &c.kind) {
-            Some(ExprKind::Binary(BinaryOp::Lt | BinaryOp::Le | BinaryOp::Gt | BinaryOp::Ge | BinaryOp::Ne, a, b))
-                if is_var(a) =>
-            {
-                Some(b.as_ref())
+        match cond.and_then(|c| self.static_comparison(var, c)) {
+            Some(_) => true,
+            None => {
+                let compared = cond.and_then(|c| comparison(var, c));
+                let (span, label) = match compared {
+                    Some((_, _, b)) => (b.span, "not a constant".to_string()),
+                    None => (
+                        cond.map(|c| c.span).unwrap_or(s.span),
+                        format!("expected `{var} < CONSTANT` (or <=, >, >=, !=)"),
+                    ),
+                };
+                self.error(err("E0401", "loop has no static bound", span, label).with_note(format!(
+                    "give the loop a constant bound beside the dynamic one: `{var} < 16 && {var} < count`, \
+                     `{var} < min(count, 16)`, or test the dynamic one inside: `if ({var} >= count) break;`"
+                )));
+                false
             }
-            Some(ExprKind::Binary(BinaryOp::Lt | BinaryOp::Le | BinaryOp::Gt | BinaryOp::Ge | BinaryOp::Ne, a, b))
-                if is_var(b) =>
+        }
+    }
+
+    /// The comparison of the counter with a constant that bounds the loop, as
+    /// (operator, whether the counter is on the left, the constant): the
+    /// condition itself (`i < 16`); either side of an `&&` (`i < 16 && i <
+    /// count`: the other side may be anything, a dynamic limit); or a `min`
+    /// (`max` counting down) of a constant and anything (`i < min(count, 16)`
+    /// is bounded by `i < 16`). The loop runs at most as often as that
+    /// comparison lets it, which is what the trip count and the cost model need.
+    fn static_comparison<'e>(&mut self, var: &str, cond: &'e Expr) -> Option<(BinaryOp, bool, &'e Expr)> {
+        if let ExprKind::Binary(BinaryOp::And, a, b) = &cond.kind {
+            return self.static_comparison(var, a).or_else(|| self.static_comparison(var, b));
+        }
+        let (op, var_left, bound) = comparison(var, cond)?;
+        if self.const_eval(bound).is_some() {
+            return Some((op, var_left, bound));
+        }
+        // Below the smaller of two values (above the larger): below the constant one.
+        let below =
+            matches!((op, var_left), (BinaryOp::Lt | BinaryOp::Le, true) | (BinaryOp::Gt | BinaryOp::Ge, false));
+        let above =
+            matches!((op, var_left), (BinaryOp::Gt | BinaryOp::Ge, true) | (BinaryOp::Lt | BinaryOp::Le, false));
+        match &bound.kind {
+            ExprKind::Call { callee, args }
+                if args.len() == 2 && ((below && callee.name == "min") || (above && callee.name == "max")) =>
             {
-                Some(a.as_ref())
+                let constant = args.iter().find(|a| self.const_eval(a).is_some())?;
+                Some((op, var_left, constant))
             }
             _ => None,
-        };
-        match bound {
-            Some(b) if self.const_eval(b).is_some() => true,
-            Some(b) => {
-                self.error(
-                    err("E0401", "loop has no static bound", b.span, "not a constant")
-                        .with_note("use a constant bound and test the dynamic limit inside: `for (int i = 0; i < 16; i++) { if (i >= count) break; ... }`"),
-                );
-                false
-            }
-            None => {
-                let span = cond.map(|c| c.span).unwrap_or(s.span);
-                self.error(err(
-                    "E0401",
-                    "loop has no static bound",
-                    span,
-                    format!("expected `{var} < CONSTANT` (or <=, >, >=, !=)"),
-                ));
-                false
-            }
         }
     }
 
@@ -138,16 +154,13 @@ impl Checker<'_> {
         cond: Option<&Expr>,
         step: Option<&Stmt>,
     ) -> bool {
-        let is_var = |e: &Expr| matches!(&e.kind, ExprKind::Name(n) if n == var);
         let start = match init.map(|i| &i.kind) {
             Some(StmtKind::Local { init: Some(v), .. }) => self.const_eval(v).map(|c| c.values[0]),
             _ => None,
         };
-        let (op, var_left, limit) = match cond.map(|c| &c.kind) {
-            Some(ExprKind::Binary(op, a, b)) => {
-                (*op, is_var(a), self.const_eval(if is_var(a) { b } else { a }).map(|c| c.values[0]))
-            }
-            _ => (BinaryOp::Lt, true, None),
+        let (op, var_left, limit) = match cond.and_then(|c| self.static_comparison(var, c)) {
+            Some((op, var_left, bound)) => (op, var_left, self.const_eval(bound).map(|c| c.values[0])),
+            None => (BinaryOp::Lt, true, None),
         };
         let delta = match step.map(|st| &st.kind) {
             Some(StmtKind::Step { increment, .. }) => Some(if *increment { 1.0 } else { -1.0 }),
@@ -185,6 +198,24 @@ impl Checker<'_> {
             .with_note("check the direction of the step against the condition"),
         );
         false
+    }
+}
+
+/// `cond` as a comparison of the counter `var` with something: (operator,
+/// whether the counter is on the left, the other side).
+fn comparison<'e>(var: &str, cond: &'e Expr) -> Option<(BinaryOp, bool, &'e Expr)> {
+    let is_var = |e: &Expr| matches!(&e.kind, ExprKind::Name(n) if n == var);
+    match &cond.kind {
+        ExprKind::Binary(op @ (BinaryOp::Lt | BinaryOp::Le | BinaryOp::Gt | BinaryOp::Ge | BinaryOp::Ne), a, b) => {
+            if is_var(a) {
+                Some((*op, true, b))
+            } else if is_var(b) {
+                Some((*op, false, a))
+            } else {
+                None
+            }
+        }
+        _ => None,
     }
 }
 
