@@ -1,7 +1,7 @@
 //! The words of the language, for tools that colour, complete and explain
 //! it: the editors' TextMate grammar, the playground's CodeMirror mode and a
 //! language server. Every list is read from the table the compiler itself
-//! uses (the lexer's [`Token::KINDS`], the checker's type names, the
+//! uses (the lexer's `Token::KINDS`, the checker's type names, the
 //! builtins, the attributes), never kept a second time by hand, so the tools
 //! cannot disagree with the compiler; `compiler/tests/it/sourcegen.rs`
 //! writes the editor files from it and fails when they are out of date.
