@@ -274,7 +274,7 @@ fn generate(
         compact: options.compact,
         source,
         // Each view writes its effects' functions differently: a cache of its own.
-        cache: codegen::Cache::new(source),
+        cache: codegen::Cache::new(),
         counters: counters.clone(),
         level,
     };

@@ -92,7 +92,8 @@ impl Writer<'_, '_, '_> {
                 if l.reassigned { format!("{name}_in: {}", l.ty.wgsl()) } else { format!("{name}: {}", l.ty.wgsl()) }
             })
             .collect();
-        self.line(0, format!("// function `{}` (line {})", f.name.name, self.line_of(f.span)));
+        // Names, not source lines: formatting a program leaves its kernels byte-identical.
+        self.line(0, format!("// function `{}`", f.name.name));
         self.line(0, format!("fn {}({}) -> {} {{", wgsl_ident(&f.name.name), params.join(", "), info.ret.wgsl()));
         for p in &info.params {
             if c.locals[p.index()].reassigned {

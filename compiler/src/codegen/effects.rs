@@ -650,7 +650,7 @@ impl<'b> Writer<'_, '_, 'b> {
                 Rate::Fine => "fine effect",
                 Rate::Out => "fine out",
             };
-            self.line(0, format!("// ---- {rate} `{}` (line {}) ----", info.name, self.line_of(decl.span)));
+            self.line(0, format!("// ---- {rate} `{}` ----", info.name));
         }
         let sig = self.eval_signature(e, value_only);
         self.line(0, format!("{sig} {{"));
@@ -760,8 +760,7 @@ impl<'b> Writer<'_, '_, 'b> {
                 site.params.iter().map(|p| format!("{}: {}", local_name(c, *p), c.locals[p.index()].ty.wgsl())),
             );
             let args: String = site.params.iter().map(|p| format!(", {}", local_name(c, *p))).collect();
-            let text = &self.i.source[site.operand.span.range()];
-            let text: String = text.split_whitespace().collect::<Vec<_>>().join(" ");
+            let text = crate::syntax::format::expression(&self.i.source[site.operand.span.range()]);
             if site.prefix.is_some() {
                 self.prefix_function(k, &ty);
             }
@@ -857,10 +856,13 @@ impl<'b> Writer<'_, '_, 'b> {
         params.extend(
             site.effects.iter().map(|e| format!("{}: {}", self.effect_name(*e), c.effects[e.index()].ty.wgsl())),
         );
-        let line = self.line_of(b.stmts[statement].span);
+        let ordinal = statement + 1;
         self.line(
             0,
-            format!("// `{}`'s body before line {line}, at another position, for derivative #{k}.", info.name),
+            format!(
+                "// `{}`'s body before its statement {ordinal}, at another position, for derivative #{k}.",
+                info.name
+            ),
         );
         self.line(0, format!("fn {}({}) -> {} {{", Name::Prefix.of(k), params.join(", "), ty.wgsl()));
         let mut inputs = BTreeSet::new();

@@ -71,7 +71,7 @@ use crate::check::{Checked, EffectId, FunctionId};
 use crate::deriv::DerivInfo;
 use crate::graph::EffectGraph;
 use crate::interface::Interface;
-use crate::syntax::ast::{Rate, Span};
+use crate::syntax::ast::Rate;
 use body::{Mode, wgsl_ident};
 use mrsl_abi::geometry::{
     DYNAMIC_INNER_BLOCK, DYNAMIC_OUTER_BLOCK, DYNAMIC_TAG_WORDS, FINE_PIXELS_PER_LANE, HIERARCHICAL_LEVEL0,
@@ -126,12 +126,11 @@ pub(crate) fn counters(checked: &Checked, graph: &EffectGraph) -> Vec<EffectId> 
     graph.order.iter().copied().filter(|e| checked.effects[e.index()].rate == Rate::Coarse).collect()
 }
 
-/// What the kernels of one compile share, computed once: where the source's
-/// lines start, and the text of the functions every kernel that has them
-/// writes identically (effect, value-only and user functions, derivative
-/// helpers), written by the first kernel that needs each.
+/// What the kernels of one compile share, computed once: the text of the
+/// functions every kernel that has them writes identically (effect,
+/// value-only and user functions, derivative helpers), written by the first
+/// kernel that needs each.
 pub(crate) struct Cache {
-    line_starts: Vec<usize>,
     pieces: RefCell<HashMap<Piece, String>>,
 }
 
@@ -167,14 +166,8 @@ enum Derivatives {
 }
 
 impl Cache {
-    pub(crate) fn new(source: &str) -> Cache {
-        let line_starts = std::iter::once(0).chain(source.match_indices('\n').map(|(k, _)| k + 1)).collect();
-        Cache { line_starts, pieces: RefCell::default() }
-    }
-
-    /// The 1-based line of byte `offset`.
-    fn line_of(&self, offset: usize) -> usize {
-        self.line_starts.partition_point(|&start| start <= offset)
+    pub(crate) fn new() -> Cache {
+        Cache { pieces: RefCell::default() }
     }
 }
 
@@ -243,10 +236,6 @@ impl<'i, 'a, 'b> Writer<'i, 'a, 'b> {
 
     fn effect_name(&self, e: EffectId) -> String {
         wgsl_ident(&self.checked().effects[e.index()].name)
-    }
-
-    fn line_of(&self, span: Span) -> usize {
-        self.i.cache.line_of(span.start as usize)
     }
 
     /// The live coarse effects in dependency order (numbered by `coarse_index`).

@@ -24,6 +24,11 @@ pub fn parse(source: &str) -> Result<Program, Diagnostic> {
     generated::ProgramParser::new().parse(&ids, Lexer::new(source)).map_err(|error| syntax_diagnostic(source, error))
 }
 
+/// Parses one expression (a derivative operand's text), or `None`.
+pub fn parse_expression(source: &str) -> Option<ast::Expr> {
+    generated::ExprParser::new().parse(&IdGen::default(), Lexer::new(source)).ok()
+}
+
 type ParseError<'a> = lalrpop_util::ParseError<usize, Token<'a>, LexErrorAt>;
 
 fn syntax_diagnostic(source: &str, error: ParseError<'_>) -> Diagnostic {

@@ -70,12 +70,9 @@ fn compiled(name: &str, source: &str, options: &mrsl::Options) -> (Vec<(String, 
 }
 
 /// The kernels and the layout of `source` and of `formatted` are the same,
-/// byte for byte, but for what the kernels' comments quote of the source:
-/// the comment over each function and effect, `// function `f` (line 12)`,
-/// names the line of its declaration, and the one over a derivative's helper
-/// the line of a statement, which formatting may move (each such line must
-/// be the line of that declaration or statement in its own source); and a
-/// derivative operand's text is quoted (see [`operand_quote`]).
+/// byte for byte (the kernels' comments name declarations and statements,
+/// never source lines, and quote a derivative operand in the canonical
+/// layout, `mrsl::format`'s own).
 #[track_caller]
 fn assert_same_kernels(name: &str, source: &str, formatted: &str, options: &mrsl::Options) {
     let (before, layout_before) = compiled(name, source, options);
@@ -83,93 +80,8 @@ fn assert_same_kernels(name: &str, source: &str, formatted: &str, options: &mrsl
     assert_eq!(layout_after, layout_before, "{name}: the layout changes once formatted");
     assert_eq!(after.len(), before.len(), "{name}: the kernels change once formatted");
     for ((kind, block, wgsl), (_, _, formatted_wgsl)) in before.iter().zip(&after) {
-        let what = format!("{name}: the {kind} kernel ({block:?})");
-        let (wgsl, formatted_wgsl) = (lines_named(&what, wgsl, source), lines_named(&what, formatted_wgsl, formatted));
-        assert!(wgsl == formatted_wgsl, "{what} changes once formatted");
+        assert!(wgsl == formatted_wgsl, "{name}: the {kind} kernel ({block:?}) changes once formatted");
     }
-}
-
-/// The comment that quotes a derivative operand's source text (its spaces
-/// collapsed), "// derivative operand #0 in `e`: TEXT", with the text's
-/// spaces and comments left out: where formatting breaks the operand across
-/// lines, the quote gains spaces, and a comment inside it moves.
-fn operand_quote(line: &str) -> Option<String> {
-    let (head, text) = line.split_once("`: ").filter(|_| line.starts_with("// derivative operand #"))?;
-    let code: String = without_comments(text).chars().filter(|c| !c.is_whitespace()).collect();
-    Some(format!("{head}`: {code}\n"))
-}
-
-/// `text` without its block comments and the `// cN` comments that
-/// [`with_comments`] adds (in a quote on one line, nothing shows where a
-/// line comment ended).
-fn without_comments(text: &str) -> String {
-    let mut out = String::new();
-    let mut rest = text;
-    loop {
-        let block = rest.find("/*");
-        let line = rest.find("// c").filter(|&at| rest[at + 4..].starts_with(|c: char| c.is_ascii_digit()));
-        let at = match (block, line) {
-            (Some(b), Some(l)) => b.min(l),
-            (Some(at), None) | (None, Some(at)) => at,
-            (None, None) => break,
-        };
-        out.push_str(&rest[..at]);
-        rest = &rest[at..];
-        rest = if rest.starts_with("/*") {
-            rest.find("*/").map_or("", |end| &rest[end + 2..])
-        } else {
-            rest[4..].trim_start_matches(|c: char| c.is_ascii_digit())
-        };
-    }
-    out.push_str(rest);
-    out
-}
-
-/// The comment over a derivative's helper, "// `e`'s body before line N,
-/// ...", with the line checked and left out: a statement of `e` starts on
-/// line N (its text, spaces aside, begins as the statement that the other
-/// source has there).
-fn statement_line(what: &str, line: &str, source: &str) -> Option<String> {
-    let (head, rest) = line.split_once("'s body before line ")?;
-    let (number, tail) = rest.split_once(',')?;
-    let number: usize = number.parse().ok()?;
-    let text = source.lines().nth(number - 1).unwrap_or_else(|| panic!("{what}: `{line}` names no line"));
-    let start: String = without_comments(text).chars().filter(|c| !c.is_whitespace()).take(12).collect();
-    Some(format!("{head}'s body before the line of `{start}`,{tail}\n"))
-}
-
-/// `wgsl` with each `(line N)` of a declaration's comment checked against
-/// `source` and replaced by `(line of NAME)`.
-#[track_caller]
-fn lines_named(what: &str, wgsl: &str, source: &str) -> String {
-    let mut out = String::with_capacity(wgsl.len());
-    for line in wgsl.lines() {
-        if let Some(quoted) = statement_line(what, line, source).or_else(|| operand_quote(line)) {
-            out.push_str(&quoted);
-            continue;
-        }
-        let named = (line.starts_with("// function `") || line.starts_with("// ---- "))
-            .then(|| {
-                let declared = line.split('`').nth(1)?;
-                let (head, rest) = line.split_once(" (line ")?;
-                let (number, tail) = rest.split_once(')')?;
-                Some((declared, head, number.parse::<usize>().ok()?, tail))
-            })
-            .flatten();
-        match named {
-            Some((declared, head, number, tail)) => {
-                let span = mrsl::declaration_span(source, declared).expect("the declaration a kernel names");
-                let expected = source[..span.range().start].matches('\n').count() + 1;
-                assert_eq!(number, expected, "{what}: `{line}` names another line than `{declared}`'s");
-                out.push_str(&format!("{head} (line of {declared}){tail}\n"));
-            }
-            None => {
-                out.push_str(line);
-                out.push('\n');
-            }
-        }
-    }
-    out
 }
 
 #[test]

@@ -68,6 +68,28 @@ pub fn format(source: &str) -> Result<String, Diagnostic> {
     Ok(formatted)
 }
 
+/// An expression's text in the canonical layout, on one line, its comments
+/// left out: how a kernel quotes a derivative operand, so that formatting a
+/// program leaves its kernels byte-identical. Text that does not parse as
+/// an expression comes back with its spaces collapsed.
+pub fn expression(text: &str) -> String {
+    let collapsed = |t: &str| t.split_whitespace().collect::<Vec<_>>().join(" ");
+    let mut code = text.to_string();
+    for comment in Trivia::scan(text).comments {
+        let end = comment.start + comment.text.len();
+        code.replace_range(comment.start..end, &" ".repeat(comment.text.len()));
+    }
+    let Some(expr) = crate::syntax::parse_expression(&code) else { return collapsed(text) };
+    let arena = Arena::new();
+    let trivia = Trivia::scan(&code);
+    let mut printer = Printer { arena: &arena, source: &code, trivia, next: 0, mark: '\u{F8FF}', line_ended_at: None };
+    let mut rendered = String::new();
+    match printer.expr(&expr).1.render_fmt(usize::MAX / 2, &mut rendered) {
+        Ok(()) => collapsed(&rendered),
+        Err(_) => collapsed(text),
+    }
+}
+
 /// A formatter bug, reported instead of writing a changed program.
 fn internal(what: &str) -> Diagnostic {
     Diagnostic::bug(format!("internal error in the formatter: {what}"))
