@@ -1,18 +1,11 @@
 //! The formatter (`mrsl::format`, `mrslc fmt`): idempotent, and the
 //! formatted program is the same program, kernel for kernel, with every
 //! comment kept, on the examples, the corpus and generated programs; the
-//! examples and the `ok` corpus are committed formatted.
+//! examples and the corpus are committed formatted.
 
 use crate::wellformed::{self, Choices, SplitMix};
 use mrsl::internals::Lexer;
 use std::path::{Path, PathBuf};
-
-/// The `ok` corpus program left as written: its expressions are laid out by
-/// hand, twenty nested calls or ten nested `?:` a line, so that the nesting
-/// levels it tests can be counted; the canonical layout writes its 126
-/// nested calls on one line of 600 columns. It is still formatted below,
-/// and compiles to the same kernels formatted.
-const HAND_LAID: &str = "0052_nesting_at_the_limits.mrsl";
 
 fn programs(dir: &str) -> Vec<(PathBuf, String)> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
@@ -93,13 +86,15 @@ fn examples_and_ok_programs_format_to_the_same_kernels_and_layout() {
     }
 }
 
-/// The examples and the `ok` corpus are committed in the canonical layout:
-/// `mrslc fmt examples compiler/tests/data/ok` fixes a failure here.
+/// The examples and the corpus, `ok` and `err` (every program that parses),
+/// are committed in the canonical layout: `mrslc fmt examples
+/// compiler/tests/data` fixes a failure here.
 #[test]
-fn examples_and_ok_programs_are_formatted() {
+fn examples_and_the_corpus_are_formatted() {
     let mut unformatted = vec![];
-    for (path, source) in programs("../examples").into_iter().chain(programs("tests/data/ok")) {
-        if path.file_name().is_some_and(|n| n == HAND_LAID) {
+    let corpus = programs("tests/data/ok").into_iter().chain(programs("tests/data/err"));
+    for (path, source) in programs("../examples").into_iter().chain(corpus) {
+        if mrsl::internals::parse(&source).is_err() {
             continue;
         }
         if mrsl::format(&source).ok().as_ref() != Some(&source) {
@@ -109,12 +104,9 @@ fn examples_and_ok_programs_are_formatted() {
     assert!(unformatted.is_empty(), "not formatted (run `mrslc fmt` on them): {unformatted:#?}");
 }
 
-/// The `err` corpus stays as written: its snapshots hold each program and
-/// its rendered diagnostics, lines and columns included, and several cases
-/// are laid out to show the nesting they test. Every one that parses
-/// formats idempotently, with its comments, to a program with the same
-/// diagnostics (codes and messages, in order); one that does not parse is
-/// its syntax error.
+/// Every `err` program that parses formats idempotently, with its comments,
+/// to a program with the same diagnostics (codes and messages, in order);
+/// one that does not parse is its syntax error.
 #[test]
 fn err_programs_format_to_the_same_diagnostics() {
     let summary = |diagnostics: Vec<mrsl::Diagnostic>| -> Vec<(String, String)> {

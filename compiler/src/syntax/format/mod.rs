@@ -63,7 +63,11 @@ pub fn format(source: &str) -> Result<String, Diagnostic> {
     let doc = printer.program(&program);
     let mut rendered = String::new();
     doc.1.render_fmt(WIDTH, &mut rendered).map_err(|_| internal("the layout could not be rendered"))?;
-    let formatted = lines::finish(&rendered, mark);
+    let mut formatted = lines::finish(&rendered, mark);
+    // A byte order mark the file opens with stays (the lexer skips it).
+    if source.starts_with(crate::syntax::lexer::BOM) && !formatted.is_empty() {
+        formatted.insert(0, crate::syntax::lexer::BOM);
+    }
     verify::same_program(&program, &comments, &formatted).map_err(|what| internal(&what))?;
     Ok(formatted)
 }
