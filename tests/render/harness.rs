@@ -136,6 +136,22 @@ pub fn render_color(
     Output { pixels: gpu.read_rgba32f(&color).unwrap(), stats, width: size.0 }
 }
 
+/// Forced refinement evaluates every effect per pixel with the reference's
+/// code: each of `programs` (name, source), in every adaptive mode over the
+/// demo's G-buffer at an odd size, is bit-identical to its reference.
+pub fn assert_forced_equals_reference(gpu: &Gpu, programs: &[(&str, &str)]) {
+    let gbuffer = mrsl_lab::scene::Scene::Demo.render(75, 43);
+    for (name, source) in programs {
+        let program = compile(source);
+        let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
+        for mode in adaptive_modes() {
+            let forced = run(gpu, &program, &gbuffer, mode, true).unwrap();
+            let worst = worst_ulps(&forced.pixels, &reference.pixels);
+            assert_eq!(worst, 0, "{name} {mode}: forced refinement differs from the reference by up to {worst} ulps");
+        }
+    }
+}
+
 /// What one of [`dispatch_in_turn`]'s dispatches left.
 pub struct Dispatched {
     /// The first output, as RGBA floats.

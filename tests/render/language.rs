@@ -3,7 +3,7 @@
 //! limit force to the reference bit for bit, and a dynamic limit in the
 //! condition renders exactly as the same limit tested by a `break`.
 
-use crate::{adaptive_modes, run, worst_ulps};
+use crate::{run, worst_ulps};
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::scene::Scene;
 use mrsl_runtime::Mode;
@@ -23,16 +23,7 @@ const BREAKS: &str = "in float3 normal;\nin float2 uv;\nuniform int count = 5;\n
 
 /// Forced refinement evaluates every effect per pixel with the reference's code.
 pub fn new_forms_force_to_the_reference(gpu: &Gpu) {
-    let gbuffer = Scene::Demo.render(75, 43);
-    for (name, source) in [("0089", DEFAULTS), ("0090", LIMITS)] {
-        let program = crate::compile(source);
-        let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
-        for mode in adaptive_modes() {
-            let forced = run(gpu, &program, &gbuffer, mode, true).unwrap();
-            let worst = worst_ulps(&forced.pixels, &reference.pixels);
-            assert_eq!(worst, 0, "{name} {mode}: forced refinement differs from the reference by up to {worst} ulps");
-        }
-    }
+    crate::assert_forced_equals_reference(gpu, &[("0089", DEFAULTS), ("0090", LIMITS)]);
 }
 
 /// The same sums in the same order, whichever way the limit is written:

@@ -2,7 +2,7 @@
 //! taken by running the statements before the derivative again at the
 //! neighbouring position (`DerivSite::prefix`, docs/language.md section 9).
 
-use crate::{adaptive_modes, dispatch_in_turn, run, worst_ulps};
+use crate::dispatch_in_turn;
 use mrsl_abi::Device;
 use mrsl_lab::gpu::Gpu;
 use mrsl_lab::scene::Scene;
@@ -22,16 +22,7 @@ const PROGRAMS: [(&str, &str); 4] = [
 /// Forced refinement evaluates every effect per pixel with the reference's
 /// code, derivative prefixes included: bit-identical in every mode.
 pub fn loop_built_derivatives_force_to_the_reference(gpu: &Gpu) {
-    let gbuffer = Scene::Demo.render(75, 43);
-    for (name, source) in PROGRAMS {
-        let program = crate::compile(source);
-        let reference = run(gpu, &program, &gbuffer, Mode::Reference, false).unwrap();
-        for mode in adaptive_modes() {
-            let forced = run(gpu, &program, &gbuffer, mode, true).unwrap();
-            let worst = worst_ulps(&forced.pixels, &reference.pixels);
-            assert_eq!(worst, 0, "{name} {mode}: forced refinement differs from the reference by up to {worst} ulps");
-        }
-    }
+    crate::assert_forced_equals_reference(gpu, &PROGRAMS);
 }
 
 /// A loop-built sum differentiated in its effect's own predicate (0086)

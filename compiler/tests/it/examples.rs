@@ -10,17 +10,9 @@ use mrsl_abi::Rate;
 
 #[test]
 fn examples_compile_to_layouts_that_match_their_declarations() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
-    let mut paths: Vec<_> = std::fs::read_dir(&dir)
-        .expect("examples/ exists")
-        .map(|entry| entry.expect("examples/ is readable").path())
-        .filter(|path| path.extension().is_some_and(|e| e == "mrsl"))
-        .collect();
-    paths.sort();
-    assert!(paths.len() >= 6, "expected at least 6 example programs, found {}", paths.len());
-    for path in paths {
-        let name = path.file_name().unwrap().to_string_lossy().into_owned();
-        let source = std::fs::read_to_string(&path).expect("example is readable");
+    let examples = crate::examples();
+    assert!(examples.len() >= 6, "expected at least 6 example programs, found {}", examples.len());
+    for (name, source) in examples {
         let options = mrsl::Options { file_name: name.clone(), ..mrsl::Options::default() };
         let program = mrsl::compile(&source, &options)
             .unwrap_or_else(|d| panic!("{name} should compile:\n{}", mrsl::render_all(&d, &name, &source)));
