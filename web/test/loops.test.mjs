@@ -11,6 +11,7 @@ import { join } from 'node:path';
 import { loadGBuffer, loadProgram, MrslError, readTexture, Shader } from '../dist/index.js';
 import { testDevice } from './support/gpu.mjs';
 import { mrslc } from './support/mrslc.mjs';
+import { bytes } from './support/fixtures.mjs';
 
 /** A coarse effect that refines, and a uniform each view sets its own way (the Rust runtime's render test's program). */
 const PROGRAM = `in float3 normal;
@@ -39,11 +40,6 @@ let gpu;
 let dir;
 let program;
 const gbuffers = new Map();
-
-const bytes = async (path) => {
-  const b = await readFile(path);
-  return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength);
-};
 
 before(async () => {
   gpu = await testDevice();

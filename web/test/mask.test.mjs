@@ -11,18 +11,13 @@ import { join } from 'node:path';
 import { applyUniforms, decodeRefineMask, loadGBuffer, loadProgram, readTexture, refineHeatmap, refineMaskBit, Shader } from '../dist/index.js';
 import { testDevice } from './support/gpu.mjs';
 import { mrslc } from './support/mrslc.mjs';
-import { SIZE } from './support/fixtures.mjs';
+import { SIZE, bytes } from './support/fixtures.mjs';
 
 let gpu;
 let dir;
 let shader;
 let gbuffer;
 let rendered;
-
-const bytes = async (path) => {
-  const b = await readFile(path);
-  return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength);
-};
 
 before(async () => {
   gpu = await testDevice();

@@ -8,7 +8,7 @@ import { readFile } from 'node:fs/promises';
 import { join } from 'node:path';
 import { applyUniforms, loadGBuffer, loadProgram, MODES, readTexture, Shader, uniformRateImage } from '../dist/index.js';
 import { testDevice } from './support/gpu.mjs';
-import { cleanup, examples, fixturesRoot, makeFixtures, SIZE, UNIFORM_RATE } from './support/fixtures.mjs';
+import { SIZE, UNIFORM_RATE, bytes, cleanup, examples, fixturesRoot, makeFixtures } from './support/fixtures.mjs';
 import { compareImages, TOLERANCE } from './support/compare.mjs';
 
 const list = examples();
@@ -20,11 +20,6 @@ before(async () => {
   if (!gpu.skip) root = fixturesRoot();
 });
 after(() => cleanup(root));
-
-const bytes = async (path) => {
-  const b = await readFile(path);
-  return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength);
-};
 
 /** Renders `mode` and reads every output back, by name. */
 async function render(device, shader, gbuffer, mode, forceRefine) {

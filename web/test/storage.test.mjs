@@ -12,7 +12,7 @@ import { join } from 'node:path';
 import { applyUniforms, loadGBuffer, loadProgram, MODES, MrslError, readTexture, Shader, uniformRateImage } from '../dist/index.js';
 import { freshAdapter, testDevice } from './support/gpu.mjs';
 import { mrslc } from './support/mrslc.mjs';
-import { SIZE } from './support/fixtures.mjs';
+import { SIZE, bytes } from './support/fixtures.mjs';
 
 let gpu;
 let device;
@@ -20,11 +20,6 @@ let dir;
 let sampled;
 let storage;
 let gbuffer;
-
-const bytes = async (path) => {
-  const b = await readFile(path);
-  return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength);
-};
 
 before(async () => {
   gpu = await testDevice();

@@ -5,10 +5,17 @@
 // driver as Dawn (SwiftShader) where it is installed. Written under a
 // temporary directory, removed by `cleanup`.
 import { existsSync, mkdtempSync, readdirSync, rmSync } from 'node:fs';
+import { readFile } from 'node:fs/promises';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { mrslc, REPO } from './mrslc.mjs';
 import { SWIFTSHADER_ICD } from './gpu.mjs';
+
+/** A file's bytes as an `ArrayBuffer` (what `loadGBuffer` reads). */
+export async function bytes(path) {
+  const b = await readFile(path);
+  return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength);
+}
 
 /** The image size: odd on both axes, so every mode's partial tiles and blocks are exercised. */
 export const SIZE = [61, 37];
